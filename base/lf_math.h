@@ -1,0 +1,111 @@
+/* lf_math.h - small vector and transform math shared by every module.
+ *
+ * lf_vec3 is single precision (what Embree and the integrator use);
+ * lf_transform holds a 4x4 matrix and its inverse in double precision so that
+ * chains of scene transforms and camera set-up stay accurate at large scale.
+ * Matrices are row-major in memory: m[row][col], points are column vectors
+ * (p' = M p), as in pbrt.  pbrt's `Transform [..16..]` directive lists the
+ * matrix column-major; the parser transposes it.
+ */
+#ifndef LF_MATH_H
+#define LF_MATH_H
+
+#include <math.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LF_PI 3.14159265358979323846
+#define LF_INV_PI 0.31830988618379067154
+#define LF_INV_2PI 0.15915494309189533577
+#define LF_INV_4PI 0.07957747154594766788
+#define LF_ONE_MINUS_EPS 0x1.fffffep-1f
+
+typedef struct lf_vec3 {
+    float x, y, z;
+} lf_vec3;
+
+typedef struct lf_vec2 {
+    float x, y;
+} lf_vec2;
+
+typedef struct lf_dvec3 {
+    double x, y, z;
+} lf_dvec3;
+
+static inline lf_vec3 lf_v3(float x, float y, float z)
+{
+    lf_vec3 v = {x, y, z};
+    return v;
+}
+static inline lf_vec3 lf_add(lf_vec3 a, lf_vec3 b) { return lf_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lf_vec3 lf_sub(lf_vec3 a, lf_vec3 b) { return lf_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lf_vec3 lf_mul(lf_vec3 a, lf_vec3 b) { return lf_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+static inline lf_vec3 lf_scale(lf_vec3 a, float s) { return lf_v3(a.x * s, a.y * s, a.z * s); }
+static inline lf_vec3 lf_madd(lf_vec3 a, lf_vec3 b, float s) { return lf_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline lf_vec3 lf_neg(lf_vec3 a) { return lf_v3(-a.x, -a.y, -a.z); }
+static inline float lf_dot(lf_vec3 a, lf_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline float lf_absdot(lf_vec3 a, lf_vec3 b) { return fabsf(lf_dot(a, b)); }
+static inline lf_vec3 lf_cross(lf_vec3 a, lf_vec3 b)
+{
+    return lf_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline float lf_length(lf_vec3 a) { return sqrtf(lf_dot(a, a)); }
+static inline lf_vec3 lf_normalize(lf_vec3 a)
+{
+    float l = lf_length(a);
+    return l > 0.f ? lf_scale(a, 1.f / l) : a;
+}
+static inline float lf_maxc(lf_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+static inline float lf_luminance(lf_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+static inline int lf_is_black(lf_vec3 c) { return c.x == 0.f && c.y == 0.f && c.z == 0.f; }
+static inline float lf_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+static inline double lf_clampd(double v, double lo, double hi) { return v < lo ? lo : (v > hi ? hi : v); }
+static inline float lf_lerpf(float t, float a, float b) { return a + t * (b - a); }
+static inline float lf_radians(float deg) { return deg * (float)(LF_PI / 180.0); }
+
+/* Orthonormal basis around unit n (Duff et al. 2017, "Building an
+ * Orthonormal Basis, Revisited"). */
+static inline void lf_basis(lf_vec3 n, lf_vec3 *s, lf_vec3 *t)
+{
+    float sign = copysignf(1.f, n.z);
+    float a = -1.f / (sign + n.z);
+    float b = n.x * n.y * a;
+    *s = lf_v3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    *t = lf_v3(b, sign + n.y * n.y * a, -n.y);
+}
+
+typedef struct lf_transform {
+    double m[4][4];
+    double inv[4][4];
+} lf_transform;
+
+lf_transform lf_transform_identity(void);
+/* Builds from a row-major matrix; returns 0 and sets *out, or -1 if singular. */
+int lf_transform_from_matrix(const double m[4][4], lf_transform *out);
+lf_transform lf_transform_translate(double x, double y, double z);
+lf_transform lf_transform_scale(double x, double y, double z);
+/* Rotation by angle in degrees about axis (pbrt's Rotate). */
+lf_transform lf_transform_rotate(double angle_deg, double ax, double ay, double az);
+/* pbrt's LookAt: returns the world-to-camera transform.  Returns -1 if the
+ * up vector is parallel to the viewing direction or eye == look. */
+int lf_transform_look_at(const double eye[3], const double look[3], const double up[3], lf_transform *out);
+lf_transform lf_transform_compose(const lf_transform *a, const lf_transform *b); /* a * b */
+lf_transform lf_transform_inverse(const lf_transform *t);
+int lf_transform_is_identity(const lf_transform *t);
+/* True if the transform swaps handedness (negative determinant of 3x3). */
+int lf_transform_swaps_handedness(const lf_transform *t);
+
+lf_dvec3 lf_xform_point_d(const lf_transform *t, lf_dvec3 p);
+lf_dvec3 lf_xform_vector_d(const lf_transform *t, lf_dvec3 v);
+lf_vec3 lf_xform_point(const lf_transform *t, lf_vec3 p);
+lf_vec3 lf_xform_vector(const lf_transform *t, lf_vec3 v);
+/* Normals transform by the inverse transpose. */
+lf_vec3 lf_xform_normal(const lf_transform *t, lf_vec3 n);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

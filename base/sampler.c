@@ -1,0 +1,131 @@
+#include "lf_sampler.h"
+
+/* 32-bit integer hash (Chris Wellons' "lowbias32" finaliser). */
+uint32_t lf_hash_u32(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint32_t lf_hash_combine(uint32_t a, uint32_t b)
+{
+    return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));
+}
+
+static uint32_t reverse_bits(uint32_t x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/* Laine-Karras style hash that only lets each bit depend on lower bits;
+ * applied to bit-reversed values it is a nested uniform (Owen) scramble
+ * (Burley 2020, improved constants from Nathan Vegdahl's analysis). */
+static uint32_t lk_permute(uint32_t x, uint32_t seed)
+{
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+
+static uint32_t owen_scramble(uint32_t x, uint32_t seed)
+{
+    return reverse_bits(lk_permute(reverse_bits(x), seed));
+}
+
+/* First two Sobol dimensions: dimension 0 is the van der Corput sequence
+ * (bit reversal); dimension 1 has direction numbers v_k = v_{k-1} ^ (v_{k-1} >> 1). */
+static uint32_t sobol_dim1(uint32_t i)
+{
+    uint32_t v = 0x80000000u, x = 0;
+    for (; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u)
+            x ^= v;
+    return x;
+}
+
+static float to_unit(uint32_t x)
+{
+    float f = (float)(x >> 8) * 0x1p-24f;
+    return f;
+}
+
+void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
+{
+    st->s = s;
+    st->pixel_hash = lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
+    st->index = index;
+    st->dim = 0;
+}
+
+static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
+{
+    uint32_t pair = st->dim >> 1;
+    st->dim += 2;
+    uint32_t h = lf_hash_combine(st->pixel_hash, pair);
+    switch (st->s->kind) {
+    case LF_SAMPLER_SOBOL: {
+        uint32_t i = owen_scramble(st->index, h);
+        *a = owen_scramble(reverse_bits(i), lf_hash_u32(h ^ 0xa511e9b3u));
+        *b = owen_scramble(sobol_dim1(i), lf_hash_u32(h ^ 0x63d83595u));
+        return;
+    }
+    case LF_SAMPLER_STRATIFIED: {
+        uint32_t nx = (uint32_t)st->s->strata_x, ny = (uint32_t)st->s->strata_y, n = nx * ny;
+        /* A random permutation of the strata: index -> stratum via a
+         * bijective hash on [0, n) by cycle-walking on the next power of two. */
+        uint32_t mask = 1;
+        while (mask < n)
+            mask <<= 1;
+        mask -= 1;
+        uint32_t k = st->index % n;
+        do {
+            k = (lk_permute(k, h) ^ (h >> 7)) & mask;
+        } while (k >= n);
+        uint32_t jx = lf_hash_combine(h, st->index * 2u + 1u), jy = lf_hash_combine(h, st->index * 2u + 2u);
+        double fx = ((k % nx) + (jx >> 8) * 0x1p-24) / nx;
+        double fy = ((k / nx) + (jy >> 8) * 0x1p-24) / ny;
+        *a = (uint32_t)(fx * 4294967296.0);
+        *b = (uint32_t)(fy * 4294967296.0);
+        return;
+    }
+    case LF_SAMPLER_INDEPENDENT:
+    default:
+        *a = lf_hash_combine(h, st->index * 2u);
+        *b = lf_hash_combine(h, st->index * 2u + 1u);
+        return;
+    }
+}
+
+float lf_sample_1d(lf_sample_stream *st)
+{
+    uint32_t a, b;
+    sample_pair(st, &a, &b);
+    return to_unit(a);
+}
+
+void lf_sample_2d(lf_sample_stream *st, float *u0, float *u1)
+{
+    uint32_t a, b;
+    sample_pair(st, &a, &b);
+    *u0 = to_unit(a);
+    *u1 = to_unit(b);
+}
+
+void lf_sample_2d_d(lf_sample_stream *st, double *u0, double *u1)
+{
+    uint32_t a, b;
+    sample_pair(st, &a, &b);
+    *u0 = (a + 0.5) * 0x1p-32;
+    *u1 = (b + 0.5) * 0x1p-32;
+}

@@ -1,0 +1,37 @@
+/* Private helpers shared by the built-in cameras. */
+#ifndef LF_CAMERA_INTERNAL_H
+#define LF_CAMERA_INTERNAL_H
+
+#include <math.h>
+
+#include "lf_camera.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* Shirley-Chiu concentric mapping of [0,1)^2 onto the unit disk: area
+ * preserving, so a uniform sample stays uniform and strata stay compact. */
+static inline void lf_cam_concentric_disk(double u, double v, double *x, double *y)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        *x = *y = 0.0;
+        return;
+    }
+    double r, th;
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        th = (M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        th = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
+    }
+    *x = r * cos(th);
+    *y = r * sin(th);
+}
+
+extern const lf_camera_type lf_camera_perspective;
+extern const lf_camera_type lf_camera_orthographic;
+
+#endif

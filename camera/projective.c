@@ -1,0 +1,166 @@
+/* pbrt-v4's projective cameras: "perspective" and "orthographic".
+ *
+ * Both map a raster position to the screen window (pbrt: [-aspect, aspect] x
+ * [-1, 1] for wide images, [-1, 1] x [-1/aspect, 1/aspect] for tall ones, so
+ * "fov" spans the SHORTER image axis), raster (0,0) at the top-left corner,
+ * screen y up.  With a lens radius > 0 the ray starts on a disk of that
+ * radius at the camera origin and is aimed at the point the pinhole ray hits
+ * on the plane z = focaldistance (pbrt-v4 PerspectiveCamera::GenerateRay).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera_internal.h"
+
+typedef struct projective {
+    int orthographic;
+    double screen[4];        /* x0 x1 y0 y1 */
+    double tan_half_fov;     /* perspective: tan(fov/2) */
+    double fov_deg;
+    double lens_radius, focal_distance;
+    int width, height;
+    double sx, sy;           /* screen units per pixel */
+} projective;
+
+static int projective_create(const lf_camera_create_args *a, void **state, int ortho)
+{
+    const lf_camera_params *p = a->params;
+    projective *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(a->error, a->error_size, "out of memory");
+        return -1;
+    }
+    c->orthographic = ortho;
+    c->width = a->image_width;
+    c->height = a->image_height;
+    double aspect = p->get_float(p->ctx, "frameaspectratio", (double)a->image_width / a->image_height);
+    if (!(aspect > 0.0) || !isfinite(aspect)) {
+        snprintf(a->error, a->error_size, "\"frameaspectratio\" must be positive, got %g", aspect);
+        free(c);
+        return -1;
+    }
+    if (aspect > 1.0) {
+        c->screen[0] = -aspect, c->screen[1] = aspect, c->screen[2] = -1.0, c->screen[3] = 1.0;
+    } else {
+        c->screen[0] = -1.0, c->screen[1] = 1.0, c->screen[2] = -1.0 / aspect, c->screen[3] = 1.0 / aspect;
+    }
+    double sw[4];
+    int n = p->get_floats(p->ctx, "screenwindow", sw, 4);
+    if (n == 4) {
+        memcpy(c->screen, sw, sizeof sw);
+    } else if (n != 0) {
+        snprintf(a->error, a->error_size, "\"screenwindow\" needs 4 values (x0 x1 y0 y1), got %d", n);
+        free(c);
+        return -1;
+    }
+    if (!ortho) {
+        c->fov_deg = p->get_float(p->ctx, "fov", 90.0);
+        if (!(c->fov_deg > 0.0 && c->fov_deg < 180.0)) {
+            snprintf(a->error, a->error_size, "\"fov\" must be in (0, 180) degrees, got %g", c->fov_deg);
+            free(c);
+            return -1;
+        }
+        c->tan_half_fov = tan(c->fov_deg * 0.5 * M_PI / 180.0);
+    }
+    c->lens_radius = p->get_float(p->ctx, "lensradius", 0.0);
+    c->focal_distance = p->get_float(p->ctx, "focaldistance", 1e6);
+    if (!(c->lens_radius >= 0.0) || !isfinite(c->lens_radius)) {
+        snprintf(a->error, a->error_size, "\"lensradius\" must be >= 0, got %g", c->lens_radius);
+        free(c);
+        return -1;
+    }
+    if (!(c->focal_distance > 0.0) || !isfinite(c->focal_distance)) {
+        snprintf(a->error, a->error_size, "\"focaldistance\" must be > 0, got %g", c->focal_distance);
+        free(c);
+        return -1;
+    }
+    c->sx = (c->screen[1] - c->screen[0]) / c->width;
+    c->sy = (c->screen[3] - c->screen[2]) / c->height;
+    *state = c;
+    return 0;
+}
+
+static int perspective_create(const lf_camera_create_args *a, void **state)
+{
+    return projective_create(a, state, 0);
+}
+
+static int orthographic_create(const lf_camera_create_args *a, void **state)
+{
+    return projective_create(a, state, 1);
+}
+
+static uint32_t projective_needs(const void *state)
+{
+    const projective *c = state;
+    return c->lens_radius > 0.0 ? LF_CAMERA_NEEDS_LENS : 0u;
+}
+
+static double projective_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+{
+    const projective *c = state;
+    /* raster -> screen: x grows right, y grows up from the bottom edge. */
+    double px = c->screen[0] + s->film_x * c->sx;
+    double py = c->screen[3] - s->film_y * c->sy;
+    double o[3], d[3];
+    if (c->orthographic) {
+        o[0] = px, o[1] = py, o[2] = 0.0;
+        d[0] = 0.0, d[1] = 0.0, d[2] = 1.0;
+    } else {
+        o[0] = o[1] = o[2] = 0.0;
+        d[0] = px * c->tan_half_fov, d[1] = py * c->tan_half_fov, d[2] = 1.0;
+        double inv = 1.0 / sqrt(d[0] * d[0] + d[1] * d[1] + 1.0);
+        d[0] *= inv, d[1] *= inv, d[2] *= inv;
+    }
+    if (c->lens_radius > 0.0) {
+        double lx, ly;
+        lf_cam_concentric_disk(s->lens_u, s->lens_v, &lx, &ly);
+        lx *= c->lens_radius, ly *= c->lens_radius;
+        double ft = c->focal_distance / d[2];
+        double f[3] = {o[0] + d[0] * ft, o[1] + d[1] * ft, o[2] + d[2] * ft};
+        o[0] += lx, o[1] += ly;
+        d[0] = f[0] - o[0], d[1] = f[1] - o[1], d[2] = f[2] - o[2];
+        double inv = 1.0 / sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        d[0] *= inv, d[1] *= inv, d[2] *= inv;
+    }
+    memcpy(r->origin, o, sizeof o);
+    memcpy(r->dir, d, sizeof d);
+    return 1.0;
+}
+
+static void projective_destroy(void *state)
+{
+    free(state);
+}
+
+static int projective_describe(const void *state, char *buf, size_t size)
+{
+    const projective *c = state;
+    int n;
+    if (c->orthographic)
+        n = snprintf(buf, size, "model: orthographic, screen window [%g %g] x [%g %g] camera units\n", c->screen[0],
+                     c->screen[1], c->screen[2], c->screen[3]);
+    else
+        n = snprintf(buf, size,
+                     "model: pinhole projection, fov %g deg across the shorter image axis\n"
+                     "focal length in pixels: %.6g\n",
+                     c->fov_deg, (c->width < c->height ? c->width : c->height) * 0.5 / c->tan_half_fov);
+    if (n < 0 || (size_t)n >= size)
+        return n;
+    if (c->lens_radius > 0.0)
+        n += snprintf(buf + n, size - n, "defocus: thin lens, radius %g, focal distance %g (pbrt semantics)\n",
+                      c->lens_radius, c->focal_distance);
+    else
+        n += snprintf(buf + n, size - n, "defocus: none (lensradius 0: no lens samples drawn)\n");
+    return n;
+}
+
+const lf_camera_type lf_camera_perspective = {
+    LF_CAMERA_ABI_VERSION, "perspective", perspective_create, projective_needs, projective_generate_ray,
+    projective_destroy, projective_describe};
+
+const lf_camera_type lf_camera_orthographic = {
+    LF_CAMERA_ABI_VERSION, "orthographic", orthographic_create, projective_needs, projective_generate_ray,
+    projective_destroy, projective_describe};

@@ -1,0 +1,90 @@
+/* The camera registry: built-ins are rows of a static table; plugins loaded
+ * at run time are appended to a second table with the same row type. */
+#include <dlfcn.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "camera_internal.h"
+
+static const lf_camera_type *const builtin[] = {
+    &lf_camera_perspective,
+    &lf_camera_orthographic,
+};
+#define N_BUILTIN ((int)(sizeof builtin / sizeof builtin[0]))
+
+enum { MAX_PLUGIN_TYPES = 64 };
+static const lf_camera_type *plugin_types[MAX_PLUGIN_TYPES];
+static int n_plugin_types;
+
+int lf_camera_count(void)
+{
+    return N_BUILTIN + n_plugin_types;
+}
+
+const lf_camera_type *lf_camera_at(int i)
+{
+    if (i < 0 || i >= lf_camera_count())
+        return NULL;
+    return i < N_BUILTIN ? builtin[i] : plugin_types[i - N_BUILTIN];
+}
+
+const lf_camera_type *lf_camera_find(const char *name)
+{
+    for (int i = 0; i < lf_camera_count(); i++)
+        if (strcmp(lf_camera_at(i)->name, name) == 0)
+            return lf_camera_at(i);
+    return NULL;
+}
+
+typedef const lf_camera_type *const *(*plugin_entry_fn)(int *count);
+
+int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
+{
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        snprintf(err, err_size, "cannot load camera plugin %s: %s", path, dlerror());
+        return -1;
+    }
+    plugin_entry_fn entry;
+    *(void **)&entry = dlsym(h, "lf_camera_plugin_types");
+    if (!entry) {
+        snprintf(err, err_size, "camera plugin %s does not export lf_camera_plugin_types()", path);
+        dlclose(h);
+        return -1;
+    }
+    int count = 0;
+    const lf_camera_type *const *types = entry(&count);
+    if (!types || count <= 0) {
+        snprintf(err, err_size, "camera plugin %s registers no camera types", path);
+        dlclose(h);
+        return -1;
+    }
+    for (int i = 0; i < count; i++) {
+        const lf_camera_type *t = types[i];
+        if (!t || t->abi_version != LF_CAMERA_ABI_VERSION) {
+            snprintf(err, err_size, "camera plugin %s: type %d has ABI version %u, this lfrender needs %u", path, i,
+                     t ? t->abi_version : 0u, LF_CAMERA_ABI_VERSION);
+            dlclose(h);
+            return -1;
+        }
+        if (!t->name || !t->create || !t->generate_ray || !t->destroy || !t->needs) {
+            snprintf(err, err_size, "camera plugin %s: type %d lacks a name or a required function", path, i);
+            dlclose(h);
+            return -1;
+        }
+        if (lf_camera_find(t->name)) {
+            snprintf(err, err_size, "camera plugin %s: a camera named \"%s\" is already registered", path, t->name);
+            dlclose(h);
+            return -1;
+        }
+    }
+    if (n_plugin_types + count > MAX_PLUGIN_TYPES) {
+        snprintf(err, err_size, "camera plugin %s: too many plugin camera types (limit %d)", path, MAX_PLUGIN_TYPES);
+        dlclose(h);
+        return -1;
+    }
+    for (int i = 0; i < count; i++)
+        plugin_types[n_plugin_types++] = types[i];
+    /* The handle stays open for the life of the process: the types live in it. */
+    return 0;
+}

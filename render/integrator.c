@@ -1,0 +1,143 @@
+/* Unidirectional path tracing with next-event estimation and multiple
+ * importance sampling (power heuristic), Russian roulette and maxdepth,
+ * following pbrt-v4's PathIntegrator so that scenes converge to the same
+ * images.  Per bounce the sampler dimensions are: light choice, light
+ * position, BSDF lobe, BSDF direction, roulette. */
+#include <math.h>
+
+#include "render_internal.h"
+
+static float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    if (isinf(a2))
+        return 1.f;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
+}
+
+static double light_pmf(const lf_scene *s, int light)
+{
+    return lf_distrib1d_pmf(&s->light_distrib, light);
+}
+
+/* Direct lighting at a non-specular surface: one light sample, MIS-weighted. */
+static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo,
+                             lf_sample_stream *st, long long *rays)
+{
+    float ul = lf_sample_1d(st), u0, u1;
+    lf_sample_2d(st, &u0, &u1);
+    if (s->n_lights == 0)
+        return lf_v3(0, 0, 0);
+    double pmf, ur;
+    int li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
+    (void)ur;
+    if (!(pmf > 0))
+        return lf_v3(0, 0, 0);
+    const lf_light *l = &s->lights[li];
+    lf_light_sample ls;
+    if (!lf_light_sample_li(s, l, h->sc.p, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
+        return lf_v3(0, 0, 0);
+    lf_vec3 f = lf_bsdf_f(bsdf, wo, ls.wi);
+    float cosi = lf_absdot(ls.wi, h->sc.ns);
+    if (lf_is_black(f) || cosi == 0)
+        return lf_v3(0, 0, 0);
+    lf_vec3 o = lf_offset_origin(h->sc.p, h->sc.ng, ls.wi);
+    float tmax = isinf(ls.dist) ? INFINITY : ls.dist * (1.f - 1e-4f);
+    (*rays)++;
+    if (lf_scene_occluded(s, o, ls.wi, tmax))
+        return lf_v3(0, 0, 0);
+    float p_l = (float)pmf * ls.pdf;
+    float w = 1.f;
+    if (!ls.delta)
+        w = power_heuristic(p_l, lf_bsdf_pdf(bsdf, wo, ls.wi));
+    return lf_scale(lf_mul(f, ls.Li), cosi * w / p_l);
+}
+
+lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, lf_sample_stream *st,
+                   long long *rays)
+{
+    lf_vec3 L = lf_v3(0, 0, 0), beta = lf_v3(1, 1, 1);
+    int depth = 0, specular_bounce = 0;
+    float p_b = 1.f, eta_scale = 1.f;
+    lf_vec3 prev_p = o;
+    int passes = 0;
+    for (;;) {
+        lf_hit h;
+        (*rays)++;
+        if (!lf_scene_intersect(s, o, d, INFINITY, &h)) {
+            for (int k = 0; k < s->n_infinite; k++) {
+                const lf_light *l = &s->lights[s->infinite_lights[k]];
+                lf_vec3 Le = lf_light_infinite_le(l, d);
+                if (lf_is_black(Le))
+                    continue;
+                if (depth == 0 || specular_bounce) {
+                    L = lf_add(L, lf_mul(beta, Le));
+                } else {
+                    float p_l = (float)light_pmf(s, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
+                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
+                }
+            }
+            break;
+        }
+        lf_vec3 wo = lf_neg(d);
+        if (h.light >= 0) {
+            const lf_light *l = &s->lights[h.light];
+            lf_vec3 Le = lf_light_area_le(l, &h, d);
+            if (!lf_is_black(Le)) {
+                if (depth == 0 || specular_bounce) {
+                    L = lf_add(L, lf_mul(beta, Le));
+                } else {
+                    float p_l = (float)light_pmf(s, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
+                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
+                }
+            }
+        }
+        const lf_material *mat = lf_materials_get(s->materials, h.material);
+        if (lf_material_is_interface(mat)) {
+            /* No surface here (pbrt "interface"): continue the ray unchanged. */
+            o = lf_offset_origin(h.sc.p, h.sc.ng, d);
+            if (++passes > 256)
+                break;
+            continue;
+        }
+        if (depth++ == in->max_depth)
+            break;
+        lf_bsdf bsdf;
+        lf_material_bsdf(mat, &h.sc, &bsdf);
+        if (!lf_bsdf_is_specular(&bsdf))
+            L = lf_add(L, lf_mul(beta, sample_direct(s, &h, &bsdf, wo, st, rays)));
+        else {
+            /* keep the dimension layout fixed per bounce */
+            float a, b;
+            (void)lf_sample_1d(st);
+            lf_sample_2d(st, &a, &b);
+        }
+        float uc = lf_sample_1d(st), u0, u1;
+        lf_sample_2d(st, &u0, &u1);
+        struct lf_bsdf_sample bs;
+        if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
+            break;
+        float cosi = lf_absdot(bs.wi, h.sc.ns);
+        beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
+        p_b = bs.pdf;
+        specular_bounce = bs.specular;
+        if (bs.transmission && bs.eta > 0)
+            eta_scale *= bs.eta * bs.eta;
+        prev_p = h.sc.p;
+        o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
+        d = bs.wi;
+        /* Russian roulette (pbrt-v4: after depth 1, on beta * eta_scale). */
+        float rr = lf_sample_1d(st);
+        lf_vec3 rr_beta = lf_scale(beta, eta_scale);
+        float m = lf_maxc(rr_beta);
+        if (m < 1.f && depth > 1) {
+            float q = fmaxf(0.f, 1.f - m);
+            if (rr < q)
+                break;
+            beta = lf_scale(beta, 1.f / (1.f - q));
+        }
+        if (!(lf_maxc(beta) > 0))
+            break;
+    }
+    return L;
+}

@@ -1,0 +1,74 @@
+/* lf_render.h - the host renderer: scene description in, image out.
+ *
+ *   lf_scene_desc desc;               // from lf_scene_parse_file()
+ *   lf_render_opts o = lf_render_opts_default();
+ *   lf_renderer *r;
+ *   if (lf_renderer_create(&desc, &o, &r, &err)) ...   // builds everything, checks every parameter
+ *   char *plan = lf_renderer_explain(r);               // the effect plan (--explain)
+ *   lf_image img; lf_attrs meta = {0};
+ *   lf_renderer_render(r, &img, &meta, &err);          // linear radiance + lensfield:* metadata
+ *   lf_renderer_free(r);
+ *
+ * Rendering is deterministic for a seed: every sample is a function of
+ * (seed, pixel, sample index) and every pixel is accumulated by one thread in
+ * sample order, so the thread count never changes a bit of the result.
+ */
+#ifndef LF_RENDER_H
+#define LF_RENDER_H
+
+#include <stdint.h>
+
+#include "../base/lf_error.h"
+#include "../image/lf_image.h"
+#include "lf_scene_desc.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef void (*lf_progress_fn)(void *ctx, long done, long total);
+
+typedef struct lf_render_opts {
+    int spp;              /* 0: the Sampler's "pixelsamples" */
+    int threads;          /* 0: all cores */
+    uint32_t seed;        /* used when has_seed; otherwise the Sampler's "seed" */
+    int has_seed;
+    int crop[4];          /* pixel bounds x0 x1 y0 y1 (half-open); crop[1] <= crop[0]: none */
+    lf_progress_fn progress;
+    void *progress_ctx;
+    const char *scene_path; /* for metadata and the camera's scene_dir */
+} lf_render_opts;
+
+lf_render_opts lf_render_opts_default(void);
+
+typedef struct lf_renderer lf_renderer;
+
+/* Builds the camera, film, sampler, materials, lights and the Embree scene.
+ * Every parameter the scene wrote must be read by someone, or this fails
+ * with the file:line:col of the first unused one. */
+int lf_renderer_create(lf_scene_desc *desc, const lf_render_opts *opts, lf_renderer **out, lf_error *err);
+/* Non-fatal notes gathered while building ("file:line:col: warning: ..."), or NULL. */
+const char *lf_renderer_warnings(const lf_renderer *r);
+/* The effect plan: camera model, which effects are simulated and why. malloc'ed. */
+char *lf_renderer_explain(const lf_renderer *r);
+/* Renders into *img (allocated here; the crop window's size) and fills meta
+ * with lensfield:* attributes.  Samples whose radiance is NaN/Inf are
+ * dropped and counted (lensfield:nonfinite_samples, lf_renderer_stats). */
+int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err);
+/* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
+const char *lf_renderer_film_filename(const lf_renderer *r);
+
+typedef struct lf_render_stats {
+    long long camera_paths;      /* samples traced */
+    long long rays;              /* all rays (camera, bounce, shadow) */
+    long long nonfinite_samples; /* dropped NaN/Inf samples */
+    long long zero_weight_camera_rays;
+    double seconds;
+} lf_render_stats;
+lf_render_stats lf_renderer_stats(const lf_renderer *r);
+void lf_renderer_free(lf_renderer *r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

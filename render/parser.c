@@ -1,0 +1,1967 @@
+/* parser.c - the pbrt-v4 scene-file reader (see lf_scene_desc.h).
+ *
+ * A hand-written tokenizer feeds a table of directive handlers that keep
+ * pbrt-v4's graphics state (BasicSceneBuilder in pbrt-v4's scene.cpp): two
+ * CTMs, attribute stack, named coordinate systems, materials, textures and
+ * object instances.  Every error names file:line:col; the first error stops
+ * the parse and everything built so far is freed.
+ *
+ * Where lensfield deliberately differs from pbrt-v4 (all documented at the
+ * handler): Include paths are relative to the including file; TransformBegin
+ * saves only the CTMs (pbrt-v3 semantics, which is what files that still use
+ * it expect); WorldEnd, ColorSpace, Option, MakeNamedMedium and
+ * MediumInterface are accepted with a warning; an unclosed AttributeBegin is
+ * a warning.
+ */
+#include "lf_scene_desc.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#define MAX_INCLUDE_DEPTH 64
+
+/* ------------------------------------------------------------------------ */
+/* Small utilities                                                          */
+
+static char *dup_range(const char *s, size_t n)
+{
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, s, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static char *dup_cstr(const char *s) { return dup_range(s, strlen(s)); }
+
+/* Grows *arr so that it holds at least count + 1 elements. */
+static int grow(void **arr, size_t *cap, size_t count, size_t elem)
+{
+    if (count < *cap)
+        return 0;
+    size_t ncap = *cap ? *cap * 2 : 8;
+    void *p = realloc(*arr, ncap * elem);
+    if (!p)
+        return -1;
+    *arr = p;
+    *cap = ncap;
+    return 0;
+}
+
+/* String -> int map with borrowed keys (the names live in the description
+ * or in the parser), open addressing; for named materials, textures,
+ * objects and coordinate systems, which large scenes have thousands of. */
+typedef struct strmap {
+    const char **keys;
+    int *vals;
+    size_t cap, count;
+} strmap;
+
+static uint64_t hash_str(const char *s)
+{
+    uint64_t h = 1469598103934665603ull; /* FNV-1a */
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211ull;
+    return h;
+}
+
+static int strmap_get(const strmap *m, const char *key)
+{
+    if (!m->cap)
+        return -1;
+    for (size_t i = hash_str(key) & (m->cap - 1);; i = (i + 1) & (m->cap - 1)) {
+        if (!m->keys[i])
+            return -1;
+        if (strcmp(m->keys[i], key) == 0)
+            return m->vals[i];
+    }
+}
+
+static int strmap_put(strmap *m, const char *key, int val);
+
+static int strmap_rehash(strmap *m, size_t ncap)
+{
+    strmap n = {calloc(ncap, sizeof *n.keys), calloc(ncap, sizeof *n.vals), ncap, 0};
+    if (!n.keys || !n.vals) {
+        free(n.keys);
+        free(n.vals);
+        return -1;
+    }
+    for (size_t i = 0; i < m->cap; i++)
+        if (m->keys[i])
+            strmap_put(&n, m->keys[i], m->vals[i]);
+    free(m->keys);
+    free(m->vals);
+    *m = n;
+    return 0;
+}
+
+/* Inserts or replaces. */
+static int strmap_put(strmap *m, const char *key, int val)
+{
+    if (2 * (m->count + 1) > m->cap && strmap_rehash(m, m->cap ? 2 * m->cap : 16))
+        return -1;
+    size_t i = hash_str(key) & (m->cap - 1);
+    while (m->keys[i] && strcmp(m->keys[i], key) != 0)
+        i = (i + 1) & (m->cap - 1);
+    if (!m->keys[i])
+        m->count++;
+    m->keys[i] = key;
+    m->vals[i] = val;
+    return 0;
+}
+
+static void strmap_free(strmap *m)
+{
+    free(m->keys);
+    free(m->vals);
+    memset(m, 0, sizeof *m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Tokenizer                                                                */
+
+typedef enum tok_kind { TK_EOF, TK_STRING, TK_NUMBER, TK_WORD, TK_LBRACK, TK_RBRACK } tok_kind;
+
+typedef struct token {
+    tok_kind kind;
+    const char *s; /* raw text; for strings, between the quotes, escapes undecoded */
+    size_t n;
+    double num;    /* TK_NUMBER */
+    int escaped;   /* TK_STRING contains a backslash */
+    lf_loc loc;
+} token;
+
+typedef struct lexer {
+    const char *text;
+    size_t len, pos;
+    int line, col;
+    const char *file; /* kept in the description's strings */
+    const char *dir;  /* directory of file, for Include and plymesh paths */
+    token peeked;
+    int has_peek;
+} lexer;
+
+typedef struct parser parser;
+static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static int lx_getc(lexer *L)
+{
+    if (L->pos >= L->len)
+        return EOF;
+    int c = (unsigned char)L->text[L->pos++];
+    if (c == '\n') {
+        L->line++;
+        L->col = 1;
+    } else {
+        L->col++;
+    }
+    return c;
+}
+
+static int lx_peekc(const lexer *L) { return L->pos < L->len ? (unsigned char)L->text[L->pos] : EOF; }
+
+static int is_space(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+
+static int is_escape_char(int c) { return c && strchr("bfnrt\\'\"", c) != NULL; }
+
+static int lex_scan(parser *P, lexer *L, token *t)
+{
+    for (;;) {
+        int c = lx_peekc(L);
+        if (c == EOF) {
+            memset(t, 0, sizeof *t);
+            t->kind = TK_EOF;
+            t->loc = (lf_loc){L->file, L->line, L->col};
+            return LF_OK;
+        }
+        if (is_space(c)) {
+            lx_getc(L);
+            continue;
+        }
+        if (c == '#') {
+            while ((c = lx_peekc(L)) != EOF && c != '\n' && c != '\r')
+                lx_getc(L);
+            continue;
+        }
+        break;
+    }
+    memset(t, 0, sizeof *t);
+    t->loc = (lf_loc){L->file, L->line, L->col};
+    size_t start = L->pos;
+    int c = lx_getc(L);
+    if (c == '[' || c == ']') {
+        t->kind = c == '[' ? TK_LBRACK : TK_RBRACK;
+        t->s = L->text + start;
+        t->n = 1;
+        return LF_OK;
+    }
+    if (c == '"') {
+        t->kind = TK_STRING;
+        t->s = L->text + L->pos;
+        for (;;) {
+            c = lx_getc(L);
+            if (c == EOF)
+                return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: end of file before the closing '\"'");
+            if (c == '\n')
+                return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: newline before the closing '\"'");
+            if (c == '"')
+                break;
+            if (c == '\\') {
+                int e = lx_getc(L);
+                if (!is_escape_char(e))
+                    return perr(P, LF_ERR_PARSE, &t->loc,
+                                e == EOF ? "unterminated string: end of file after '\\'"
+                                         : "unknown escape sequence in string");
+                t->escaped = 1;
+            }
+        }
+        t->n = (size_t)(L->text + L->pos - 1 - t->s);
+        return LF_OK;
+    }
+    /* Bare token: a directive, a number, or true/false. */
+    while ((c = lx_peekc(L)) != EOF && !is_space(c) && c != '"' && c != '[' && c != ']' && c != '#')
+        lx_getc(L);
+    t->s = L->text + start;
+    t->n = L->pos - start;
+    char first = t->s[0];
+    if (isdigit((unsigned char)first) || first == '-' || first == '+' || first == '.') {
+        char buf[128];
+        if (t->n >= sizeof buf)
+            return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%.40s...\"", t->s);
+        memcpy(buf, t->s, t->n);
+        buf[t->n] = '\0';
+        char *end;
+        errno = 0;
+        double v = strtod(buf, &end);
+        if (end == buf || *end)
+            return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%s\"", buf);
+        if (!isfinite(v))
+            return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%s\"", buf);
+        t->kind = TK_NUMBER;
+        t->num = v;
+        return LF_OK;
+    }
+    t->kind = TK_WORD;
+    return LF_OK;
+}
+
+static int lex_next(parser *P, lexer *L, token *t)
+{
+    if (L->has_peek) {
+        *t = L->peeked;
+        L->has_peek = 0;
+        return LF_OK;
+    }
+    return lex_scan(P, L, t);
+}
+
+static int lex_peek(parser *P, lexer *L, token *t)
+{
+    if (!L->has_peek) {
+        int rc = lex_scan(P, L, &L->peeked);
+        if (rc)
+            return rc;
+        L->has_peek = 1;
+    }
+    *t = L->peeked;
+    return LF_OK;
+}
+
+/* The decoded contents of a string token (malloc'ed), or NULL (no memory). */
+static char *tok_string(const token *t)
+{
+    char *d = malloc(t->n + 1);
+    if (!d)
+        return NULL;
+    size_t j = 0;
+    for (size_t i = 0; i < t->n; i++) {
+        char c = t->s[i];
+        if (c == '\\' && i + 1 < t->n) {
+            c = t->s[++i];
+            switch (c) {
+            case 'b': c = '\b'; break;
+            case 'f': c = '\f'; break;
+            case 'n': c = '\n'; break;
+            case 'r': c = '\r'; break;
+            case 't': c = '\t'; break;
+            default: break; /* \\ \' \" stand for themselves */
+            }
+        }
+        d[j++] = c;
+    }
+    d[j] = '\0';
+    return d;
+}
+
+static int tok_is(const token *t, const char *word)
+{
+    size_t n = strlen(word);
+    return t->n == n && memcmp(t->s, word, n) == 0;
+}
+
+/* What a token is, for messages: `string "abc"`, `number 3`, `"Shape"`. */
+static const char *describe(const token *t, char *buf, size_t size)
+{
+    int n = t->n > 40 ? 40 : (int)t->n;
+    const char *more = t->n > 40 ? "..." : "";
+    switch (t->kind) {
+    case TK_EOF: snprintf(buf, size, "end of file"); break;
+    case TK_STRING: snprintf(buf, size, "string \"%.*s%s\"", n, t->s, more); break;
+    case TK_NUMBER: snprintf(buf, size, "number %.*s%s", n, t->s, more); break;
+    case TK_WORD: snprintf(buf, size, "\"%.*s%s\"", n, t->s, more); break;
+    case TK_LBRACK: snprintf(buf, size, "'['"); break;
+    case TK_RBRACK: snprintf(buf, size, "']'"); break;
+    }
+    return buf;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Parser state                                                             */
+
+enum { ATTR_SHAPE, ATTR_LIGHT, ATTR_MATERIAL, ATTR_MEDIUM, ATTR_TEXTURE, ATTR_COUNT };
+static const char *const attr_targets[ATTR_COUNT] = {"shape", "light", "material", "medium", "texture"};
+
+/* pbrt-v4's GraphicsState, less what lensfield ignores (media, colour space). */
+typedef struct gstate {
+    lf_transform ctm[2];
+    int active[2];
+    int material;   /* >= 0: index; -1: none; <= -2: NamedMaterial reference -2 - material */
+    int area_light; /* index into area_lights, or -1 */
+    int reverse_orientation;
+    lf_paramset attrs[ATTR_COUNT];
+} gstate;
+
+typedef struct pushed {
+    char kind; /* 'a' AttributeBegin, 'o' ObjectBegin, 't' TransformBegin */
+    lf_loc loc;
+    gstate saved; /* for 't' only ctm and active are meaningful, attrs empty */
+} pushed;
+
+typedef struct named_ref { /* a name resolved after the whole scene is read */
+    char *name;
+    lf_loc loc;
+} named_ref;
+
+typedef struct coord_sys {
+    char *name;
+    lf_transform xf[2];
+} coord_sys;
+
+struct parser {
+    lf_scene_desc *d;
+    lf_error *err;
+    gstate gs;
+    pushed *stack;
+    size_t n_stack, cap_stack;
+    int world;          /* inside the world block */
+    int current_object; /* ObjectBegin being defined, or -1 */
+
+    coord_sys *coordsys;
+    size_t n_coordsys, cap_coordsys;
+    strmap coordsys_map, material_map, float_tex_map, spectrum_tex_map, object_map;
+
+    named_ref *material_refs; /* NamedMaterial uses */
+    size_t n_material_refs, cap_material_refs;
+    named_ref *instance_refs; /* parallel to d->instances */
+    size_t cap_instance_refs;
+
+    size_t cap_strings, cap_textures, cap_materials, cap_lights, cap_area_lights, cap_shapes, cap_objects,
+        cap_instances;
+    size_t warnings_len, warnings_cap;
+    int include_depth;
+    int warned_transform_begin;
+};
+
+static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
+{
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (loc)
+        return lf_error_set(P->err, code, "%s:%d:%d: %s", loc->file ? loc->file : "<unknown>", loc->line,
+                            loc->col, msg);
+    return lf_error_set(P->err, code, "%s", msg);
+}
+
+static int nomem(parser *P) { return lf_error_set(P->err, LF_ERR_NOMEM, "out of memory while parsing the scene"); }
+
+static void pwarn(parser *P, const lf_loc *loc, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void pwarn(parser *P, const lf_loc *loc, const char *fmt, ...)
+{
+    char msg[900], line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    int n = snprintf(line, sizeof line, "%s:%d:%d: warning: %s\n", loc->file, loc->line, loc->col, msg);
+    if (n < 0)
+        return;
+    size_t len = (size_t)n < sizeof line ? (size_t)n : sizeof line - 1;
+    lf_scene_desc *d = P->d;
+    if (P->warnings_len + len + 1 > P->warnings_cap) {
+        size_t cap = P->warnings_cap ? P->warnings_cap : 256;
+        while (cap < P->warnings_len + len + 1)
+            cap *= 2;
+        char *w = realloc(d->warnings, cap);
+        if (!w)
+            return; /* a lost warning is not worth failing the parse */
+        d->warnings = w;
+        P->warnings_cap = cap;
+    }
+    memcpy(d->warnings + P->warnings_len, line, len + 1);
+    P->warnings_len += len;
+}
+
+/* Keeps a copy of s alive as long as the description (file names for
+ * lf_loc, base directories). */
+static const char *keep_string(parser *P, const char *s)
+{
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->strings, &P->cap_strings, d->n_strings, sizeof *d->strings))
+        return NULL;
+    char *c = dup_cstr(s);
+    if (!c)
+        return NULL;
+    d->strings[d->n_strings++] = c;
+    return c;
+}
+
+static void gstate_free(gstate *g)
+{
+    for (int i = 0; i < ATTR_COUNT; i++)
+        lf_params_free(&g->attrs[i]);
+}
+
+static int gstate_copy(gstate *dst, const gstate *src)
+{
+    *dst = *src;
+    for (int i = 0; i < ATTR_COUNT; i++)
+        memset(&dst->attrs[i], 0, sizeof dst->attrs[i]);
+    for (int i = 0; i < ATTR_COUNT; i++)
+        if (lf_params_copy(&dst->attrs[i], &src->attrs[i])) {
+            gstate_free(dst);
+            return -1;
+        }
+    return 0;
+}
+
+static lf_anim_xform current_xform(const parser *P)
+{
+    lf_anim_xform a;
+    a.xf[0] = P->gs.ctm[0];
+    a.xf[1] = P->gs.ctm[1];
+    a.time[0] = P->d->transform_start_time;
+    a.time[1] = P->d->transform_end_time;
+    a.animated = memcmp(a.xf[0].m, a.xf[1].m, sizeof a.xf[0].m) != 0;
+    return a;
+}
+
+/* CTM = CTM * t for each active CTM (pbrt's ForActiveTransforms). */
+static void apply_transform(parser *P, const lf_transform *t)
+{
+    for (int i = 0; i < 2; i++)
+        if (P->gs.active[i])
+            P->gs.ctm[i] = lf_transform_compose(&P->gs.ctm[i], t);
+}
+
+static void set_transform(parser *P, const lf_transform *t)
+{
+    for (int i = 0; i < 2; i++)
+        if (P->gs.active[i])
+            P->gs.ctm[i] = *t;
+}
+
+static int set_coordsys(parser *P, const char *name, const lf_transform xf[2])
+{
+    int idx = strmap_get(&P->coordsys_map, name);
+    if (idx >= 0) {
+        P->coordsys[idx].xf[0] = xf[0];
+        P->coordsys[idx].xf[1] = xf[1];
+        return LF_OK;
+    }
+    if (grow((void **)&P->coordsys, &P->cap_coordsys, P->n_coordsys, sizeof *P->coordsys))
+        return nomem(P);
+    coord_sys *c = &P->coordsys[P->n_coordsys];
+    if (!(c->name = dup_cstr(name)))
+        return nomem(P);
+    c->xf[0] = xf[0];
+    c->xf[1] = xf[1];
+    if (strmap_put(&P->coordsys_map, c->name, (int)P->n_coordsys)) {
+        free(c->name);
+        return nomem(P);
+    }
+    P->n_coordsys++;
+    return LF_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Arguments and parameter lists                                            */
+
+static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *out)
+{
+    for (int i = 0; i < n; i++) {
+        token t;
+        int rc = lex_next(P, L, &t);
+        if (rc)
+            return rc;
+        if (t.kind != TK_NUMBER) {
+            char b[96];
+            return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects %d numbers, got %s after %d", (int)dir->n, dir->s, n,
+                        describe(&t, b, sizeof b), i);
+        }
+        out[i] = t.num;
+    }
+    return LF_OK;
+}
+
+/* Reads one quoted string argument of directive `dir` into *out (malloc'ed). */
+static int expect_string(parser *P, lexer *L, const token *dir, const char *what, char **out, lf_loc *loc)
+{
+    token t;
+    int rc = lex_next(P, L, &t);
+    if (rc)
+        return rc;
+    if (t.kind != TK_STRING) {
+        char b[96];
+        return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects a quoted string (%s), got %s", (int)dir->n, dir->s, what,
+                    describe(&t, b, sizeof b));
+    }
+    if (!(*out = tok_string(&t)))
+        return nomem(P);
+    if (loc)
+        *loc = t.loc;
+    return LF_OK;
+}
+
+/* What kind of value each parameter type takes. */
+typedef enum value_class { VC_NUMBER, VC_STRING, VC_BOOL, VC_SPECTRUM } value_class;
+
+static value_class class_of(lf_param_type t)
+{
+    switch (t) {
+    case LF_PT_STRING:
+    case LF_PT_TEXTURE: return VC_STRING;
+    case LF_PT_BOOL: return VC_BOOL;
+    case LF_PT_SPECTRUM: return VC_SPECTRUM;
+    default: return VC_NUMBER;
+    }
+}
+
+typedef struct value_acc {
+    double *nums;
+    size_t n_nums, cap_nums;
+    char **strs;
+    size_t n_strs, cap_strs;
+    unsigned char *bools;
+    size_t n_bools, cap_bools;
+} value_acc;
+
+static void acc_free(value_acc *a)
+{
+    free(a->nums);
+    for (size_t i = 0; i < a->n_strs; i++)
+        free(a->strs[i]);
+    free(a->strs);
+    free(a->bools);
+    memset(a, 0, sizeof *a);
+}
+
+static int is_nonfinite_word(const token *t)
+{
+    static const char *const words[] = {"nan", "inf", "infinity"};
+    for (size_t i = 0; i < 3; i++)
+        if (t->n == strlen(words[i]) && strncasecmp(t->s, words[i], t->n) == 0)
+            return 1;
+    return 0;
+}
+
+/* Adds one value token to the parameter being read, checking it against the
+ * declared type. */
+static int add_value(parser *P, const token *t, lf_param_type type, const char *decl, value_acc *a)
+{
+    char b[96];
+    value_class vc = class_of(type);
+    if (t->kind == TK_WORD && is_nonfinite_word(t))
+        return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%.*s\" in parameter \"%s\"", (int)t->n, t->s,
+                    decl);
+    int is_bool_word = t->kind == TK_WORD && (tok_is(t, "true") || tok_is(t, "false"));
+    if (t->kind == TK_NUMBER) {
+        if (vc != VC_NUMBER && vc != VC_SPECTRUM)
+            return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" expects %s, got %s", decl,
+                        vc == VC_BOOL ? "true or false" : "a quoted string", describe(t, b, sizeof b));
+        if (vc == VC_SPECTRUM && a->n_strs)
+            return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" mixes a spectrum name and numbers", decl);
+        if (type == LF_PT_INTEGER && (t->num != floor(t->num) || fabs(t->num) > 2147483647.0))
+            return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" expects integers, got %s", decl,
+                        describe(t, b, sizeof b));
+        if (grow((void **)&a->nums, &a->cap_nums, a->n_nums, sizeof *a->nums))
+            return nomem(P);
+        a->nums[a->n_nums++] = t->num;
+        return LF_OK;
+    }
+    if (t->kind == TK_STRING) {
+        char *s = tok_string(t);
+        if (!s)
+            return nomem(P);
+        if (vc == VC_BOOL) { /* pbrt-v4 also accepts "true" and "false" quoted */
+            int v = strcmp(s, "true") == 0 ? 1 : strcmp(s, "false") == 0 ? 0 : -1;
+            free(s);
+            if (v < 0)
+                return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" expects true or false, got %s", decl,
+                            describe(t, b, sizeof b));
+            if (grow((void **)&a->bools, &a->cap_bools, a->n_bools, 1))
+                return nomem(P);
+            a->bools[a->n_bools++] = (unsigned char)v;
+            return LF_OK;
+        }
+        if (vc == VC_NUMBER || (vc == VC_SPECTRUM && (a->n_nums || a->n_strs))) {
+            free(s);
+            if (vc == VC_SPECTRUM)
+                return perr(P, LF_ERR_PARSE, &t->loc,
+                            "parameter \"%s\" expects (wavelength, value) pairs or one spectrum name, got %s", decl,
+                            describe(t, b, sizeof b));
+            return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" expects numbers, got %s", decl,
+                        describe(t, b, sizeof b));
+        }
+        if (grow((void **)&a->strs, &a->cap_strs, a->n_strs, sizeof *a->strs)) {
+            free(s);
+            return nomem(P);
+        }
+        a->strs[a->n_strs++] = s;
+        return LF_OK;
+    }
+    if (is_bool_word) {
+        if (vc != VC_BOOL)
+            return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\" expects %s, got %s", decl,
+                        vc == VC_STRING ? "a quoted string" : "numbers", describe(t, b, sizeof b));
+        if (grow((void **)&a->bools, &a->cap_bools, a->n_bools, 1))
+            return nomem(P);
+        a->bools[a->n_bools++] = tok_is(t, "true");
+        return LF_OK;
+    }
+    return perr(P, LF_ERR_PARSE, &t->loc, "parameter \"%s\": expected a value, got %s", decl, describe(t, b, sizeof b));
+}
+
+/* Value-count rules pbrt-v4 enforces when it builds a ParameterDictionary. */
+static int check_count(parser *P, const lf_loc *loc, lf_param_type type, const char *decl, const value_acc *a)
+{
+    size_t n = a->n_nums;
+    switch (type) {
+    case LF_PT_POINT2:
+    case LF_PT_VECTOR2:
+        if (n % 2)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" has %zu values, not a multiple of 2", decl, n);
+        break;
+    case LF_PT_POINT3:
+    case LF_PT_VECTOR3:
+    case LF_PT_NORMAL3:
+        if (n % 3)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" has %zu values, not a multiple of 3", decl, n);
+        break;
+    case LF_PT_RGB:
+        if (n != 3)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 3 values, got %zu", decl, n);
+        break;
+    case LF_PT_BLACKBODY:
+        if (n != 1)
+            return perr(P, LF_ERR_PARSE, loc,
+                        "parameter \"%s\" needs 1 value (temperature in kelvin; pbrt-v3's scale is gone), got %zu",
+                        decl, n);
+        break;
+    case LF_PT_SPECTRUM:
+        if (a->n_strs == 0 && (n < 2 || n % 2))
+            return perr(P, LF_ERR_PARSE, loc,
+                        "parameter \"%s\" needs (wavelength, value) pairs or one spectrum name, got %zu numbers", decl,
+                        n);
+        break;
+    case LF_PT_TEXTURE:
+        if (a->n_strs != 1)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 1 texture name, got %zu", decl, a->n_strs);
+        break;
+    default: break;
+    }
+    return LF_OK;
+}
+
+/* Splits a "type name" declaration. */
+static int split_decl(parser *P, const token *t, const char *decl, lf_param_type *type, char **name)
+{
+    const char *p = decl;
+    while (*p == ' ' || *p == '\t')
+        p++;
+    const char *type_b = p;
+    while (*p && *p != ' ' && *p != '\t')
+        p++;
+    const char *type_e = p;
+    while (*p == ' ' || *p == '\t')
+        p++;
+    const char *name_b = p;
+    while (*p && *p != ' ' && *p != '\t')
+        p++;
+    const char *name_e = p;
+    while (*p == ' ' || *p == '\t')
+        p++;
+    if (type_b == type_e || name_b == name_e || *p)
+        return perr(P, LF_ERR_PARSE, &t->loc, "malformed parameter declaration \"%s\": expected \"type name\"", decl);
+    char word[64];
+    size_t tn = (size_t)(type_e - type_b);
+    if (tn >= sizeof word)
+        tn = sizeof word - 1;
+    memcpy(word, type_b, tn);
+    word[tn] = '\0';
+    if (lf_param_type_from_name(word, type))
+        return perr(P, LF_ERR_PARSE, &t->loc, "unknown parameter type \"%s\" in \"%s\"", word, decl);
+    if (!(*name = dup_range(name_b, (size_t)(name_e - name_b))))
+        return nomem(P);
+    return LF_OK;
+}
+
+/* Reads the parameter list that follows a directive's fixed arguments:
+ * pairs of "type name" and a value or [ values ], up to the next token that
+ * is not a quoted string. */
+static int parse_params(parser *P, lexer *L, lf_paramset *out)
+{
+    for (;;) {
+        token t;
+        int rc = lex_peek(P, L, &t);
+        if (rc)
+            return rc;
+        if (t.kind != TK_STRING)
+            return LF_OK;
+        lex_next(P, L, &t);
+        char *decl = tok_string(&t);
+        if (!decl)
+            return nomem(P);
+        lf_param_type type;
+        char *name = NULL;
+        if ((rc = split_decl(P, &t, decl, &type, &name))) {
+            free(decl);
+            return rc;
+        }
+        value_acc a = {0};
+        token v;
+        if ((rc = lex_next(P, L, &v)))
+            goto fail;
+        if (v.kind == TK_LBRACK) {
+            token open = v;
+            for (;;) {
+                if ((rc = lex_next(P, L, &v)))
+                    goto fail;
+                if (v.kind == TK_RBRACK)
+                    break;
+                if (v.kind == TK_EOF) {
+                    rc = perr(P, LF_ERR_PARSE, &open.loc, "unclosed '[' in parameter \"%s\": end of file before ']'",
+                              decl);
+                    goto fail;
+                }
+                if (v.kind == TK_LBRACK || (v.kind == TK_WORD && !tok_is(&v, "true") && !tok_is(&v, "false") &&
+                                            !is_nonfinite_word(&v))) {
+                    char b[96];
+                    rc = perr(P, LF_ERR_PARSE, &v.loc, "expected a value or ']' to close the '[' at %d:%d, got %s",
+                              open.loc.line, open.loc.col, describe(&v, b, sizeof b));
+                    goto fail;
+                }
+                if ((rc = add_value(P, &v, type, decl, &a)))
+                    goto fail;
+            }
+        } else if (v.kind == TK_NUMBER || v.kind == TK_STRING ||
+                   (v.kind == TK_WORD && (tok_is(&v, "true") || tok_is(&v, "false") || is_nonfinite_word(&v)))) {
+            if ((rc = add_value(P, &v, type, decl, &a)))
+                goto fail;
+        } else {
+            char b[96];
+            rc = perr(P, LF_ERR_PARSE, &v.loc, "parameter \"%s\" has no value: expected a value or '[', got %s", decl,
+                      describe(&v, b, sizeof b));
+            goto fail;
+        }
+        if ((rc = check_count(P, &t.loc, type, decl, &a)))
+            goto fail;
+        lf_param p = {0};
+        p.type = type;
+        p.name = name;
+        p.nums = a.nums;
+        p.n_nums = a.n_nums;
+        p.strs = a.strs;
+        p.n_strs = a.n_strs;
+        p.bools = a.bools;
+        p.n_bools = a.n_bools;
+        p.loc = t.loc;
+        if (lf_params_add(out, &p)) {
+            rc = nomem(P);
+            goto fail;
+        }
+        free(decl);
+        continue;
+    fail:
+        acc_free(&a);
+        free(name);
+        free(decl);
+        return rc;
+    }
+}
+
+/* "type" params: the common shape of Shape, Camera, Material, ... */
+static int parse_entity(parser *P, lexer *L, const token *dir, const char *what, lf_entity *e)
+{
+    memset(e, 0, sizeof *e);
+    e->loc = dir->loc;
+    int rc = expect_string(P, L, dir, what, &e->type, NULL);
+    if (!rc)
+        rc = parse_params(P, L, &e->params);
+    return rc;
+}
+
+/* Frees what one parameter owns (lf_params_free does this for whole sets). */
+static void param_release(lf_param *p)
+{
+    free(p->name);
+    free(p->nums);
+    for (size_t k = 0; k < p->n_strs; k++)
+        free(p->strs[k]);
+    free(p->strs);
+    free(p->bools);
+    memset(p, 0, sizeof *p);
+}
+
+static void entity_free(lf_entity *e)
+{
+    free(e->type);
+    lf_params_free(&e->params);
+    memset(e, 0, sizeof *e);
+}
+
+/* pbrt-v4's VERIFY_OPTIONS / VERIFY_WORLD. */
+static int require_options(parser *P, const token *dir)
+{
+    if (P->world)
+        return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s not allowed inside world block (after WorldBegin)",
+                    (int)dir->n, dir->s);
+    return LF_OK;
+}
+
+static int require_world(parser *P, const token *dir)
+{
+    if (!P->world)
+        return perr(P, LF_ERR_PARSE, &dir->loc,
+                    "%.*s not allowed before WorldBegin (scene description must be inside the world block)",
+                    (int)dir->n, dir->s);
+    return LF_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Directive handlers                                                       */
+
+typedef int (*directive_fn)(parser *P, lexer *L, const token *dir);
+
+static int parse_text(parser *P, const char *text, size_t len, const char *file, const char *dir, lf_loc *eof);
+
+static int d_identity(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    (void)dir;
+    lf_transform id = lf_transform_identity();
+    set_transform(P, &id);
+    return LF_OK;
+}
+
+static int d_translate(parser *P, lexer *L, const token *dir)
+{
+    double v[3];
+    int rc = expect_numbers(P, L, dir, 3, v);
+    if (rc)
+        return rc;
+    lf_transform t = lf_transform_translate(v[0], v[1], v[2]);
+    apply_transform(P, &t);
+    return LF_OK;
+}
+
+static int d_scale(parser *P, lexer *L, const token *dir)
+{
+    double v[3];
+    int rc = expect_numbers(P, L, dir, 3, v);
+    if (rc)
+        return rc;
+    lf_transform t = lf_transform_scale(v[0], v[1], v[2]);
+    apply_transform(P, &t);
+    return LF_OK;
+}
+
+static int d_rotate(parser *P, lexer *L, const token *dir)
+{
+    double v[4];
+    int rc = expect_numbers(P, L, dir, 4, v);
+    if (rc)
+        return rc;
+    lf_transform t = lf_transform_rotate(v[0], v[1], v[2], v[3]);
+    apply_transform(P, &t);
+    return LF_OK;
+}
+
+static int d_lookat(parser *P, lexer *L, const token *dir)
+{
+    double v[9];
+    int rc = expect_numbers(P, L, dir, 9, v);
+    if (rc)
+        return rc;
+    lf_transform t;
+    if (lf_transform_look_at(v, v + 3, v + 6, &t))
+        return perr(P, LF_ERR_PARSE, &dir->loc,
+                    "LookAt: eye equals look, or the up vector is parallel to the viewing direction");
+    apply_transform(P, &t);
+    return LF_OK;
+}
+
+/* Transform / ConcatTransform: 16 numbers listed column-major (pbrt
+ * transposes them), normally inside [ ]; the brackets are optional here. */
+static int read_matrix(parser *P, lexer *L, const token *dir, lf_transform *out)
+{
+    token t;
+    int rc = lex_peek(P, L, &t);
+    if (rc)
+        return rc;
+    int bracketed = t.kind == TK_LBRACK;
+    if (bracketed)
+        lex_next(P, L, &t);
+    double v[16];
+    char b[96];
+    for (int i = 0; i < 16; i++) {
+        if ((rc = lex_next(P, L, &t)))
+            return rc;
+        if (t.kind != TK_NUMBER) {
+            if (bracketed && t.kind == TK_RBRACK)
+                return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects 16 numbers, got %d", (int)dir->n, dir->s, i);
+            return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects 16 numbers, got %s after %d", (int)dir->n, dir->s,
+                        describe(&t, b, sizeof b), i);
+        }
+        v[i] = t.num;
+    }
+    if (bracketed) {
+        if ((rc = lex_next(P, L, &t)))
+            return rc;
+        if (t.kind != TK_RBRACK)
+            return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects 16 numbers: expected ']' after them, got %s",
+                        (int)dir->n, dir->s, describe(&t, b, sizeof b));
+    }
+    double m[4][4];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++)
+            m[r][c] = v[c * 4 + r];
+    if (lf_transform_from_matrix(m, out)) {
+        /* pbrt-v4 keeps a singular matrix and fills its inverse with NaN. */
+        memcpy(out->m, m, sizeof m);
+        for (int r = 0; r < 4; r++)
+            for (int c = 0; c < 4; c++)
+                out->inv[r][c] = NAN;
+        pwarn(P, &dir->loc, "%.*s: the matrix is singular", (int)dir->n, dir->s);
+    }
+    return LF_OK;
+}
+
+static int d_transform(parser *P, lexer *L, const token *dir)
+{
+    lf_transform t;
+    int rc = read_matrix(P, L, dir, &t);
+    if (!rc)
+        set_transform(P, &t);
+    return rc;
+}
+
+static int d_concat_transform(parser *P, lexer *L, const token *dir)
+{
+    lf_transform t;
+    int rc = read_matrix(P, L, dir, &t);
+    if (!rc)
+        apply_transform(P, &t);
+    return rc;
+}
+
+static int d_coordinate_system(parser *P, lexer *L, const token *dir)
+{
+    char *name;
+    int rc = expect_string(P, L, dir, "a coordinate system name", &name, NULL);
+    if (rc)
+        return rc;
+    rc = set_coordsys(P, name, P->gs.ctm);
+    free(name);
+    return rc;
+}
+
+static int d_coordsys_transform(parser *P, lexer *L, const token *dir)
+{
+    char *name;
+    lf_loc loc;
+    int rc = expect_string(P, L, dir, "a coordinate system name", &name, &loc);
+    if (rc)
+        return rc;
+    int idx = strmap_get(&P->coordsys_map, name);
+    if (idx >= 0) {
+        /* Both CTMs, whatever ActiveTransform says (pbrt-v4). */
+        P->gs.ctm[0] = P->coordsys[idx].xf[0];
+        P->gs.ctm[1] = P->coordsys[idx].xf[1];
+    } else {
+        pwarn(P, &loc, "couldn't find named coordinate system \"%s\"", name);
+    }
+    free(name);
+    return LF_OK;
+}
+
+static int d_transform_times(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_options(P, dir);
+    double v[2];
+    if (!rc)
+        rc = expect_numbers(P, L, dir, 2, v);
+    if (rc)
+        return rc;
+    P->d->transform_start_time = v[0];
+    P->d->transform_end_time = v[1];
+    return LF_OK;
+}
+
+static int d_active_transform(parser *P, lexer *L, const token *dir)
+{
+    token t;
+    int rc = lex_next(P, L, &t);
+    if (rc)
+        return rc;
+    if (t.kind == TK_WORD && tok_is(&t, "All")) {
+        P->gs.active[0] = P->gs.active[1] = 1;
+    } else if (t.kind == TK_WORD && tok_is(&t, "StartTime")) {
+        P->gs.active[0] = 1;
+        P->gs.active[1] = 0;
+    } else if (t.kind == TK_WORD && tok_is(&t, "EndTime")) {
+        P->gs.active[0] = 0;
+        P->gs.active[1] = 1;
+    } else {
+        char b[96];
+        return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects StartTime, EndTime or All, got %s", (int)dir->n, dir->s,
+                    describe(&t, b, sizeof b));
+    }
+    return LF_OK;
+}
+
+static int d_reverse_orientation(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    int rc = require_world(P, dir);
+    if (!rc)
+        P->gs.reverse_orientation = !P->gs.reverse_orientation;
+    return rc;
+}
+
+static int push_state(parser *P, char kind, const lf_loc *loc)
+{
+    if (grow((void **)&P->stack, &P->cap_stack, P->n_stack, sizeof *P->stack))
+        return nomem(P);
+    pushed *e = &P->stack[P->n_stack];
+    e->kind = kind;
+    e->loc = *loc;
+    if (kind == 't') {
+        memset(&e->saved, 0, sizeof e->saved);
+        e->saved.ctm[0] = P->gs.ctm[0];
+        e->saved.ctm[1] = P->gs.ctm[1];
+        e->saved.active[0] = P->gs.active[0];
+        e->saved.active[1] = P->gs.active[1];
+    } else if (gstate_copy(&e->saved, &P->gs)) {
+        return nomem(P);
+    }
+    P->n_stack++;
+    return LF_OK;
+}
+
+static const char *block_name(char kind)
+{
+    return kind == 'a' ? "AttributeBegin" : kind == 'o' ? "ObjectBegin" : "TransformBegin";
+}
+
+/* Pops the innermost block, which must have been opened by `kind`. */
+static int pop_state(parser *P, char kind, const token *dir)
+{
+    if (P->n_stack == 0)
+        return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s without a matching %s", (int)dir->n, dir->s, block_name(kind));
+    pushed *e = &P->stack[P->n_stack - 1];
+    if (e->kind != kind)
+        return perr(P, LF_ERR_PARSE, &dir->loc, "mismatched nesting: %.*s closes the %s at %s:%d:%d", (int)dir->n,
+                    dir->s, block_name(e->kind), e->loc.file, e->loc.line, e->loc.col);
+    if (kind == 't') {
+        P->gs.ctm[0] = e->saved.ctm[0];
+        P->gs.ctm[1] = e->saved.ctm[1];
+        P->gs.active[0] = e->saved.active[0];
+        P->gs.active[1] = e->saved.active[1];
+    } else {
+        gstate_free(&P->gs);
+        P->gs = e->saved;
+    }
+    P->n_stack--;
+    return LF_OK;
+}
+
+static int d_attribute_begin(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    int rc = require_world(P, dir);
+    return rc ? rc : push_state(P, 'a', &dir->loc);
+}
+
+static int d_attribute_end(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    int rc = require_world(P, dir);
+    return rc ? rc : pop_state(P, 'a', dir);
+}
+
+/* Deprecated since pbrt-v4.  lensfield keeps pbrt-v3's meaning: only the
+ * CTMs (and which of them are active) are saved and restored. */
+static int d_transform_begin(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    if (!P->warned_transform_begin) {
+        pwarn(P, &dir->loc, "TransformBegin/End are deprecated; use AttributeBegin/End");
+        P->warned_transform_begin = 1;
+    }
+    return push_state(P, 't', &dir->loc);
+}
+
+static int d_transform_end(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    return pop_state(P, 't', dir);
+}
+
+static int d_attribute(parser *P, lexer *L, const token *dir)
+{
+    char *target;
+    lf_loc loc;
+    int rc = expect_string(P, L, dir, "shape, light, material, medium or texture", &target, &loc);
+    if (rc)
+        return rc;
+    int which = -1;
+    for (int i = 0; i < ATTR_COUNT; i++)
+        if (strcmp(target, attr_targets[i]) == 0)
+            which = i;
+    if (which < 0) {
+        rc = perr(P, LF_ERR_PARSE, &loc,
+                  "unknown attribute target \"%s\": must be \"shape\", \"light\", \"material\", \"medium\" or "
+                  "\"texture\"",
+                  target);
+        free(target);
+        return rc;
+    }
+    free(target);
+    lf_paramset ps = {0};
+    if ((rc = parse_params(P, L, &ps))) {
+        lf_params_free(&ps);
+        return rc;
+    }
+    /* A later Attribute overrides an earlier one of the same name.  Items
+     * move from ps to attrs one at a time; ps keeps what has not moved. */
+    lf_paramset *attrs = &P->gs.attrs[which];
+    for (size_t i = 0; i < ps.count; i++) {
+        lf_param *p = &ps.items[i];
+        size_t j;
+        for (j = 0; j < attrs->count; j++)
+            if (strcmp(attrs->items[j].name, p->name) == 0)
+                break;
+        if (j < attrs->count) {
+            param_release(&attrs->items[j]);
+            attrs->items[j] = *p;
+        } else if (lf_params_add(attrs, p)) {
+            lf_params_free(&ps);
+            return nomem(P);
+        }
+        memset(p, 0, sizeof *p);
+        p->name = NULL;
+    }
+    lf_params_free(&ps);
+    return LF_OK;
+}
+
+static int d_world_begin(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    int rc = require_options(P, dir);
+    if (rc)
+        return rc;
+    P->world = 1;
+    P->gs.ctm[0] = P->gs.ctm[1] = lf_transform_identity();
+    P->gs.active[0] = P->gs.active[1] = 1;
+    return set_coordsys(P, "world", P->gs.ctm);
+}
+
+static int d_world_end(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    pwarn(P, &dir->loc, "WorldEnd is pbrt-v3 syntax and is ignored");
+    return LF_OK;
+}
+
+static int join_path(const char *dir, const char *rel, char **out)
+{
+    if (rel[0] == '/' || !dir || !dir[0] || strcmp(dir, ".") == 0) {
+        *out = dup_cstr(rel);
+    } else {
+        size_t n = strlen(dir) + strlen(rel) + 2;
+        *out = malloc(n);
+        if (*out)
+            snprintf(*out, n, "%s/%s", dir, rel);
+    }
+    return *out ? 0 : -1;
+}
+
+/* The directory part of path: "a/b/c.pbrt" -> "a/b", "c.pbrt" -> ".". */
+static char *dir_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        return dup_cstr(".");
+    if (slash == path)
+        return dup_cstr("/");
+    return dup_range(path, (size_t)(slash - path));
+}
+
+static int read_whole_file(const char *path, char **text, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return -1;
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    for (;;) {
+        if (!buf) {
+            fclose(f);
+            errno = ENOMEM;
+            return -1;
+        }
+        n += fread(buf + n, 1, cap - n, f);
+        if (n < cap)
+            break;
+        cap *= 2;
+        char *nb = realloc(buf, cap);
+        if (!nb)
+            free(buf);
+        buf = nb;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        errno = EIO;
+        return -1;
+    }
+    *text = buf;
+    *len = n;
+    return 0;
+}
+
+/* Parses `path` with the current graphics state, as if its text stood in
+ * place of the directive.  `from` is where the Include was written (NULL for
+ * the top-level file). */
+static int parse_path(parser *P, const char *path, const lf_loc *from, lf_loc *eof)
+{
+    char *text;
+    size_t len;
+    if (read_whole_file(path, &text, &len)) {
+        if (from)
+            return perr(P, LF_ERR_IO, from, "cannot open included file \"%s\": %s", path, strerror(errno));
+        return perr(P, LF_ERR_IO, NULL, "cannot open scene file \"%s\": %s", path, strerror(errno));
+    }
+    char *dir = dir_of(path);
+    const char *kept_file = keep_string(P, path);
+    const char *kept_dir = dir ? keep_string(P, dir) : NULL;
+    free(dir);
+    int rc;
+    if (!kept_file || !kept_dir)
+        rc = nomem(P);
+    else
+        rc = parse_text(P, text, len, kept_file, kept_dir, eof);
+    free(text);
+    return rc;
+}
+
+/* Include and Import: pbrt-v4 resolves the name against the directory of the
+ * main scene file; lensfield uses the directory of the including file,
+ * which is the same for the common single-directory layout and also works
+ * for nested directories.  Import is read like Include (pbrt-v4 parses it in
+ * parallel; the result is the same). */
+static int d_include(parser *P, lexer *L, const token *dir)
+{
+    char *name;
+    int rc = expect_string(P, L, dir, "a file name", &name, NULL);
+    if (rc)
+        return rc;
+    if (tok_is(dir, "Import") && !P->world) {
+        free(name);
+        return perr(P, LF_ERR_PARSE, &dir->loc, "Import is only allowed inside the world block");
+    }
+    if (P->include_depth >= MAX_INCLUDE_DEPTH) {
+        free(name);
+        return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s nested more than %d deep (does a file include itself?)",
+                    (int)dir->n, dir->s, MAX_INCLUDE_DEPTH);
+    }
+    char *path;
+    if (join_path(L->dir, name, &path)) {
+        free(name);
+        return nomem(P);
+    }
+    free(name);
+    P->include_depth++;
+    rc = parse_path(P, path, &dir->loc, NULL);
+    P->include_depth--;
+    free(path);
+    return rc;
+}
+
+/* Camera, Film, Sampler, Integrator, PixelFilter, Accelerator. */
+static int d_option_entity(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_options(P, dir);
+    if (rc)
+        return rc;
+    lf_entity e;
+    if ((rc = parse_entity(P, L, dir, "a type name", &e))) {
+        entity_free(&e);
+        return rc;
+    }
+    lf_scene_desc *d = P->d;
+    lf_entity *slot = tok_is(dir, "Film")          ? &d->film
+                      : tok_is(dir, "Sampler")     ? &d->sampler
+                      : tok_is(dir, "Integrator")  ? &d->integrator
+                      : tok_is(dir, "PixelFilter") ? &d->filter
+                      : tok_is(dir, "Accelerator") ? &d->accelerator
+                                                   : &d->camera.e;
+    entity_free(slot);
+    *slot = e;
+    if (slot == &d->camera.e) {
+        d->camera.world_to_camera = current_xform(P);
+        /* pbrt-v4 names the camera-to-world transform "camera". */
+        lf_transform inv[2] = {lf_transform_inverse(&P->gs.ctm[0]), lf_transform_inverse(&P->gs.ctm[1])};
+        return set_coordsys(P, "camera", inv);
+    }
+    return LF_OK;
+}
+
+/* lensfield renders in linear sRGB and has no global options: both are read
+ * and ignored (pbrt-v4 allows them anywhere, so no world-block check). */
+static int d_color_space(parser *P, lexer *L, const token *dir)
+{
+    char *name;
+    int rc = expect_string(P, L, dir, "a colour space name", &name, NULL);
+    if (rc)
+        return rc;
+    pwarn(P, &dir->loc, "ColorSpace \"%s\" ignored: lensfield renders in linear sRGB", name);
+    free(name);
+    return LF_OK;
+}
+
+static int d_option(parser *P, lexer *L, const token *dir)
+{
+    lf_paramset ps = {0};
+    int rc = parse_params(P, L, &ps);
+    if (!rc && ps.count == 0) {
+        token t;
+        char b[96];
+        lex_peek(P, L, &t);
+        rc = perr(P, LF_ERR_PARSE, &t.loc, "Option expects a \"type name\" value pair, got %s",
+                  describe(&t, b, sizeof b));
+    }
+    if (!rc)
+        pwarn(P, &dir->loc, "Option \"%s\" ignored", ps.items[0].name);
+    lf_params_free(&ps);
+    return rc;
+}
+
+static int merge_attrs(parser *P, lf_paramset *ps, int which)
+{
+    return lf_params_merge_defaults(ps, &P->gs.attrs[which]) ? nomem(P) : LF_OK;
+}
+
+static int d_material(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *d->materials))
+        return nomem(P);
+    lf_material_desc *m = &d->materials[d->n_materials];
+    memset(m, 0, sizeof *m);
+    rc = parse_entity(P, L, dir, "a material type", &m->e);
+    if (!rc)
+        rc = merge_attrs(P, &m->e.params, ATTR_MATERIAL);
+    if (rc) {
+        entity_free(&m->e);
+        return rc;
+    }
+    P->gs.material = (int)d->n_materials++;
+    return LF_OK;
+}
+
+static int d_make_named_material(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *d->materials))
+        return nomem(P);
+    lf_material_desc *m = &d->materials[d->n_materials];
+    memset(m, 0, sizeof *m);
+    m->e.loc = dir->loc;
+    lf_loc name_loc;
+    rc = expect_string(P, L, dir, "a material name", &m->name, &name_loc);
+    if (!rc)
+        rc = parse_params(P, L, &m->e.params);
+    if (!rc)
+        rc = merge_attrs(P, &m->e.params, ATTR_MATERIAL);
+    if (!rc) {
+        int prev = strmap_get(&P->material_map, m->name);
+        if (prev >= 0) {
+            const lf_loc *pl = &d->materials[prev].e.loc;
+            rc = perr(P, LF_ERR_PARSE, &name_loc, "named material \"%s\" redefined (first defined at %s:%d:%d)",
+                      m->name, pl->file, pl->line, pl->col);
+        }
+    }
+    if (!rc) {
+        /* The type travels as a "string type" parameter; move it to e.type so
+         * named and anonymous materials look alike to the scene builder. */
+        size_t i;
+        for (i = 0; i < m->e.params.count; i++)
+            if (strcmp(m->e.params.items[i].name, "type") == 0)
+                break;
+        lf_param *tp = i < m->e.params.count ? &m->e.params.items[i] : NULL;
+        if (!tp || tp->type != LF_PT_STRING || tp->n_strs != 1) {
+            rc = perr(P, LF_ERR_PARSE, tp ? &tp->loc : &name_loc,
+                      "MakeNamedMaterial \"%s\": needs a \"string type\" parameter with one value", m->name);
+        } else {
+            m->e.type = tp->strs[0];
+            tp->strs[0] = NULL;
+            param_release(tp);
+            memmove(tp, tp + 1, (m->e.params.count - i - 1) * sizeof *tp);
+            m->e.params.count--;
+        }
+    }
+    if (!rc && strmap_put(&P->material_map, m->name, (int)d->n_materials))
+        rc = nomem(P);
+    if (rc) {
+        entity_free(&m->e);
+        free(m->name);
+        return rc;
+    }
+    d->n_materials++;
+    return LF_OK;
+}
+
+static int d_named_material(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    if (grow((void **)&P->material_refs, &P->cap_material_refs, P->n_material_refs, sizeof *P->material_refs))
+        return nomem(P);
+    named_ref *r = &P->material_refs[P->n_material_refs];
+    if ((rc = expect_string(P, L, dir, "a material name", &r->name, &r->loc)))
+        return rc;
+    /* Resolved at the end: pbrt-v4 allows MakeNamedMaterial after its use. */
+    P->gs.material = -2 - (int)P->n_material_refs++;
+    return LF_OK;
+}
+
+static int d_texture(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->textures, &P->cap_textures, d->n_textures, sizeof *d->textures))
+        return nomem(P);
+    lf_texture_desc *t = &d->textures[d->n_textures];
+    memset(t, 0, sizeof *t);
+    t->e.loc = dir->loc;
+    char *kind = NULL;
+    lf_loc name_loc, kind_loc;
+    rc = expect_string(P, L, dir, "a texture name", &t->name, &name_loc);
+    if (!rc)
+        rc = expect_string(P, L, dir, "\"float\" or \"spectrum\"", &kind, &kind_loc);
+    if (!rc && strcmp(kind, "float") != 0 && strcmp(kind, "spectrum") != 0)
+        rc = perr(P, LF_ERR_PARSE, &kind_loc, "texture type \"%s\" unknown: must be \"float\" or \"spectrum\"", kind);
+    if (!rc)
+        t->is_float = strcmp(kind, "float") == 0;
+    if (!rc)
+        rc = expect_string(P, L, dir, "a texture class", &t->e.type, NULL);
+    if (!rc)
+        rc = parse_params(P, L, &t->e.params);
+    if (!rc)
+        rc = merge_attrs(P, &t->e.params, ATTR_TEXTURE);
+    strmap *names = t->is_float ? &P->float_tex_map : &P->spectrum_tex_map;
+    if (!rc) {
+        int prev = strmap_get(names, t->name);
+        if (prev >= 0) {
+            const lf_loc *pl = &d->textures[prev].e.loc;
+            rc = perr(P, LF_ERR_PARSE, &name_loc, "%s texture \"%s\" redefined (first defined at %s:%d:%d)", kind,
+                      t->name, pl->file, pl->line, pl->col);
+        }
+    }
+    if (!rc && strmap_put(names, t->name, (int)d->n_textures))
+        rc = nomem(P);
+    free(kind);
+    if (rc) {
+        entity_free(&t->e);
+        free(t->name);
+        return rc;
+    }
+    t->object_to_world = P->gs.ctm[0];
+    d->n_textures++;
+    return LF_OK;
+}
+
+static int d_light_source(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->lights, &P->cap_lights, d->n_lights, sizeof *d->lights))
+        return nomem(P);
+    lf_light_desc *l = &d->lights[d->n_lights];
+    memset(l, 0, sizeof *l);
+    rc = parse_entity(P, L, dir, "a light type", &l->e);
+    if (!rc)
+        rc = merge_attrs(P, &l->e.params, ATTR_LIGHT);
+    if (rc) {
+        entity_free(&l->e);
+        return rc;
+    }
+    l->light_to_world = current_xform(P);
+    l->reverse_orientation = P->gs.reverse_orientation;
+    d->n_lights++;
+    return LF_OK;
+}
+
+static int d_area_light_source(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->area_lights, &P->cap_area_lights, d->n_area_lights, sizeof *d->area_lights))
+        return nomem(P);
+    lf_entity *e = &d->area_lights[d->n_area_lights];
+    rc = parse_entity(P, L, dir, "an area light type", e);
+    if (!rc)
+        rc = merge_attrs(P, &e->params, ATTR_LIGHT);
+    if (rc) {
+        entity_free(e);
+        return rc;
+    }
+    P->gs.area_light = (int)d->n_area_lights++;
+    return LF_OK;
+}
+
+static int d_shape(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->shapes, &P->cap_shapes, d->n_shapes, sizeof *d->shapes))
+        return nomem(P);
+    lf_shape_desc *s = &d->shapes[d->n_shapes];
+    memset(s, 0, sizeof *s);
+    rc = parse_entity(P, L, dir, "a shape type", &s->e);
+    if (!rc)
+        rc = merge_attrs(P, &s->e.params, ATTR_SHAPE);
+    if (rc) {
+        entity_free(&s->e);
+        return rc;
+    }
+    s->object_to_world = current_xform(P);
+    s->material = P->gs.material;
+    s->area_light = P->gs.area_light;
+    s->reverse_orientation = P->gs.reverse_orientation;
+    s->object = P->current_object;
+    s->base_dir = L->dir;
+    if (s->object >= 0 && s->area_light >= 0)
+        pwarn(P, &dir->loc, "area lights are not supported with object instancing");
+    d->n_shapes++;
+    return LF_OK;
+}
+
+static int d_object_begin(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    char *name;
+    lf_loc loc;
+    if ((rc = expect_string(P, L, dir, "an object name", &name, &loc)))
+        return rc;
+    if (P->current_object >= 0)
+        rc = perr(P, LF_ERR_PARSE, &dir->loc, "ObjectBegin \"%s\" inside the definition of object \"%s\"", name,
+                  P->d->objects[P->current_object].name);
+    else if (strmap_get(&P->object_map, name) >= 0)
+        rc = perr(P, LF_ERR_PARSE, &loc, "object \"%s\" redefined", name);
+    lf_scene_desc *d = P->d;
+    if (!rc && grow((void **)&d->objects, &P->cap_objects, d->n_objects, sizeof *d->objects))
+        rc = nomem(P);
+    /* ObjectBegin also opens an attribute block (pbrt-v4). */
+    if (!rc)
+        rc = push_state(P, 'o', &dir->loc);
+    if (rc) {
+        free(name);
+        return rc;
+    }
+    lf_object_desc *o = &d->objects[d->n_objects];
+    o->name = name;
+    o->object_to_world = current_xform(P);
+    P->current_object = (int)d->n_objects++;
+    if (strmap_put(&P->object_map, o->name, P->current_object))
+        return nomem(P);
+    return LF_OK;
+}
+
+static int d_object_end(parser *P, lexer *L, const token *dir)
+{
+    (void)L;
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    if (P->current_object < 0)
+        return perr(P, LF_ERR_PARSE, &dir->loc, "ObjectEnd outside of an object definition");
+    if ((rc = pop_state(P, 'o', dir)))
+        return rc;
+    P->current_object = -1;
+    return LF_OK;
+}
+
+static int d_object_instance(parser *P, lexer *L, const token *dir)
+{
+    int rc = require_world(P, dir);
+    if (rc)
+        return rc;
+    lf_scene_desc *d = P->d;
+    size_t cap = P->cap_instances;
+    if (grow((void **)&d->instances, &P->cap_instances, d->n_instances, sizeof *d->instances))
+        return nomem(P);
+    if (P->cap_instances != cap) {
+        named_ref *r = realloc(P->instance_refs, P->cap_instances * sizeof *r);
+        if (!r)
+            return nomem(P);
+        P->instance_refs = r;
+        P->cap_instance_refs = P->cap_instances;
+    }
+    named_ref *ref = &P->instance_refs[d->n_instances];
+    if ((rc = expect_string(P, L, dir, "an object name", &ref->name, &ref->loc)))
+        return rc;
+    if (P->current_object >= 0) {
+        rc = perr(P, LF_ERR_PARSE, &dir->loc, "ObjectInstance \"%s\" inside the definition of object \"%s\"",
+                  ref->name, d->objects[P->current_object].name);
+        free(ref->name);
+        return rc;
+    }
+    lf_instance_desc *inst = &d->instances[d->n_instances++];
+    inst->object = -1; /* resolved at the end: pbrt-v4 allows use before definition */
+    inst->instance_to_world = current_xform(P);
+    inst->loc = dir->loc;
+    return LF_OK;
+}
+
+/* Participating media are not rendered: read the directive, drop it. */
+static int d_make_named_medium(parser *P, lexer *L, const token *dir)
+{
+    char *name;
+    int rc = expect_string(P, L, dir, "a medium name", &name, NULL);
+    if (rc)
+        return rc;
+    lf_paramset ps = {0};
+    rc = parse_params(P, L, &ps);
+    if (!rc)
+        pwarn(P, &dir->loc, "MakeNamedMedium \"%s\" ignored: participating media are not supported", name);
+    lf_params_free(&ps);
+    free(name);
+    return rc;
+}
+
+static int d_medium_interface(parser *P, lexer *L, const token *dir)
+{
+    char *inside;
+    int rc = expect_string(P, L, dir, "an interior medium name", &inside, NULL);
+    if (rc)
+        return rc;
+    free(inside);
+    token t;
+    if ((rc = lex_peek(P, L, &t)))
+        return rc;
+    if (t.kind == TK_STRING) /* the exterior name is optional */
+        lex_next(P, L, &t);
+    pwarn(P, &dir->loc, "MediumInterface ignored: participating media are not supported");
+    return LF_OK;
+}
+
+static const struct directive {
+    const char *name;
+    directive_fn fn;
+} directives[] = {
+    {"Accelerator", d_option_entity},
+    {"ActiveTransform", d_active_transform},
+    {"AreaLightSource", d_area_light_source},
+    {"Attribute", d_attribute},
+    {"AttributeBegin", d_attribute_begin},
+    {"AttributeEnd", d_attribute_end},
+    {"Camera", d_option_entity},
+    {"ColorSpace", d_color_space},
+    {"ConcatTransform", d_concat_transform},
+    {"CoordSysTransform", d_coordsys_transform},
+    {"CoordinateSystem", d_coordinate_system},
+    {"Film", d_option_entity},
+    {"Identity", d_identity},
+    {"Import", d_include},
+    {"Include", d_include},
+    {"Integrator", d_option_entity},
+    {"LightSource", d_light_source},
+    {"LookAt", d_lookat},
+    {"MakeNamedMaterial", d_make_named_material},
+    {"MakeNamedMedium", d_make_named_medium},
+    {"Material", d_material},
+    {"MediumInterface", d_medium_interface},
+    {"NamedMaterial", d_named_material},
+    {"ObjectBegin", d_object_begin},
+    {"ObjectEnd", d_object_end},
+    {"ObjectInstance", d_object_instance},
+    {"Option", d_option},
+    {"PixelFilter", d_option_entity},
+    {"ReverseOrientation", d_reverse_orientation},
+    {"Rotate", d_rotate},
+    {"Sampler", d_option_entity},
+    {"Scale", d_scale},
+    {"Shape", d_shape},
+    {"Texture", d_texture},
+    {"Transform", d_transform},
+    {"TransformBegin", d_transform_begin},
+    {"TransformEnd", d_transform_end},
+    {"TransformTimes", d_transform_times},
+    {"Translate", d_translate},
+    {"WorldBegin", d_world_begin},
+    {"WorldEnd", d_world_end},
+};
+
+/* Parses one file's text; *eof (if not NULL) receives where it ended. */
+static int parse_text(parser *P, const char *text, size_t len, const char *file, const char *dir, lf_loc *eof)
+{
+    lexer L = {text, len, 0, 1, 1, file, dir, {0}, 0};
+    for (;;) {
+        token t;
+        int rc = lex_next(P, &L, &t);
+        if (rc)
+            return rc;
+        if (t.kind == TK_EOF) {
+            if (eof)
+                *eof = t.loc;
+            return LF_OK;
+        }
+        char b[96];
+        if (t.kind != TK_WORD)
+            return perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
+        directive_fn fn = NULL;
+        for (size_t i = 0; i < sizeof directives / sizeof directives[0]; i++)
+            if (tok_is(&t, directives[i].name)) {
+                fn = directives[i].fn;
+                break;
+            }
+        if (!fn)
+            return perr(P, LF_ERR_PARSE, &t.loc, "unknown directive %s", describe(&t, b, sizeof b));
+        if ((rc = fn(P, &L, &t)))
+            return rc;
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Set-up, end of input, clean-up                                           */
+
+static void parser_free(parser *P)
+{
+    gstate_free(&P->gs);
+    for (size_t i = 0; i < P->n_stack; i++)
+        gstate_free(&P->stack[i].saved);
+    free(P->stack);
+    for (size_t i = 0; i < P->n_coordsys; i++)
+        free(P->coordsys[i].name);
+    free(P->coordsys);
+    strmap_free(&P->coordsys_map);
+    strmap_free(&P->material_map);
+    strmap_free(&P->float_tex_map);
+    strmap_free(&P->spectrum_tex_map);
+    strmap_free(&P->object_map);
+    for (size_t i = 0; i < P->n_material_refs; i++)
+        free(P->material_refs[i].name);
+    free(P->material_refs);
+    if (P->instance_refs)
+        for (size_t i = 0; i < P->d->n_instances; i++)
+            free(P->instance_refs[i].name);
+    free(P->instance_refs);
+}
+
+/* What pbrt-v4 checks once all files are read. */
+static int finish(parser *P, const lf_loc *eof)
+{
+    lf_scene_desc *d = P->d;
+    if (!P->world)
+        return perr(P, LF_ERR_PARSE, eof, "end of file before WorldBegin");
+    while (P->n_stack) {
+        pushed *e = &P->stack[P->n_stack - 1];
+        if (e->kind == 'o')
+            pwarn(P, &e->loc, "ObjectBegin without ObjectEnd at end of file");
+        else
+            pwarn(P, &e->loc, "%s without %s at end of file", block_name(e->kind),
+                  e->kind == 'a' ? "AttributeEnd" : "TransformEnd");
+        gstate_free(&e->saved);
+        P->n_stack--;
+    }
+    /* Resolve NamedMaterial references; every one must name a material. */
+    int *resolved = NULL;
+    if (P->n_material_refs) {
+        resolved = malloc(P->n_material_refs * sizeof *resolved);
+        if (!resolved)
+            return nomem(P);
+    }
+    for (size_t i = 0; i < P->n_material_refs; i++) {
+        resolved[i] = strmap_get(&P->material_map, P->material_refs[i].name);
+        if (resolved[i] < 0) {
+            int rc = perr(P, LF_ERR_PARSE, &P->material_refs[i].loc, "NamedMaterial \"%s\" is not defined",
+                          P->material_refs[i].name);
+            free(resolved);
+            return rc;
+        }
+    }
+    for (size_t i = 0; i < d->n_shapes; i++)
+        if (d->shapes[i].material <= -2)
+            d->shapes[i].material = resolved[-2 - d->shapes[i].material];
+    free(resolved);
+    for (size_t i = 0; i < d->n_instances; i++) {
+        int o = strmap_get(&P->object_map, P->instance_refs[i].name);
+        if (o < 0)
+            return perr(P, LF_ERR_PARSE, &P->instance_refs[i].loc, "ObjectInstance \"%s\": no such object",
+                        P->instance_refs[i].name);
+        d->instances[i].object = o;
+    }
+    return LF_OK;
+}
+
+static int parse_begin(parser *P, lf_scene_desc *out, lf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    memset(P, 0, sizeof *P);
+    P->d = out;
+    P->err = err;
+    out->transform_start_time = 0.0;
+    out->transform_end_time = 1.0;
+    P->gs.ctm[0] = P->gs.ctm[1] = lf_transform_identity();
+    P->gs.active[0] = P->gs.active[1] = 1;
+    P->gs.material = -1;
+    P->gs.area_light = -1;
+    P->current_object = -1;
+    return set_coordsys(P, "world", P->gs.ctm);
+}
+
+static int parse_end(parser *P, int rc, const lf_loc *eof)
+{
+    if (!rc)
+        rc = finish(P, eof);
+    parser_free(P);
+    if (rc) {
+        /* Make sure the caller sees a message even for a bare status. */
+        if (P->err && P->err->code == LF_OK)
+            lf_error_set(P->err, rc, "scene parse failed");
+        lf_scene_desc_free(P->d);
+    }
+    return rc;
+}
+
+int lf_scene_parse_file(const char *path, lf_scene_desc *out, lf_error *err)
+{
+    parser P;
+    lf_loc eof = {path, 1, 1};
+    int rc = parse_begin(&P, out, err);
+    if (!rc)
+        rc = parse_path(&P, path, NULL, &eof);
+    return parse_end(&P, rc, &eof);
+}
+
+int lf_scene_parse_string(const char *text, const char *name, lf_scene_desc *out, lf_error *err)
+{
+    parser P;
+    if (!name)
+        name = "<string>";
+    int rc = parse_begin(&P, out, err);
+    const char *file = NULL, *dir = NULL;
+    if (!rc) {
+        char *dname = dir_of(name);
+        file = keep_string(&P, name);
+        dir = dname ? keep_string(&P, dname) : NULL;
+        free(dname);
+        if (!file || !dir)
+            rc = nomem(&P);
+    }
+    lf_loc eof = {name, 1, 1};
+    if (!rc)
+        rc = parse_text(&P, text ? text : "", text ? strlen(text) : 0, file, dir, &eof);
+    return parse_end(&P, rc, &eof);
+}
+
+void lf_scene_desc_free(lf_scene_desc *d)
+{
+    if (!d)
+        return;
+    entity_free(&d->camera.e);
+    entity_free(&d->film);
+    entity_free(&d->sampler);
+    entity_free(&d->integrator);
+    entity_free(&d->filter);
+    entity_free(&d->accelerator);
+    for (size_t i = 0; i < d->n_textures; i++) {
+        entity_free(&d->textures[i].e);
+        free(d->textures[i].name);
+    }
+    free(d->textures);
+    for (size_t i = 0; i < d->n_materials; i++) {
+        entity_free(&d->materials[i].e);
+        free(d->materials[i].name);
+    }
+    free(d->materials);
+    for (size_t i = 0; i < d->n_lights; i++)
+        entity_free(&d->lights[i].e);
+    free(d->lights);
+    for (size_t i = 0; i < d->n_area_lights; i++)
+        entity_free(&d->area_lights[i]);
+    free(d->area_lights);
+    for (size_t i = 0; i < d->n_shapes; i++)
+        entity_free(&d->shapes[i].e);
+    free(d->shapes);
+    for (size_t i = 0; i < d->n_objects; i++)
+        free(d->objects[i].name);
+    free(d->objects);
+    free(d->instances);
+    free(d->warnings);
+    for (size_t i = 0; i < d->n_strings; i++)
+        free(d->strings[i]);
+    free(d->strings);
+    memset(d, 0, sizeof *d);
+}

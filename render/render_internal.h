@@ -1,0 +1,148 @@
+/* Private structures of the renderer (render/ only). */
+#ifndef LF_RENDER_INTERNAL_H
+#define LF_RENDER_INTERNAL_H
+
+#include <embree3/rtcore.h>
+#include <stdint.h>
+
+#include "../base/lf_distrib.h"
+#include "../base/lf_filter.h"
+#include "../base/lf_math.h"
+#include "../base/lf_sampler.h"
+#include "../camera/lf_camera.h"
+#include "lf_render.h"
+#include "lf_shading.h"
+
+/* A world-space triangle mesh (trianglemesh, plymesh, bilinearmesh, disk,
+ * and spheres that Embree's sphere primitive cannot represent). */
+typedef struct lf_mesh {
+    int n_tris, n_verts;
+    int *idx;      /* 3 per triangle */
+    float *P;      /* world space, 3 per vertex */
+    float *N;      /* world space shading normals, or NULL */
+    float *uv;     /* 2 per vertex, or NULL (pbrt defaults per triangle) */
+    int material;
+    int light_first;   /* index of the first triangle's light, -1 if not emissive */
+    int flip_normal;   /* reverse orientation XOR handedness swap */
+} lf_mesh;
+
+typedef struct lf_sphere {
+    lf_vec3 center;
+    float radius;
+    lf_transform object_to_world; /* for pbrt's (u,v) parameterisation */
+    int material;
+    int light;         /* -1 if not emissive */
+    int flip_normal;
+} lf_sphere;
+
+typedef enum lf_light_kind {
+    LF_LIGHT_POINT,
+    LF_LIGHT_SPOT,
+    LF_LIGHT_DISTANT,
+    LF_LIGHT_INFINITE_UNIFORM,
+    LF_LIGHT_INFINITE_IMAGE,
+    LF_LIGHT_TRIANGLE,
+    LF_LIGHT_SPHERE
+} lf_light_kind;
+
+typedef struct lf_envmap {
+    int width, height;       /* square, pbrt-v4 equal-area octahedral layout */
+    float *rgb;
+    lf_distrib2d distrib;
+    lf_transform light_to_world;
+} lf_envmap;
+
+typedef struct lf_light {
+    lf_light_kind kind;
+    lf_vec3 L;          /* radiance (area, infinite, distant) or intensity (point, spot), scale applied */
+    lf_vec3 pos;        /* point, spot */
+    lf_vec3 dir;        /* spot axis; distant: direction light travels FROM (towards the light) */
+    float cos_total, cos_start; /* spot */
+    int mesh, prim;     /* triangle */
+    int sphere;         /* sphere */
+    float area;
+    int twosided;
+    lf_envmap *env;     /* infinite image */
+    double power;       /* for the light-selection distribution */
+} lf_light;
+
+typedef struct lf_scene {
+    RTCDevice device;
+    RTCScene rtc;
+    lf_mesh *meshes;
+    int n_meshes;
+    lf_sphere *spheres;
+    int n_spheres;
+    unsigned sphere_geom_id; /* RTC_INVALID_GEOMETRY_ID if none */
+    unsigned *geom_mesh;     /* geomID -> mesh index (or -1) */
+    int n_geom;
+    lf_light *lights;
+    int n_lights;
+    int *infinite_lights;    /* indices of infinite lights */
+    int n_infinite;
+    lf_distrib1d light_distrib; /* light selection by power */
+    lf_vec3 bounds_min, bounds_max;
+    float scene_radius;
+    lf_vec3 scene_center;
+    long long n_triangles;
+    lf_materials *materials;
+    char *warnings;
+} lf_scene;
+
+int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err);
+void lf_scene_free(lf_scene *s);
+/* Appends a warning line to a malloc'ed buffer. */
+void lf_warn_append(char **buf, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* A surface hit, everything the integrator needs. */
+typedef struct lf_hit {
+    float t;
+    lf_shading_ctx sc; /* p, ng (facing the normal's side: not flipped to the ray), ns, dpdu, uv */
+    int material;
+    int light;         /* -1 if not emissive */
+} lf_hit;
+
+/* ---- lights (render/lights.c) ---- */
+typedef struct lf_light_sample {
+    lf_vec3 wi;     /* towards the light */
+    lf_vec3 Li;
+    float pdf;      /* solid angle (1 for delta lights) */
+    float dist;     /* distance to the sampled point (INFINITY for infinite/distant) */
+    int delta;
+} lf_light_sample;
+
+int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0, float u1, lf_light_sample *ls);
+/* Solid-angle pdf of sampling direction wi from p that hits the light at hit
+ * (area lights) or escapes (infinite). */
+float lf_light_pdf_li(const lf_scene *s, const lf_light *l, lf_vec3 p, lf_vec3 wi, const lf_hit *hit);
+/* Emitted radiance from an area light's surface towards -w (w = ray direction). */
+lf_vec3 lf_light_area_le(const lf_light *l, const lf_hit *hit, lf_vec3 w);
+/* Radiance arriving along a ray direction from an infinite light. */
+lf_vec3 lf_light_infinite_le(const lf_light *l, lf_vec3 dir);
+double lf_light_power(const lf_scene *s, const lf_light *l);
+int lf_envmap_load(const char *path, lf_envmap *env, lf_error *err);
+void lf_envmap_free(lf_envmap *env);
+lf_vec3 lf_equal_area_square_to_sphere(float u, float v);
+void lf_equal_area_sphere_to_square(lf_vec3 d, float *u, float *v);
+
+/* ---- intersection (render/scene.c) ---- */
+int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_hit *hit);
+int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax);
+/* Origin offset off a surface to avoid self-intersection, on the side of w. */
+lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w);
+
+/* ---- integrator (render/integrator.c) ---- */
+typedef struct lf_integrator {
+    int max_depth;
+    int regularize;
+} lf_integrator;
+
+/* Radiance along a world-space camera ray. rays counts traced rays. */
+lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, lf_sample_stream *st,
+                   long long *rays);
+
+#endif

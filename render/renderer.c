@@ -1,0 +1,659 @@
+/* The renderer: reads Film, Sampler, PixelFilter, Integrator and Camera,
+ * builds the scene, and renders tiles on a pool of threads. */
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#if defined(__SSE__) || defined(__x86_64__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+#include "render_internal.h"
+
+#define LF_VERSION_STRING "lensfield 0.1"
+
+struct lf_renderer {
+    lf_scene scene;
+    lf_integrator integrator;
+    lf_sampler sampler;
+    lf_filter filter;
+    const lf_camera_type *camera_type;
+    void *camera;
+    uint32_t camera_needs;
+    lf_transform camera_to_world;
+    double shutter_open, shutter_close;
+    double imaging_ratio; /* exposure time * ISO / 100 (pbrt-v4 PixelSensor) */
+    int xres, yres;
+    int px0, px1, py0, py1; /* pixel bounds rendered */
+    double diagonal_mm;
+    int save_half;
+    double max_component;
+    char *film_filename;
+    char *camera_name;
+    char *sampler_name;
+    char *filter_name;
+    char *integrator_name;
+    char *scene_path;
+    char *warnings;
+    lf_render_opts opts;
+    int threads;
+    lf_render_stats stats;
+    lf_transform world_to_camera;
+};
+
+lf_render_opts lf_render_opts_default(void)
+{
+    lf_render_opts o;
+    memset(&o, 0, sizeof o);
+    return o;
+}
+
+static char *dupstr(const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+static void where_of(char *buf, size_t n, const lf_loc *loc)
+{
+    snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
+}
+
+/* ---- camera parameter adaptor (the plugin ABI's lf_camera_params) ---- */
+static double cp_float(void *ctx, const char *name, double def) { return lf_params_float(ctx, name, def); }
+static int cp_int(void *ctx, const char *name, int def) { return lf_params_int(ctx, name, def); }
+static int cp_bool(void *ctx, const char *name, int def) { return lf_params_bool(ctx, name, def); }
+static const char *cp_string(void *ctx, const char *name, const char *def)
+{
+    return lf_params_string(ctx, name, def);
+}
+static int cp_floats(void *ctx, const char *name, double *out, int max)
+{
+    const lf_param *p = lf_params_peek(ctx, name);
+    if (!p)
+        return 0;
+    size_t n = 0;
+    const double *v = lf_params_nums(ctx, name, p->type == LF_PT_INTEGER ? LF_PT_INTEGER : LF_PT_FLOAT, &n);
+    if (!v)
+        return 0;
+    for (size_t i = 0; i < n && (int)i < max; i++)
+        out[i] = v[i];
+    return (int)n;
+}
+
+static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_entity *f = &d->film;
+    lf_paramset empty = {0};
+    lf_paramset *ps = f->type ? &f->params : &empty;
+    char where[512];
+    where_of(where, sizeof where, &f->loc);
+    if (f->type && strcmp(f->type, "rgb") != 0)
+        lf_warn_append(&r->warnings, "%s: warning: Film \"%s\" is rendered as Film \"rgb\"", where, f->type);
+    r->xres = lf_params_int(ps, "xresolution", 1280);
+    r->yres = lf_params_int(ps, "yresolution", 720);
+    r->film_filename = dupstr(lf_params_string(ps, "filename", "pbrt.exr"));
+    r->diagonal_mm = lf_params_float(ps, "diagonal", 35.0);
+    double iso = lf_params_float(ps, "iso", 100.0);
+    r->save_half = lf_params_bool(ps, "savefp16", 1);
+    r->max_component = lf_params_float(ps, "maxcomponentvalue", INFINITY);
+    const char *sensor = lf_params_string(ps, "sensor", "cie1931");
+    double wb = lf_params_float(ps, "whitebalance", 0.0);
+    if (strcmp(sensor, "cie1931") != 0 || wb != 0.0)
+        lf_warn_append(&r->warnings, "%s: warning: Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
+                       "modelled; no white balance applied", where, sensor, wb);
+    if (r->xres <= 0 || r->yres <= 0 || r->xres > 65536 || r->yres > 65536)
+        return lf_error_set(err, LF_ERR_PARAM, "%s: Film resolution %dx%d is out of range (1..65536)", where, r->xres,
+                            r->yres);
+    if (!(iso > 0))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: Film \"iso\" must be positive", where);
+    r->imaging_ratio = iso / 100.0; /* times exposure time, applied once the shutter is known */
+    /* pbrt-v4: cropwindow in NDC, pixelbounds in pixels (pixelbounds wins). */
+    double cw[4] = {0, 1, 0, 1};
+    size_t n = 0;
+    const double *c = lf_params_nums(ps, "cropwindow", LF_PT_FLOAT, &n);
+    if (c) {
+        if (n != 4)
+            return lf_error_set(err, LF_ERR_PARAM, "%s: \"cropwindow\" needs 4 values", where);
+        memcpy(cw, c, sizeof cw);
+    }
+    r->px0 = (int)ceil(r->xres * fmin(cw[0], cw[1]));
+    r->px1 = (int)ceil(r->xres * fmax(cw[0], cw[1]));
+    r->py0 = (int)ceil(r->yres * fmin(cw[2], cw[3]));
+    r->py1 = (int)ceil(r->yres * fmax(cw[2], cw[3]));
+    const double *pb = lf_params_nums(ps, "pixelbounds", LF_PT_INTEGER, &n);
+    if (pb) {
+        if (n != 4)
+            return lf_error_set(err, LF_ERR_PARAM, "%s: \"pixelbounds\" needs 4 values", where);
+        r->px0 = (int)pb[0], r->px1 = (int)pb[1], r->py0 = (int)pb[2], r->py1 = (int)pb[3];
+    }
+    if (lf_params_finish(ps, "Film \"rgb\"", err))
+        return err->code;
+    return 0;
+}
+
+static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_entity *e = &d->sampler;
+    lf_paramset empty = {0};
+    lf_paramset *ps = e->type ? &e->params : &empty;
+    const char *type = e->type ? e->type : "zsobol";
+    char where[512];
+    where_of(where, sizeof where, &e->loc);
+    r->sampler.spp = lf_params_int(ps, "pixelsamples", 16);
+    r->sampler.seed = (uint32_t)lf_params_int(ps, "seed", 0);
+    lf_params_string(ps, "randomization", NULL);
+    if (!strcmp(type, "zsobol") || !strcmp(type, "sobol") || !strcmp(type, "paddedsobol") ||
+        !strcmp(type, "pmj02bn") || !strcmp(type, "halton")) {
+        r->sampler.kind = LF_SAMPLER_SOBOL;
+        if (strcmp(type, "zsobol") && strcmp(type, "sobol") && strcmp(type, "paddedsobol"))
+            lf_warn_append(&r->warnings,
+                           "%s: note: Sampler \"%s\" is not implemented; using \"paddedsobol\" (Owen-scrambled Sobol), "
+                           "the closest",
+                           where, type);
+    } else if (!strcmp(type, "stratified")) {
+        r->sampler.kind = LF_SAMPLER_STRATIFIED;
+        int xs = lf_params_int(ps, "xsamples", 4), ys = lf_params_int(ps, "ysamples", 4);
+        lf_params_bool(ps, "jitter", 1);
+        if (xs <= 0 || ys <= 0)
+            return lf_error_set(err, LF_ERR_PARAM, "%s: stratified xsamples/ysamples must be positive", where);
+        r->sampler.strata_x = xs;
+        r->sampler.strata_y = ys;
+        r->sampler.spp = xs * ys;
+    } else if (!strcmp(type, "independent")) {
+        r->sampler.kind = LF_SAMPLER_INDEPENDENT;
+    } else {
+        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown Sampler \"%s\"", where, type);
+    }
+    r->sampler_name = dupstr(type);
+    if (r->opts.spp > 0) {
+        r->sampler.spp = r->opts.spp;
+        if (r->sampler.kind == LF_SAMPLER_STRATIFIED) {
+            int sx = (int)floor(sqrt((double)r->opts.spp));
+            while (r->opts.spp % sx)
+                sx--;
+            r->sampler.strata_x = sx;
+            r->sampler.strata_y = r->opts.spp / sx;
+        }
+    }
+    if (r->opts.has_seed)
+        r->sampler.seed = r->opts.seed;
+    if (r->sampler.spp <= 0)
+        return lf_error_set(err, LF_ERR_PARAM, "%s: pixelsamples must be positive, got %d", where, r->sampler.spp);
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "Sampler \"%s\"", type);
+    return lf_params_finish(ps, ctx, err);
+}
+
+static int read_filter(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_entity *e = &d->filter;
+    lf_paramset empty = {0};
+    lf_paramset *ps = e->type ? &e->params : &empty;
+    const char *type = e->type ? e->type : "gaussian";
+    char where[512];
+    where_of(where, sizeof where, &e->loc);
+    static const struct {
+        const char *name;
+        lf_filter_kind kind;
+    } kinds[] = {{"box", LF_FILTER_BOX},
+                 {"triangle", LF_FILTER_TRIANGLE},
+                 {"gaussian", LF_FILTER_GAUSSIAN},
+                 {"mitchell", LF_FILTER_MITCHELL},
+                 {"lanczos", LF_FILTER_LANCZOS}};
+    int k = -1;
+    for (int i = 0; i < 5; i++)
+        if (!strcmp(type, kinds[i].name))
+            k = i;
+    if (k < 0)
+        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown PixelFilter \"%s\"", where, type);
+    lf_filter_params fp = {0};
+    fp.xradius = lf_params_float(ps, "xradius", -1);
+    fp.yradius = lf_params_float(ps, "yradius", -1);
+    if (kinds[k].kind == LF_FILTER_GAUSSIAN)
+        fp.sigma = lf_params_float(ps, "sigma", 0.5);
+    if (kinds[k].kind == LF_FILTER_MITCHELL) {
+        fp.b = lf_params_float(ps, "B", 1.0 / 3), fp.b_set = 1;
+        fp.c = lf_params_float(ps, "C", 1.0 / 3), fp.c_set = 1;
+    }
+    if (kinds[k].kind == LF_FILTER_LANCZOS)
+        fp.tau = lf_params_float(ps, "tau", 3.0);
+    if (lf_filter_init(&r->filter, kinds[k].kind, &fp, err))
+        return err->code;
+    r->filter_name = dupstr(type);
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "PixelFilter \"%s\"", type);
+    return lf_params_finish(ps, ctx, err);
+}
+
+static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_entity *e = &d->integrator;
+    lf_paramset empty = {0};
+    lf_paramset *ps = e->type ? &e->params : &empty;
+    const char *type = e->type ? e->type : "volpath";
+    char where[512];
+    where_of(where, sizeof where, &e->loc);
+    if (!strcmp(type, "ambientocclusion") || !strcmp(type, "aov"))
+        return lf_error_set(err, LF_ERR_UNSUPPORTED,
+                            "%s: Integrator \"%s\" is not supported (it computes something other than radiance)", where,
+                            type);
+    if (strcmp(type, "path") && strcmp(type, "volpath"))
+        lf_warn_append(&r->warnings,
+                       "%s: warning: Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
+                       "image",
+                       where, type);
+    r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
+    r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
+    const char *ls = lf_params_string(ps, "lightsampler", "bvh");
+    (void)ls;
+    lf_params_find(ps, "strategy");
+    lf_params_find(ps, "bidirectional");
+    lf_params_find(ps, "visualizestrategies");
+    lf_params_find(ps, "visualizeweights");
+    if (r->integrator.max_depth < 0)
+        return lf_error_set(err, LF_ERR_PARAM, "%s: maxdepth must be >= 0", where);
+    r->integrator_name = dupstr(type);
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "Integrator \"%s\"", type);
+    return lf_params_finish(ps, ctx, err);
+}
+
+static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_camera_desc *cd = &d->camera;
+    lf_paramset empty = {0};
+    lf_paramset *ps = cd->e.type ? &cd->e.params : &empty;
+    const char *type = cd->e.type ? cd->e.type : "perspective";
+    char where[512];
+    where_of(where, sizeof where, &cd->e.loc);
+    r->camera_type = lf_camera_find(type);
+    if (!r->camera_type) {
+        char names[512] = "";
+        for (int i = 0; i < lf_camera_count(); i++) {
+            strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
+            strncat(names, lf_camera_at(i)->name, sizeof names - strlen(names) - 1);
+        }
+        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown camera \"%s\" (registered: %s)", where, type, names);
+    }
+    r->shutter_open = lf_params_float(ps, "shutteropen", 0.0);
+    r->shutter_close = lf_params_float(ps, "shutterclose", 1.0);
+    if (r->shutter_close < r->shutter_open) {
+        lf_warn_append(&r->warnings, "%s: warning: shutterclose < shutteropen; swapping them (as pbrt does)", where);
+        double t = r->shutter_open;
+        r->shutter_open = r->shutter_close;
+        r->shutter_close = t;
+    }
+    r->imaging_ratio *= r->shutter_close - r->shutter_open;
+    lf_camera_params cp = {ps, cp_float, cp_int, cp_bool, cp_string, cp_floats};
+    char cerr[1024] = "", cwarn[1024] = "";
+    char scene_dir[4096] = ".";
+    if (r->scene_path) {
+        const char *slash = strrchr(r->scene_path, '/');
+        if (slash)
+            snprintf(scene_dir, sizeof scene_dir, "%.*s", (int)(slash - r->scene_path), r->scene_path);
+    }
+    lf_camera_create_args args = {sizeof args,   &cp,  r->xres,       r->yres,       r->diagonal_mm, r->shutter_open,
+                                  r->shutter_close, scene_dir, cerr, sizeof cerr, cwarn,       sizeof cwarn};
+    if (r->camera_type->create(&args, &r->camera)) {
+        r->camera = NULL;
+        return lf_error_set(err, LF_ERR_PARAM, "%s: Camera \"%s\": %s", where, type, cerr[0] ? cerr : "cannot create");
+    }
+    if (cwarn[0])
+        lf_warn_append(&r->warnings, "%s: warning: Camera \"%s\": %s", where, type, cwarn);
+    r->camera_needs = r->camera_type->needs(r->camera);
+    r->camera_name = dupstr(type);
+    if (cd->world_to_camera.animated)
+        lf_warn_append(&r->warnings, "%s: warning: camera motion is not supported yet; using the start transform",
+                       where);
+    r->world_to_camera = cd->world_to_camera.xf[0];
+    r->camera_to_world = lf_transform_inverse(&cd->world_to_camera.xf[0]);
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "Camera \"%s\"", type);
+    return lf_params_finish(ps, ctx, err);
+}
+
+int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer **out, lf_error *err)
+{
+    *out = NULL;
+    lf_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    r->opts = *opts;
+    r->scene_path = dupstr(opts->scene_path);
+    if (d->warnings)
+        lf_warn_append(&r->warnings, "%s", d->warnings);
+    if (read_film(r, d, err) || read_sampler(r, d, err) || read_filter(r, d, err) || read_integrator(r, d, err) ||
+        make_camera(r, d, err))
+        goto fail;
+    if (opts->crop[1] > opts->crop[0]) {
+        r->px0 = opts->crop[0], r->px1 = opts->crop[1], r->py0 = opts->crop[2], r->py1 = opts->crop[3];
+    }
+    if (r->px0 < 0 || r->py0 < 0 || r->px1 > r->xres || r->py1 > r->yres || r->px1 <= r->px0 || r->py1 <= r->py0) {
+        lf_error_set(err, LF_ERR_PARAM, "crop window [%d,%d) x [%d,%d) is empty or outside the %dx%d film", r->px0,
+                     r->px1, r->py0, r->py1, r->xres, r->yres);
+        goto fail;
+    }
+    if (lf_scene_build(d, &r->scene, err))
+        goto fail;
+    if (r->scene.warnings)
+        lf_warn_append(&r->warnings, "%s", r->scene.warnings);
+    if (d->accelerator.type)
+        for (size_t i = 0; i < d->accelerator.params.count; i++)
+            d->accelerator.params.items[i].used = 1; /* Embree builds its own BVH */
+    long nproc = sysconf(_SC_NPROCESSORS_ONLN);
+    r->threads = opts->threads > 0 ? opts->threads : (nproc > 0 ? (int)nproc : 1);
+    *out = r;
+    return 0;
+fail:
+    lf_renderer_free(r);
+    return err && err->code ? err->code : LF_ERR_INTERNAL;
+}
+
+const char *lf_renderer_warnings(const lf_renderer *r)
+{
+    return r->warnings;
+}
+
+const char *lf_renderer_film_filename(const lf_renderer *r)
+{
+    return r->film_filename;
+}
+
+lf_render_stats lf_renderer_stats(const lf_renderer *r)
+{
+    return r->stats;
+}
+
+void lf_renderer_free(lf_renderer *r)
+{
+    if (!r)
+        return;
+    if (r->camera && r->camera_type)
+        r->camera_type->destroy(r->camera);
+    if (r->scene.device || r->scene.meshes || r->scene.materials)
+        lf_scene_free(&r->scene);
+    lf_filter_free(&r->filter);
+    free(r->film_filename);
+    free(r->camera_name);
+    free(r->sampler_name);
+    free(r->filter_name);
+    free(r->integrator_name);
+    free(r->scene_path);
+    free(r->warnings);
+    free(r);
+}
+
+/* ---- the effect plan ---- */
+
+static void appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+{
+    va_list ap;
+    for (;;) {
+        va_start(ap, fmt);
+        int n = vsnprintf(*buf ? *buf + *len : NULL, *buf ? *cap - *len : 0, fmt, ap);
+        va_end(ap);
+        if (n < 0)
+            return;
+        if (*buf && *len + (size_t)n < *cap) {
+            *len += (size_t)n;
+            return;
+        }
+        size_t nc = (*cap + (size_t)n + 256) * 2;
+        char *nb = realloc(*buf, nc);
+        if (!nb)
+            return;
+        *buf = nb;
+        *cap = nc;
+    }
+}
+
+char *lf_renderer_explain(const lf_renderer *r)
+{
+    char *b = NULL;
+    size_t len = 0, cap = 0;
+    const lf_scene *s = &r->scene;
+    appendf(&b, &len, &cap, "scene: %s\n", r->scene_path ? r->scene_path : "(memory)");
+    appendf(&b, &len, &cap, "film: %dx%d, rendering pixels [%d,%d) x [%d,%d), diagonal %g mm\n", r->xres, r->yres,
+            r->px0, r->px1, r->py0, r->py1, r->diagonal_mm);
+    appendf(&b, &len, &cap, "camera: \"%s\"\n", r->camera_name);
+    if (r->camera_type->describe) {
+        char desc[4096];
+        int n = r->camera_type->describe(r->camera, desc, sizeof desc);
+        if (n > 0) {
+            char *line = desc, *nl;
+            while (line && *line) {
+                nl = strchr(line, '\n');
+                if (nl)
+                    *nl = '\0';
+                appendf(&b, &len, &cap, "  %s\n", line);
+                line = nl ? nl + 1 : NULL;
+            }
+        }
+    }
+    appendf(&b, &len, &cap, "effects:\n");
+    appendf(&b, &len, &cap, "  defocus: %s\n",
+            r->camera_needs & LF_CAMERA_NEEDS_LENS ? "on (the camera samples its lens)"
+                                                   : "off (pinhole: no lens samples drawn)");
+    appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
+            r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");
+    appendf(&b, &len, &cap, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
+    appendf(&b, &len, &cap, "  dispersion: %s\n",
+            r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH ? "on (the camera samples wavelength)"
+                                                         : "off (no wavelength samples)");
+    appendf(&b, &len, &cap, "  exposure: imaging ratio %g (shutter %g s x ISO/100)\n", r->imaging_ratio,
+            r->shutter_close - r->shutter_open);
+    appendf(&b, &len, &cap, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
+            r->sampler.kind == LF_SAMPLER_SOBOL        ? "Owen-scrambled Sobol, padded pairs"
+            : r->sampler.kind == LF_SAMPLER_STRATIFIED ? "jittered strata"
+                                                       : "independent uniform",
+            r->sampler.spp, r->sampler.seed);
+    appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
+    appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette\n",
+            r->integrator_name, r->integrator.max_depth);
+    appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
+            s->n_triangles, s->n_meshes, s->n_spheres, "static BVH");
+    int counts[7] = {0};
+    for (int i = 0; i < s->n_lights; i++)
+        counts[s->lights[i].kind]++;
+    appendf(&b, &len, &cap,
+            "lights: %d (point %d, spot %d, distant %d, infinite %d, image infinite %d, area triangles %d, area "
+            "spheres %d), chosen by power\n",
+            s->n_lights, counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6]);
+    appendf(&b, &len, &cap, "threads: %d\n", r->threads);
+    return b;
+}
+
+/* ---- rendering ---- */
+
+enum { TILE = 16 };
+
+typedef struct job {
+    lf_renderer *r;
+    lf_image *img;
+    int tiles_x, tiles_y;
+    atomic_int next_tile;
+    atomic_long done_tiles;
+    atomic_llong rays, paths, nonfinite, zero_weight;
+    pthread_mutex_t progress_lock;
+} job;
+
+static void render_tile(job *jb, int tile, long long *rays, long long *paths, long long *nonfinite,
+                        long long *zero_weight)
+{
+    lf_renderer *r = jb->r;
+    int tx = tile % jb->tiles_x, ty = tile / jb->tiles_x;
+    int x0 = r->px0 + tx * TILE, y0 = r->py0 + ty * TILE;
+    int x1 = x0 + TILE < r->px1 ? x0 + TILE : r->px1, y1 = y0 + TILE < r->py1 ? y0 + TILE : r->py1;
+    const lf_camera_type *ct = r->camera_type;
+    int need_lens = (r->camera_needs & LF_CAMERA_NEEDS_LENS) != 0;
+    int need_wl = (r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) != 0;
+    float scale = (float)r->imaging_ratio;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            double sum[3] = {0, 0, 0}, wsum = 0;
+            for (int i = 0; i < r->sampler.spp; i++) {
+                lf_sample_stream st;
+                lf_sample_start(&st, &r->sampler, x, y, (uint32_t)i);
+                double fu, fv, dx, dy;
+                lf_sample_2d_d(&st, &fu, &fv);
+                double fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);
+                lf_camera_sample cs;
+                cs.film_x = x + 0.5 + dx;
+                cs.film_y = y + 0.5 + dy;
+                cs.lens_u = cs.lens_v = 0.5;
+                if (need_lens)
+                    lf_sample_2d_d(&st, &cs.lens_u, &cs.lens_v);
+                cs.time = r->shutter_open;
+                cs.wavelength_u = 0.5;
+                if (need_wl) {
+                    double unused;
+                    lf_sample_2d_d(&st, &cs.wavelength_u, &unused);
+                }
+                lf_camera_ray cr;
+                cr.time = cs.time;
+                cr.wavelength_nm = 0;
+                double w = ct->generate_ray(r->camera, &cs, &cr);
+                (*paths)++;
+                wsum += fw;
+                if (!(w > 0) || !isfinite(w)) {
+                    (*zero_weight)++;
+                    continue;
+                }
+                lf_dvec3 o = lf_xform_point_d(&r->camera_to_world, (lf_dvec3){cr.origin[0], cr.origin[1], cr.origin[2]});
+                lf_dvec3 d = lf_xform_vector_d(&r->camera_to_world, (lf_dvec3){cr.dir[0], cr.dir[1], cr.dir[2]});
+                double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+                lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
+                lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
+                lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, &st, rays);
+                L = lf_scale(L, (float)w * scale);
+                if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
+                    (*nonfinite)++;
+                    continue;
+                }
+                if (isfinite(r->max_component)) {
+                    float m = lf_maxc(L);
+                    if (m > r->max_component)
+                        L = lf_scale(L, (float)(r->max_component / m));
+                }
+                sum[0] += fw * L.x, sum[1] += fw * L.y, sum[2] += fw * L.z;
+            }
+            float *px = lf_image_px(jb->img, x - r->px0, y - r->py0);
+            for (int c = 0; c < 3; c++)
+                px[c] = wsum != 0 ? (float)(sum[c] / wsum) : 0.f;
+        }
+}
+
+static void *worker(void *arg)
+{
+    job *jb = arg;
+#if defined(__SSE__) || defined(__x86_64__)
+    /* Denormals slow float math by orders of magnitude and carry no light. */
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    long long rays = 0, paths = 0, nonfinite = 0, zero_weight = 0;
+    int total = jb->tiles_x * jb->tiles_y;
+    for (;;) {
+        int t = atomic_fetch_add(&jb->next_tile, 1);
+        if (t >= total)
+            break;
+        render_tile(jb, t, &rays, &paths, &nonfinite, &zero_weight);
+        long done = atomic_fetch_add(&jb->done_tiles, 1) + 1;
+        if (jb->r->opts.progress) {
+            pthread_mutex_lock(&jb->progress_lock);
+            jb->r->opts.progress(jb->r->opts.progress_ctx, done, total);
+            pthread_mutex_unlock(&jb->progress_lock);
+        }
+    }
+    atomic_fetch_add(&jb->rays, rays);
+    atomic_fetch_add(&jb->paths, paths);
+    atomic_fetch_add(&jb->nonfinite, nonfinite);
+    atomic_fetch_add(&jb->zero_weight, zero_weight);
+    return NULL;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err)
+{
+    int w = r->px1 - r->px0, h = r->py1 - r->py0;
+    if (lf_image_alloc(img, w, h, 3, err))
+        return err->code;
+    job jb;
+    memset(&jb, 0, sizeof jb);
+    jb.r = r;
+    jb.img = img;
+    jb.tiles_x = (w + TILE - 1) / TILE;
+    jb.tiles_y = (h + TILE - 1) / TILE;
+    pthread_mutex_init(&jb.progress_lock, NULL);
+    double t0 = now_seconds();
+    int nt = r->threads;
+    pthread_t *th = calloc((size_t)nt, sizeof *th);
+    if (!th) {
+        lf_image_free(img);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    int started = 0;
+    for (int i = 1; i < nt; i++)
+        if (pthread_create(&th[i], NULL, worker, &jb) == 0)
+            started++;
+        else
+            th[i] = 0;
+    worker(&jb);
+    for (int i = 1; i < nt; i++)
+        if (th[i])
+            pthread_join(th[i], NULL);
+    free(th);
+    (void)started;
+    pthread_mutex_destroy(&jb.progress_lock);
+    r->stats.seconds = now_seconds() - t0;
+    r->stats.rays = jb.rays;
+    r->stats.camera_paths = jb.paths;
+    r->stats.nonfinite_samples = jb.nonfinite;
+    r->stats.zero_weight_camera_rays = jb.zero_weight;
+    if (meta) {
+        lf_attrs_set_string(meta, "lensfield:version", LF_VERSION_STRING);
+        lf_attrs_set_string(meta, "lensfield:camera", r->camera_name);
+        if (r->scene_path)
+            lf_attrs_set_string(meta, "lensfield:scene", r->scene_path);
+        lf_attrs_set_int(meta, "lensfield:spp", r->sampler.spp);
+        lf_attrs_set_int(meta, "lensfield:seed", (int)r->sampler.seed);
+        lf_attrs_set_string(meta, "lensfield:sampler", r->sampler_name);
+        lf_attrs_set_string(meta, "lensfield:filter", r->filter_name);
+        lf_attrs_set_int(meta, "lensfield:maxdepth", r->integrator.max_depth);
+        lf_attrs_set_double(meta, "lensfield:render_time_s", r->stats.seconds);
+        lf_attrs_set_int(meta, "lensfield:threads", r->threads);
+        float res[2] = {(float)r->xres, (float)r->yres};
+        lf_attrs_set_floats(meta, "lensfield:full_resolution", res, 2);
+        float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
+        lf_attrs_set_floats(meta, "lensfield:pixel_bounds", crop, 4);
+        lf_attrs_set_double(meta, "lensfield:film_diagonal_mm", r->diagonal_mm);
+        lf_attrs_set_double(meta, "lensfield:shutter_open", r->shutter_open);
+        lf_attrs_set_double(meta, "lensfield:shutter_close", r->shutter_close);
+        lf_attrs_set_double(meta, "lensfield:imaging_ratio", r->imaging_ratio);
+        lf_attrs_set_int(meta, "lensfield:nonfinite_samples", (int)r->stats.nonfinite_samples);
+        double m[16];
+        for (int i = 0; i < 16; i++)
+            m[i] = r->world_to_camera.m[i / 4][i % 4];
+        lf_attrs_set_m44d(meta, "lensfield:world_to_camera", m);
+    }
+    return 0;
+}

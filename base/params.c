@@ -381,7 +381,9 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
         type_error(ps, p, "rgb, blackbody, spectrum or float");
         return 1;
     }
-    *out = c;
+    /* Out-of-gamut spectra (a 1900 K blackbody has negative blue in sRGB)
+     * would emit or reflect negative light: clip to the gamut. */
+    *out = lf_v3(c.x > 0.f ? c.x : 0.f, c.y > 0.f ? c.y : 0.f, c.z > 0.f ? c.z : 0.f);
     return 1;
 }
 

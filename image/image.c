@@ -75,7 +75,8 @@ size_t lf_image_count_nonfinite(const lf_image *img)
         return 0;
     size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels, bad = 0;
     for (size_t i = 0; i < n; i++)
-        bad += !isfinite(img->data[i]);
+        if (!isfinite(img->data[i]))
+            bad++;
     return bad;
 }
 

@@ -57,6 +57,8 @@ char *lf_renderer_explain(const lf_renderer *r);
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err);
 /* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
 const char *lf_renderer_film_filename(const lf_renderer *r);
+/* Film "savefp16" (pbrt default true): store EXR channels as half floats. */
+int lf_renderer_film_half(const lf_renderer *r);
 
 typedef struct lf_render_stats {
     long long camera_paths;      /* samples traced */

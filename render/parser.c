@@ -516,6 +516,8 @@ static int set_coordsys(parser *P, const char *name, const lf_transform xf[2])
 /* ------------------------------------------------------------------------ */
 /* Arguments and parameter lists                                            */
 
+static int is_nonfinite_word(const token *t);
+
 static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *out)
 {
     for (int i = 0; i < n; i++) {
@@ -523,11 +525,13 @@ static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *
         int rc = lex_next(P, L, &t);
         if (rc)
             return rc;
-        if (t.kind != TK_NUMBER) {
-            char b[96];
+        char b[96];
+        if (t.kind == TK_WORD && is_nonfinite_word(&t))
+            return perr(P, LF_ERR_NUMERIC, &t.loc, "non-finite number %s in %.*s", describe(&t, b, sizeof b),
+                        (int)dir->n, dir->s);
+        if (t.kind != TK_NUMBER)
             return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects %d numbers, got %s after %d", (int)dir->n, dir->s, n,
                         describe(&t, b, sizeof b), i);
-        }
         out[i] = t.num;
     }
     return LF_OK;
@@ -946,6 +950,9 @@ static int read_matrix(parser *P, lexer *L, const token *dir, lf_transform *out)
     for (int i = 0; i < 16; i++) {
         if ((rc = lex_next(P, L, &t)))
             return rc;
+        if (t.kind == TK_WORD && is_nonfinite_word(&t))
+            return perr(P, LF_ERR_NUMERIC, &t.loc, "non-finite number %s in %.*s", describe(&t, b, sizeof b),
+                        (int)dir->n, dir->s);
         if (t.kind != TK_NUMBER) {
             if (bracketed && t.kind == TK_RBRACK)
                 return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects 16 numbers, got %d", (int)dir->n, dir->s, i);

@@ -372,6 +372,11 @@ const char *lf_renderer_film_filename(const lf_renderer *r)
     return r->film_filename;
 }
 
+int lf_renderer_film_half(const lf_renderer *r)
+{
+    return r->save_half;
+}
+
 lf_render_stats lf_renderer_stats(const lf_renderer *r)
 {
     return r->stats;

@@ -241,6 +241,18 @@ int main(int argc, char **argv)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
         lf_write_opts wo = {0};
+        wo.half = lf_renderer_film_half(r);
+        if (wo.half) {
+            /* Half floats top out at 65504: keep bright renders exact in float. */
+            size_t n = (size_t)img.width * img.height * img.channels;
+            for (size_t k = 0; k < n; k++)
+                if (img.data[k] > 65504.f) {
+                    fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
+                                    "writing 32-bit float channels\n");
+                    wo.half = 0;
+                    break;
+                }
+        }
         if (!quiet)
             fprintf(stderr, "lfrender: %lld camera paths in %.3f s: %.3f M paths/s, %.3f M rays/s\n",
                     st.camera_paths, st.seconds, st.camera_paths / st.seconds * 1e-6, st.rays / st.seconds * 1e-6);

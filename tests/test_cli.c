@@ -1,0 +1,157 @@
+/* lfrender as a user runs it: exit codes, messages, atomic outputs,
+ * metadata, --explain, --crop, --camera-plugin. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "image/lf_image.h"
+#include "lf_test.h"
+
+static char dir[256];
+static char out_text[65536];
+
+/* Runs a shell command, captures stdout+stderr into out_text, returns the exit code. */
+static int run(const char *fmt, ...)
+{
+    char cmd[4096], full[4600];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    snprintf(full, sizeof full, "%s > %s/log.txt 2>&1", cmd, dir);
+    int st = system(full);
+    char path[512];
+    snprintf(path, sizeof path, "%s/log.txt", dir);
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(out_text, 1, sizeof out_text - 1, f) : 0;
+    out_text[n] = '\0';
+    if (f)
+        fclose(f);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int exists(const char *path)
+{
+    struct stat s;
+    return stat(path, &s) == 0;
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    fputs(text, f);
+    fclose(f);
+}
+
+static const char *scene_ok =
+    "LookAt 0 0 -3 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" [40]\n"
+    "Film \"rgb\" \"integer xresolution\" [32] \"integer yresolution\" [24] \"bool savefp16\" false\n"
+    "Sampler \"zsobol\" \"integer pixelsamples\" [4]\n"
+    "WorldBegin\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\nShape \"sphere\"\n";
+
+int main(void)
+{
+    snprintf(dir, sizeof dir, "/tmp/lf_cli_XXXXXX");
+    if (!mkdtemp(dir))
+        return 1;
+    char scene[512], bad[512], out[512], png[512];
+    snprintf(scene, sizeof scene, "%s/ok.pbrt", dir);
+    snprintf(bad, sizeof bad, "%s/bad.pbrt", dir);
+    snprintf(out, sizeof out, "%s/o.exr", dir);
+    snprintf(png, sizeof png, "%s/o.png", dir);
+    write_file(scene, scene_ok);
+
+    CHECK(run("%s --help", LF_LFRENDER) == 0);
+    CHECK(strstr(out_text, "usage: lfrender") != NULL);
+    CHECK(run("%s", LF_LFRENDER) == 2);
+    CHECK(run("%s %s --spp abc", LF_LFRENDER, scene) == 2);
+    CHECK(strstr(out_text, "--spp") != NULL);
+    CHECK(run("%s %s --bogus", LF_LFRENDER, scene) == 2);
+
+    /* a good render: EXR with metadata, PNG */
+    CHECK(run("%s %s -o %s --seed 7 --threads 2 --quiet", LF_LFRENDER, scene, out) == 0);
+    lf_image img;
+    lf_attrs a = {0};
+    lf_error err = {0};
+    CHECK_MSG(lf_image_read(out, &img, &a, &err) == 0, "%s", err.msg);
+    if (!err.code) {
+        CHECK(img.width == 32 && img.height == 24);
+        const lf_attr *spp = lf_attrs_get(&a, "lensfield:spp"), *seed = lf_attrs_get(&a, "lensfield:seed");
+        const lf_attr *cam = lf_attrs_get(&a, "lensfield:camera"), *t = lf_attrs_get(&a, "lensfield:render_time_s");
+        CHECK(spp && spp->type == LF_ATTR_INT && spp->i == 4);
+        CHECK(seed && seed->type == LF_ATTR_INT && seed->i == 7);
+        CHECK(cam && cam->type == LF_ATTR_STRING && strcmp(cam->s, "perspective") == 0);
+        CHECK(t && t->d >= 0);
+        /* the background is the environment: exactly 0.5 */
+        CHECK_NEAR(lf_image_px(&img, 0, 0)[0], 0.5, 1e-6);
+        lf_image_free(&img);
+    }
+    lf_attrs_free(&a);
+    CHECK(run("%s %s -o %s --quiet", LF_LFRENDER, scene, png) == 0);
+    CHECK(exists(png));
+
+    /* --crop: only the requested pixels, same values as the full render */
+    char crop[512];
+    snprintf(crop, sizeof crop, "%s/crop.exr", dir);
+    CHECK(run("%s %s -o %s --seed 7 --crop 8 20 4 16 --quiet", LF_LFRENDER, scene, crop) == 0);
+    lf_image full, part;
+    if (lf_image_read(out, &full, NULL, &err) == 0 && lf_image_read(crop, &part, NULL, &err) == 0) {
+        CHECK(part.width == 12 && part.height == 12);
+        int same = 1;
+        for (int y = 0; y < 12; y++)
+            for (int x = 0; x < 12; x++)
+                for (int c = 0; c < 3; c++)
+                    same &= lf_image_px(&part, x, y)[c] == lf_image_px(&full, x + 8, y + 4)[c];
+        CHECK(same);
+        lf_image_free(&full);
+        lf_image_free(&part);
+    }
+
+    /* --explain prints the plan and writes nothing */
+    char none[512];
+    snprintf(none, sizeof none, "%s/none.exr", dir);
+    CHECK(run("%s %s --explain -o %s", LF_LFRENDER, scene, none) == 0);
+    CHECK(strstr(out_text, "camera: \"perspective\"") != NULL);
+    CHECK(strstr(out_text, "defocus: off") != NULL);
+    CHECK(strstr(out_text, "motion blur: off") != NULL);
+    CHECK(!exists(none));
+
+    /* a bad scene: exit 1, file:line:col, the existing output untouched */
+    write_file(bad, "LookAt 0 0 -3 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" [40\n");
+    struct stat before, after;
+    stat(out, &before);
+    CHECK(run("%s %s -o %s", LF_LFRENDER, bad, out) == 1);
+    CHECK_MSG(strstr(out_text, "bad.pbrt:") != NULL, "message: %s", out_text);
+    stat(out, &after);
+    CHECK(before.st_size == after.st_size && before.st_mtime == after.st_mtime);
+    write_file(bad, "WorldBegin\nShape \"sphere\" \"float radius\" [1] \"float radus\" [2]\n");
+    CHECK(run("%s %s -o %s/never.exr", LF_LFRENDER, bad, dir) == 1);
+    CHECK_MSG(strstr(out_text, "bad.pbrt:2:") && strstr(out_text, "radus"), "message: %s", out_text);
+    char never[512];
+    snprintf(never, sizeof never, "%s/never.exr", dir);
+    CHECK(!exists(never));
+    CHECK(run("%s %s/missing.pbrt", LF_LFRENDER, dir) == 1);
+    CHECK(strstr(out_text, "missing.pbrt") != NULL);
+
+    /* a camera from a plugin */
+    char pano[512];
+    snprintf(pano, sizeof pano, "%s/pano.pbrt", dir);
+    write_file(pano, "Camera \"panorama\"\nFilm \"rgb\" \"integer xresolution\" [16] \"integer yresolution\" [8]\n"
+                     "Sampler \"independent\" \"integer pixelsamples\" [1]\n"
+                     "WorldBegin\nLightSource \"infinite\"\n");
+    CHECK(run("%s %s -o %s/pano.exr --quiet", LF_LFRENDER, pano, dir) == 1); /* not registered */
+    CHECK(strstr(out_text, "panorama") != NULL);
+    CHECK(run("%s --camera-plugin %s %s -o %s/pano.exr --quiet", LF_LFRENDER, LF_PLUGIN_PATH, pano, dir) == 0);
+
+    /* no temporary files left behind */
+    CHECK(run("ls -A %s | grep -c tmp", dir) != 0 || strncmp(out_text, "0", 1) == 0);
+    char rm[600];
+    snprintf(rm, sizeof rm, "rm -rf %s", dir);
+    if (system(rm) != 0)
+        fprintf(stderr, "could not remove %s\n", dir);
+    return lf_test_end();
+}

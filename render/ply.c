@@ -269,32 +269,37 @@ static int host_is_little_endian(void)
     return *(const unsigned char *)&one == 1;
 }
 
-/* Reads one scalar of type t; 0, or -1 on malformed/truncated data. */
+/* Reads one scalar of type t: 0, -1 for a malformed value, or
+ * END_OF_DATA. */
+#define END_OF_DATA (-2)
+
 static int read_scalar(ply_reader *r, scalar_type t, double *out)
 {
     if (r->format == PLY_ASCII) {
         const char *p = r->buf + r->pos;
+        int line = r->line;
         while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n') {
             if (*p == '\n')
-                r->line++;
+                line++;
             p++;
         }
         r->pos = (size_t)(p - r->buf);
-        if (!*p)
-            return -1;
+        if (!*p || r->pos >= r->len)
+            return END_OF_DATA; /* r->line stays on the last line with data */
+        r->line = line;
         char *end;
         double v = strtod(p, &end);
         if (end == p || (*end && *end != ' ' && *end != '\t' && *end != '\r' && *end != '\n'))
             return -1;
         r->pos = (size_t)(end - r->buf);
-        if (t < ST_FLOAT32 && v != floor(v))
+        if (!isfinite(v) || (t < ST_FLOAT32 && v != floor(v)))
             return -1;
         *out = v;
         return 0;
     }
     size_t n = scalar_size[t];
     if (r->len - r->pos < n)
-        return -1;
+        return END_OF_DATA;
     unsigned char b[8];
     memcpy(b, r->buf + r->pos, n);
     r->pos += n;
@@ -314,7 +319,7 @@ static int read_scalar(ply_reader *r, scalar_type t, double *out)
     case ST_FLOAT32: { float v; memcpy(&v, b, 4); *out = v; break; }
     case ST_FLOAT64: { double v; memcpy(&v, b, 8); *out = v; break; }
     }
-    return 0;
+    return isfinite(*out) ? 0 : -1;
 }
 
 static void assign_roles(ply_element *el, int *has_normals, int *has_uv, int is_vertex)
@@ -350,6 +355,12 @@ static void assign_roles(ply_element *el, int *has_normals, int *has_uv, int is_
         unsigned n = (1u << ROLE_NX) | (1u << ROLE_NY) | (1u << ROLE_NZ), uv = (1u << ROLE_U) | (1u << ROLE_V);
         *has_normals = (seen & n) == n;
         *has_uv = (seen & uv) == uv;
+        /* A partial set (nx without nz, u without v) is ignored. */
+        for (size_t i = 0; i < el->n_props; i++) {
+            prop_role r = el->props[i].role;
+            if ((!*has_normals && r >= ROLE_NX && r <= ROLE_NZ) || (!*has_uv && (r == ROLE_U || r == ROLE_V)))
+                el->props[i].role = ROLE_SKIP;
+        }
     }
 }
 
@@ -452,9 +463,10 @@ int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
                 double v;
                 char what[160];
                 if (!p->is_list) {
-                    if (read_scalar(&r, p->type, &v)) {
+                    int got = read_scalar(&r, p->type, &v);
+                    if (got) {
                         snprintf(what, sizeof what, "\"%s\" of %s %zu", p->name, el->name, item);
-                        rc = ply_fail(&r, 0, r.pos >= r.len ? "unexpected end of data reading " : "bad value for ",
+                        rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value for ",
                                       what);
                         break;
                     }
@@ -473,9 +485,10 @@ int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
                     continue;
                 }
                 double cnt;
-                if (read_scalar(&r, p->count_type, &cnt) || cnt < 0 || cnt != floor(cnt) || cnt > 1e6) {
+                int got = read_scalar(&r, p->count_type, &cnt);
+                if (got || cnt < 0 || cnt > 1e6) {
                     snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
-                    rc = ply_fail(&r, 0, r.pos >= r.len ? "unexpected end of data reading " : "bad list count in ",
+                    rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad list count in ",
                                   what);
                     break;
                 }
@@ -490,9 +503,9 @@ int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
                     poly_cap = n;
                 }
                 for (size_t k = 0; k < n; k++) {
-                    if (read_scalar(&r, p->type, &v)) {
+                    if ((got = read_scalar(&r, p->type, &v))) {
                         snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
-                        rc = ply_fail(&r, 0, r.pos >= r.len ? "unexpected end of data reading " : "bad value in ",
+                        rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value in ",
                                       what);
                         break;
                     }

@@ -1,5 +1,7 @@
 #include "lf_sampler.h"
 
+#include <pthread.h>
+
 /* 32-bit integer hash (Chris Wellons' "lowbias32" finaliser). */
 uint32_t lf_hash_u32(uint32_t x)
 {
@@ -16,19 +18,18 @@ uint32_t lf_hash_combine(uint32_t a, uint32_t b)
     return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));
 }
 
-static uint32_t reverse_bits(uint32_t x)
+static inline uint32_t reverse_bits(uint32_t x)
 {
+    x = __builtin_bswap32(x);
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
     x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-    return (x >> 16) | (x << 16);
+    return ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
 }
 
 /* Laine-Karras style hash that only lets each bit depend on lower bits;
  * applied to bit-reversed values it is a nested uniform (Owen) scramble
  * (Burley 2020, improved constants from Nathan Vegdahl's analysis). */
-static uint32_t lk_permute(uint32_t x, uint32_t seed)
+static inline uint32_t lk_permute(uint32_t x, uint32_t seed)
 {
     x ^= x * 0x3d20adeau;
     x += seed;
@@ -38,20 +39,36 @@ static uint32_t lk_permute(uint32_t x, uint32_t seed)
     return x;
 }
 
-static uint32_t owen_scramble(uint32_t x, uint32_t seed)
-{
-    return reverse_bits(lk_permute(reverse_bits(x), seed));
-}
 
 /* First two Sobol dimensions: dimension 0 is the van der Corput sequence
- * (bit reversal); dimension 1 has direction numbers v_k = v_{k-1} ^ (v_{k-1} >> 1). */
-static uint32_t sobol_dim1(uint32_t i)
+ * (bit reversal); dimension 1 has direction numbers v_k = v_{k-1} ^ (v_{k-1} >> 1).
+ * Dimension 1 is linear over GF(2) in the index bits, so it is evaluated a
+ * byte at a time from four 256-entry tables; the tables hold the
+ * bit-reversed values, which is the form the Owen scramble consumes. */
+static uint32_t sobol1_rev_table[4][256];
+static pthread_once_t sobol_once = PTHREAD_ONCE_INIT;
+
+static void sobol_tables_init(void)
 {
-    uint32_t v = 0x80000000u, x = 0;
-    for (; i; i >>= 1, v ^= v >> 1)
-        if (i & 1u)
-            x ^= v;
-    return x;
+    uint32_t v[32];
+    v[0] = 0x80000000u;
+    for (int k = 1; k < 32; k++)
+        v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+    for (int byte = 0; byte < 4; byte++)
+        for (int b = 0; b < 256; b++) {
+            uint32_t x = 0;
+            for (int k = 0; k < 8; k++)
+                if (b & (1 << k))
+                    x ^= v[8 * byte + k];
+            sobol1_rev_table[byte][b] = reverse_bits(x);
+        }
+}
+
+/* reverse_bits(sobol dimension 1 of index i) */
+static inline uint32_t sobol1_rev(uint32_t i)
+{
+    return sobol1_rev_table[0][i & 0xffu] ^ sobol1_rev_table[1][(i >> 8) & 0xffu] ^
+           sobol1_rev_table[2][(i >> 16) & 0xffu] ^ sobol1_rev_table[3][i >> 24];
 }
 
 static float to_unit(uint32_t x)
@@ -62,6 +79,8 @@ static float to_unit(uint32_t x)
 
 void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
 {
+    if (s->kind == LF_SAMPLER_SOBOL)
+        pthread_once(&sobol_once, sobol_tables_init);
     st->s = s;
     st->pixel_hash = lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
     st->index = index;
@@ -75,9 +94,14 @@ static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
     uint32_t h = lf_hash_combine(st->pixel_hash, pair);
     switch (st->s->kind) {
     case LF_SAMPLER_SOBOL: {
-        uint32_t i = owen_scramble(st->index, h);
-        *a = owen_scramble(reverse_bits(i), lf_hash_u32(h ^ 0xa511e9b3u));
-        *b = owen_scramble(sobol_dim1(i), lf_hash_u32(h ^ 0x63d83595u));
+        /* Owen scrambling is reverse o hash o reverse; the reversals that
+         * cancel are left out:
+         *   i = owen(index)            shuffled index
+         *   a = owen(dim0(i)) = reverse(lk(i))           since dim0 = reverse
+         *   b = owen(dim1(i)) = reverse(lk(reverse(dim1(i)))) */
+        uint32_t i = reverse_bits(lk_permute(reverse_bits(st->index), h));
+        *a = reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u)));
+        *b = reverse_bits(lk_permute(sobol1_rev(i), lf_hash_u32(h ^ 0x63d83595u)));
         return;
     }
     case LF_SAMPLER_STRATIFIED: {
@@ -109,6 +133,13 @@ static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
 
 float lf_sample_1d(lf_sample_stream *st)
 {
+    if (st->s->kind == LF_SAMPLER_SOBOL) {
+        /* a 1D value needs only the first Sobol dimension of the pair */
+        uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
+        st->dim += 2;
+        uint32_t i = reverse_bits(lk_permute(reverse_bits(st->index), h));
+        return to_unit(reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u))));
+    }
     uint32_t a, b;
     sample_pair(st, &a, &b);
     return to_unit(a);

@@ -67,6 +67,12 @@ typedef struct lf_camera_params {
     /* Array of floats (any numeric declared type): copies up to max values,
      * returns how many the parameter has (0 if absent). */
     int (*get_floats)(void *ctx, const char *name, double *out, int max);
+    /* Loads an image (e.g. an aperture mask) as one linear grey channel (the
+     * mean of its colour channels), row 0 at the top.  Relative paths are
+     * resolved against the scene file's directory.  *pixels is malloc'ed;
+     * the camera frees it with free().  Returns 0, or -1 with a message. */
+    int (*load_image)(void *ctx, const char *path, int *width, int *height, float **pixels, char *err,
+                      size_t err_size);
 } lf_camera_params;
 
 typedef struct lf_camera_create_args {

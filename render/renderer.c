@@ -72,20 +72,69 @@ static void where_of(char *buf, size_t n, const lf_loc *loc)
 }
 
 /* ---- camera parameter adaptor (the plugin ABI's lf_camera_params) ---- */
-static double cp_float(void *ctx, const char *name, double def) { return lf_params_float(ctx, name, def); }
-static int cp_int(void *ctx, const char *name, int def) { return lf_params_int(ctx, name, def); }
-static int cp_bool(void *ctx, const char *name, int def) { return lf_params_bool(ctx, name, def); }
+typedef struct camera_param_ctx {
+    lf_paramset *ps;
+    const char *scene_dir;
+} camera_param_ctx;
+
+static double cp_float(void *ctx, const char *name, double def)
+{
+    return lf_params_float(((camera_param_ctx *)ctx)->ps, name, def);
+}
+static int cp_int(void *ctx, const char *name, int def)
+{
+    return lf_params_int(((camera_param_ctx *)ctx)->ps, name, def);
+}
+static int cp_bool(void *ctx, const char *name, int def)
+{
+    return lf_params_bool(((camera_param_ctx *)ctx)->ps, name, def);
+}
 static const char *cp_string(void *ctx, const char *name, const char *def)
 {
-    return lf_params_string(ctx, name, def);
+    return lf_params_string(((camera_param_ctx *)ctx)->ps, name, def);
+}
+static int cp_image(void *ctx, const char *path, int *width, int *height, float **pixels, char *msg, size_t msg_size)
+{
+    const camera_param_ctx *c = ctx;
+    char full[4096];
+    if (path[0] == '/' || !c->scene_dir || !c->scene_dir[0])
+        snprintf(full, sizeof full, "%s", path);
+    else
+        snprintf(full, sizeof full, "%s/%s", c->scene_dir, path);
+    lf_image img;
+    lf_error err = {0};
+    if (lf_image_read(full, &img, NULL, &err)) {
+        snprintf(msg, msg_size, "%s", err.msg);
+        return -1;
+    }
+    size_t n = (size_t)img.width * img.height;
+    float *g = malloc(sizeof(float) * (n ? n : 1));
+    if (!g) {
+        lf_image_free(&img);
+        snprintf(msg, msg_size, "out of memory reading %s", full);
+        return -1;
+    }
+    int nc = img.channels >= 3 ? 3 : 1;
+    for (size_t i = 0; i < n; i++) {
+        float s = 0;
+        for (int k = 0; k < nc; k++)
+            s += img.data[i * img.channels + k];
+        g[i] = s / nc;
+    }
+    *width = img.width;
+    *height = img.height;
+    *pixels = g;
+    lf_image_free(&img);
+    return 0;
 }
 static int cp_floats(void *ctx, const char *name, double *out, int max)
 {
-    const lf_param *p = lf_params_peek(ctx, name);
+    lf_paramset *ps = ((camera_param_ctx *)ctx)->ps;
+    const lf_param *p = lf_params_peek(ps, name);
     if (!p)
         return 0;
     size_t n = 0;
-    const double *v = lf_params_nums(ctx, name, p->type == LF_PT_INTEGER ? LF_PT_INTEGER : LF_PT_FLOAT, &n);
+    const double *v = lf_params_nums(ps, name, p->type == LF_PT_INTEGER ? LF_PT_INTEGER : LF_PT_FLOAT, &n);
     if (!v)
         return 0;
     for (size_t i = 0; i < n && (int)i < max; i++)
@@ -297,14 +346,16 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         r->shutter_close = t;
     }
     r->imaging_ratio *= r->shutter_close - r->shutter_open;
-    lf_camera_params cp = {ps, cp_float, cp_int, cp_bool, cp_string, cp_floats};
     char cerr[1024] = "", cwarn[1024] = "";
     char scene_dir[4096] = ".";
-    if (r->scene_path) {
-        const char *slash = strrchr(r->scene_path, '/');
+    const char *scene_file = cd->e.loc.file ? cd->e.loc.file : r->scene_path;
+    if (scene_file) {
+        const char *slash = strrchr(scene_file, '/');
         if (slash)
-            snprintf(scene_dir, sizeof scene_dir, "%.*s", (int)(slash - r->scene_path), r->scene_path);
+            snprintf(scene_dir, sizeof scene_dir, "%.*s", (int)(slash - scene_file), scene_file);
     }
+    camera_param_ctx cpc = {ps, scene_dir};
+    lf_camera_params cp = {&cpc, cp_float, cp_int, cp_bool, cp_string, cp_floats, cp_image};
     lf_camera_create_args args = {sizeof args,   &cp,  r->xres,       r->yres,       r->diagonal_mm, r->shutter_open,
                                   r->shutter_close, scene_dir, cerr, sizeof cerr, cwarn,       sizeof cwarn};
     if (r->camera_type->create(&args, &r->camera)) {

@@ -55,9 +55,16 @@ static int g_floats(void *c, const char *name, double *out, int max)
     return k->n;
 }
 
+static int g_image(void *c, const char *path, int *w, int *h, float **px, char *err, size_t n)
+{
+    (void)c, (void)w, (void)h, (void)px;
+    snprintf(err, n, "no images in this test (%s)", path);
+    return -1;
+}
+
 static void *make(const char *type, store *s, int w, int h, char *err)
 {
-    lf_camera_params p = {s, g_float, g_int, g_bool, g_string, g_floats};
+    lf_camera_params p = {s, g_float, g_int, g_bool, g_string, g_floats, g_image};
     char warn[256] = "";
     lf_camera_create_args a = {sizeof a, &p, w, h, 35.0, 0.0, 1.0, ".", err, 512, warn, sizeof warn};
     void *state = NULL;

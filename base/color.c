@@ -1,5 +1,7 @@
 #include "lf_color.h"
 
+#include <pthread.h>
+
 #include <string.h>
 
 /* One lobe of the Wyman-Sloan-Shirley fit: a Gaussian with a different
@@ -196,4 +198,32 @@ int lf_named_spectrum_rgb(const char *name, lf_vec3 *out)
             return 0;
         }
     return -1;
+}
+
+static double wl_norm[3];
+static pthread_once_t wl_once = PTHREAD_ONCE_INIT;
+
+/* normalisation: the mean over the range of the RGB response */
+static void wl_norm_init(void)
+{
+    double sum[3] = {0, 0, 0};
+    int n = 0;
+    for (double l = LF_LAMBDA_MIN; l <= LF_LAMBDA_MAX; l += 1.0, n++) {
+        double xyz[3];
+        lf_cie_xyz_bar(l, xyz);
+        lf_vec3 c = lf_xyz_to_linear_srgb(xyz[0], xyz[1], xyz[2]);
+        sum[0] += c.x, sum[1] += c.y, sum[2] += c.z;
+    }
+    for (int k = 0; k < 3; k++)
+        wl_norm[k] = sum[k] / n;
+}
+
+lf_vec3 lf_wavelength_rgb_weight(double lambda_nm)
+{
+    pthread_once(&wl_once, wl_norm_init);
+    double *norm = wl_norm;
+    double xyz[3];
+    lf_cie_xyz_bar(lambda_nm, xyz);
+    lf_vec3 c = lf_xyz_to_linear_srgb(xyz[0], xyz[1], xyz[2]);
+    return lf_v3((float)(c.x / norm[0]), (float)(c.y / norm[1]), (float)(c.z / norm[2]));
 }

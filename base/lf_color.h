@@ -72,6 +72,17 @@ lf_vec3 lf_spectrum_pairs_rgb(const double *lambdas, const double *values, size_
  * Returns 0 and sets *out, or -1 if the name is unknown. */
 int lf_named_spectrum_rgb(const char *name, lf_vec3 *out);
 
+/* Spectral camera rays (dispersion): a camera that samples wavelength picks
+ * lambda uniformly in [LF_LAMBDA_MIN, LF_LAMBDA_MAX] nm; the radiance it
+ * carries (RGB) is multiplied by this weight, the linear-sRGB response to
+ * a unit monochromatic sample divided by its pdf and normalised so that the
+ * weights average to (1,1,1) over the range: a grey scene stays grey, and
+ * each wavelength only lights the channels it belongs to.  Channels can be
+ * negative for saturated spectral colours (outside the sRGB gamut). */
+#define LF_LAMBDA_MIN 360.0
+#define LF_LAMBDA_MAX 830.0
+lf_vec3 lf_wavelength_rgb_weight(double lambda_nm);
+
 #ifdef __cplusplus
 }
 #endif

@@ -51,7 +51,11 @@ typedef struct lf_camera_ray {
     double origin[3];      /* camera space */
     double dir[3];         /* camera space, unit length */
     double time;           /* scene time; the host sets it from the sample before the call */
-    double wavelength_nm;  /* 0 unless the camera needs wavelength */
+    double wavelength_nm;  /* 0 unless the camera needs wavelength; then a camera sets
+                            * LF_LAMBDA_MIN + wavelength_u (LF_LAMBDA_MAX - LF_LAMBDA_MIN)
+                            * nm (360..830, uniform) and the host weights the ray's RGB
+                            * radiance by that wavelength's sRGB response
+                            * (base/lf_color.h lf_wavelength_rgb_weight) */
 } lf_camera_ray;
 
 /* Read access to the camera's own parameters in the scene file.  Every

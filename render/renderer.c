@@ -15,6 +15,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "../base/lf_color.h"
 #include "render_internal.h"
 
 #define LF_VERSION_STRING "lensfield 0.1"
@@ -595,6 +596,8 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                 lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
                 lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, &st, rays);
                 L = lf_scale(L, (float)w * scale);
+                if (need_wl && cr.wavelength_nm > 0)
+                    L = lf_mul(L, lf_wavelength_rgb_weight(cr.wavelength_nm));
                 if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
                     (*nonfinite)++;
                     continue;

@@ -1,0 +1,56 @@
+/* aperture.h - aperture (bokeh) shapes shared by the lens cameras (private
+ * to camera/).
+ *
+ * An aperture is a region of the lens plane in units of the aperture radius:
+ * it fits in the unit disk (polygons have their corners on the unit circle,
+ * images fill [-1,1]^2 and are cropped to nothing else), then x is scaled by
+ * the anamorphic ratio.  Sampling is unbiased: points are uniform over the
+ * open region (or distributed by image transmission), and the returned
+ * weight makes E[weight * g(p)] equal the integral of g over the region
+ * (times transmission) divided by lf_aperture_area(), so a camera multiplies
+ * by the true area where it needs radiometry.
+ *
+ * Scene parameters (read by lf_aperture_parse, all optional):
+ *   "string aperture"  "circular" (default) | "polygon" | "square" | "pentagon"
+ *                      | "star" | an image file name (grayscale transmission)
+ *   "integer blades"   polygon blade count (default 6; square 4, pentagon 5)
+ *   "float aperturerotation"  degrees (default 0)
+ *   "float anamorphic" horizontal stretch of the aperture (default 1)
+ */
+#ifndef LF_APERTURE_H
+#define LF_APERTURE_H
+
+#include <stddef.h>
+
+#include "../base/lf_distrib.h"
+#include "lf_camera.h"
+
+typedef enum lf_aperture_kind {
+    LF_APERTURE_CIRCLE,
+    LF_APERTURE_POLYGON,
+    LF_APERTURE_STAR,
+    LF_APERTURE_IMAGE
+} lf_aperture_kind;
+
+typedef struct lf_aperture {
+    lf_aperture_kind kind;
+    int blades;
+    double rotation_rad;
+    double anamorphic;
+    /* image apertures */
+    int img_w, img_h;
+    float *img;
+    lf_distrib2d distrib;
+    double area; /* open area in radius^2 units, including anamorphic and transmission */
+} lf_aperture;
+
+/* Reads the parameters above; 0 or -1 with a message (e.g. an all-black image). */
+int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, char *err, size_t err_size);
+/* u, v in [0,1); returns the weight (0: no point), fills (x, y) in radius units. */
+double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, double *y);
+/* Is (x, y) (radius units) inside the open region? Returns its transmission. */
+double lf_aperture_transmission(const lf_aperture *a, double x, double y);
+double lf_aperture_area(const lf_aperture *a);
+void lf_aperture_free(lf_aperture *a);
+
+#endif

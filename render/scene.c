@@ -157,9 +157,10 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const lf_transform *
         if (idx[i] < 0 || idx[i] >= nv) {
             char where[512];
             loc_prefix(where, sizeof where, &sh->e.loc);
+            int bad = idx[i];
             free(P), free(N), free(uv), free(idx);
             return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"%s\": vertex index %d out of range (%d vertices)",
-                                where, sh->e.type, idx[i], nv);
+                                where, sh->e.type, bad, nv);
         }
     for (int i = 0; i < nv; i++) {
         lf_vec3 p = lf_xform_point(xf, lf_v3(P[3 * i], P[3 * i + 1], P[3 * i + 2]));

@@ -40,9 +40,12 @@ static int g_bool(void *c, const char *name, int def)
 {
     return g_int(c, name, def);
 }
+/* Cameras that need a file get the shipped double Gauss (relative to scenes/). */
 static const char *g_string(void *c, const char *name, const char *def)
 {
-    (void)c, (void)name;
+    (void)c;
+    if (!strcmp(name, "lensfile"))
+        return "lenses/dgauss.50mm.dat";
     return def;
 }
 static int g_floats(void *c, const char *name, double *out, int max)
@@ -66,7 +69,7 @@ static void *make(const char *type, store *s, int w, int h, char *err)
 {
     lf_camera_params p = {s, g_float, g_int, g_bool, g_string, g_floats, g_image};
     char warn[256] = "";
-    lf_camera_create_args a = {sizeof a, &p, w, h, 35.0, 0.0, 1.0, ".", err, 512, warn, sizeof warn};
+    lf_camera_create_args a = {sizeof a, &p, w, h, 35.0, 0.0, 1.0, LF_SOURCE_DIR "/scenes", err, 512, warn, sizeof warn};
     void *state = NULL;
     const lf_camera_type *t = lf_camera_find(type);
     if (!t || t->create(&a, &state))

@@ -1,0 +1,289 @@
+/* The physical thin-lens camera "thinlens": photographer's parameters
+ * (focal length, f-number, focus distance, sensor size) and pixel values
+ * that are exposure, not radiance.  docs/thinlens.md is the user's page.
+ *
+ * Geometry (camera space, metres; course notes "Ray Tracing for Defocus Blur
+ * (Thin Lens)"; PHYSICS.md "Two thin-lens cameras"):
+ *   - the thin lens is the plane z = 0, centred on the origin, looking +z;
+ *   - the sensor is the plane z = -z_s behind it, z_s the image distance of
+ *     the focus plane z = z_o: 1/f = 1/z_s + 1/z_o, so z_s = f z_o/(z_o - f)
+ *     (focusing moves the sensor: magnification m = z_s/z_o and the field of
+ *     view 2 atan(w / 2 z_s) change with focus, as on a real lens);
+ *   - raster (x, y) -> upright sensor coordinates (sx, sy) in metres,
+ *       sx = (x/W - 1/2) w,   sy = (1/2 - y/H) h,   h = w H/W (square pixels),
+ *     and the physical film point is p_s = (-sx, -sy, -z_s): the lens images
+ *     the scene upside down and reversed, so reading the sensor through the
+ *     point reflection gives pbrt's orientation (raster x right = camera +x,
+ *     raster y down = camera -y);
+ *   - the chief ray from p_s through the lens centre is undeviated and meets
+ *     the focus plane at the conjugate point
+ *       P = -p_s z_o/z_s = (sx/m, sy/m, z_o);
+ *     every ray from p_s through any lens point p_l passes through P (the
+ *     lens images p_s to P), so the ray leaves p_l towards P.
+ *
+ * Radiometry (PHYSICS.md "Exposure and radiometry"): the irradiance at p_s is
+ *   E = (1/z_s^2) \int_aperture L cos^4(theta) dA,
+ * theta the angle between p_l - p_s and the axis.  With p_l uniform over the
+ * open aperture of area A_ap = R^2 lf_aperture_area() (R = f/2N), the
+ * estimator is L times weight = A_ap cos^4(theta)/z_s^2 (times the aperture
+ * sample's weight).  The host multiplies by the imaging ratio (shutter time
+ * x ISO/100), so a pixel is the exposure H = E t ISO/100 (W/m^2 s): about
+ * pi/(4 N^2) times the scene radiance on axis (the camera equation), with
+ * the natural cos^4 falloff off axis.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "aperture.h"
+#include "camera_internal.h"
+
+typedef struct sensor_size {
+    const char *name;
+    double width_mm, height_mm;
+} sensor_size;
+
+/* Nominal sizes of common formats (docs/thinlens.md lists crop factors). */
+static const sensor_size sensors[] = {
+    {"mediumformat", 53.7, 40.2}, {"fullframe", 36.0, 24.0}, {"apsh", 27.9, 18.6},    {"apsc", 23.6, 15.8},
+    {"fourthirds", 17.3, 13.0},   {"1inch", 13.2, 8.8},      {"1/1.63in", 8.38, 5.59}, {"1/2.3in", 6.16, 4.62},
+    {"1/3.2in", 4.54, 3.42},
+};
+#define N_SENSORS ((int)(sizeof sensors / sizeof sensors[0]))
+
+typedef struct thinlens {
+    double focal_length;      /* f, metres */
+    double fstop;             /* N */
+    double aperture_radius;   /* R = f / 2N, metres */
+    double focus_distance;    /* z_o, metres from the lens */
+    double sensor_distance;   /* z_s, metres behind the lens */
+    double sensor_w, sensor_h;            /* metres, as imaged (h = w H/W) */
+    double nominal_w_mm, nominal_h_mm;    /* the named or given sensor */
+    char sensor_name[32];
+    double coc_mm;            /* circle of confusion for depth of field */
+    double open_area;         /* A_ap, m^2 */
+    double weight_scale;      /* A_ap / z_s^2 */
+    double inv_m;             /* z_o / z_s */
+    int width, height;
+    lf_aperture aperture;
+} thinlens;
+
+static int fail(const lf_camera_create_args *a, thinlens *c, const char *fmt, double v)
+{
+    snprintf(a->error, a->error_size, fmt, v);
+    if (c) {
+        lf_aperture_free(&c->aperture);
+        free(c);
+    }
+    return -1;
+}
+
+static int thinlens_create(const lf_camera_create_args *a, void **state)
+{
+    const lf_camera_params *p = a->params;
+    thinlens *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(a->error, a->error_size, "out of memory");
+        return -1;
+    }
+    c->width = a->image_width;
+    c->height = a->image_height;
+    double f_mm = p->get_float(p->ctx, "focallength", 50.0);
+    c->fstop = p->get_float(p->ctx, "fstop", 2.8);
+    c->focus_distance = p->get_float(p->ctx, "focusdistance", 10.0);
+    if (!(f_mm > 0.0) || !isfinite(f_mm))
+        return fail(a, c, "\"focallength\" must be > 0 mm, got %g", f_mm);
+    if (!(c->fstop > 0.0) || !isfinite(c->fstop))
+        return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
+    c->focal_length = f_mm * 1e-3;
+    if (!isfinite(c->focus_distance) || !(c->focus_distance > c->focal_length)) {
+        char msg[256];
+        snprintf(msg, sizeof msg,
+                 "\"focusdistance\" %g m is closer than the focal length (%g mm): a thin lens cannot focus there "
+                 "(1/f = 1/z_i + 1/z_o has no real image); it must exceed %g m",
+                 c->focus_distance, f_mm, c->focal_length);
+        return fail(a, c, "%s", 0.0) + (snprintf(a->error, a->error_size, "%s", msg), 0);
+    }
+
+    /* sensor: "float sensorsize" [w h] mm wins over "string sensor" */
+    double wh[2] = {0, 0};
+    int nsz = p->get_floats(p->ctx, "sensorsize", wh, 2);
+    const char *name = p->get_string(p->ctx, "sensor", "fullframe");
+    if (nsz != 0) {
+        if (nsz != 2 || !(wh[0] > 0.0) || !(wh[1] > 0.0) || !isfinite(wh[0]) || !isfinite(wh[1]))
+            return fail(a, c, "\"sensorsize\" needs two positive values [width height] in mm (got %g values)",
+                        (double)nsz);
+        c->nominal_w_mm = wh[0];
+        c->nominal_h_mm = wh[1];
+        snprintf(c->sensor_name, sizeof c->sensor_name, "custom");
+    } else {
+        int k = -1;
+        for (int i = 0; i < N_SENSORS; i++)
+            if (!strcmp(name, sensors[i].name))
+                k = i;
+        if (k < 0) {
+            char names[512] = "";
+            for (int i = 0; i < N_SENSORS; i++) {
+                strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
+                strncat(names, sensors[i].name, sizeof names - strlen(names) - 1);
+            }
+            snprintf(a->error, a->error_size, "unknown \"sensor\" \"%s\" (known: %s; or give \"float sensorsize\" [w h] mm)",
+                     name, names);
+            free(c);
+            return -1;
+        }
+        c->nominal_w_mm = sensors[k].width_mm;
+        c->nominal_h_mm = sensors[k].height_mm;
+        snprintf(c->sensor_name, sizeof c->sensor_name, "%s", sensors[k].name);
+    }
+    /* the width maps to the image width; square pixels fix the height */
+    c->sensor_w = c->nominal_w_mm * 1e-3;
+    c->sensor_h = c->sensor_w * c->height / c->width;
+    if (fabs(c->sensor_h * 1e3 - c->nominal_h_mm) > 0.01 * c->nominal_h_mm && a->warning && a->warning_size)
+        snprintf(a->warning, a->warning_size,
+                 "the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to the "
+                 "image width, pixels are square)",
+                 c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm,
+                 c->sensor_h * 1e3);
+
+    double diag_mm = hypot(c->nominal_w_mm, c->nominal_h_mm);
+    c->coc_mm = p->get_float(p->ctx, "coc", diag_mm / 1500.0);
+    if (!(c->coc_mm > 0.0) || !isfinite(c->coc_mm))
+        return fail(a, c, "\"coc\" (circle of confusion, mm) must be > 0, got %g", c->coc_mm);
+
+    if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
+        free(c);
+        return -1;
+    }
+
+    /* thin lens equation, written to stay accurate when z_o >> f */
+    double f = c->focal_length, zo = c->focus_distance;
+    c->sensor_distance = f / (1.0 - f / zo);
+    c->inv_m = zo / c->sensor_distance;
+    c->aperture_radius = f / (2.0 * c->fstop);
+    c->open_area = c->aperture_radius * c->aperture_radius * lf_aperture_area(&c->aperture);
+    c->weight_scale = c->open_area / (c->sensor_distance * c->sensor_distance);
+    if (!isfinite(c->sensor_distance) || !isfinite(c->inv_m) || !(c->weight_scale > 0) || !isfinite(c->weight_scale))
+        return fail(a, c, "focus distance %g m gives no finite sensor position", zo);
+    *state = c;
+    return 0;
+}
+
+static uint32_t thinlens_needs(const void *state)
+{
+    const thinlens *c = state;
+    return c->aperture_radius > 0.0 ? LF_CAMERA_NEEDS_LENS : 0u;
+}
+
+static double thinlens_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+{
+    const thinlens *c = state;
+    /* upright sensor coordinates, metres */
+    double sx = (s->film_x / c->width - 0.5) * c->sensor_w;
+    double sy = (0.5 - s->film_y / c->height) * c->sensor_h;
+    double lx, ly;
+    double aw = lf_aperture_sample(&c->aperture, s->lens_u, s->lens_v, &lx, &ly);
+    if (!(aw > 0.0))
+        return 0.0;
+    lx *= c->aperture_radius, ly *= c->aperture_radius;
+    /* conjugate point on the focus plane */
+    double P[3] = {sx * c->inv_m, sy * c->inv_m, c->focus_distance};
+    double d[3] = {P[0] - lx, P[1] - ly, P[2]};
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    /* cos(theta) of the ray p_s -> p_l, with p_s = (-sx, -sy, -z_s) */
+    double ax = lx + sx, ay = ly + sy, zs = c->sensor_distance;
+    double cos2 = zs * zs / (ax * ax + ay * ay + zs * zs);
+    double w = c->weight_scale * cos2 * cos2 * aw;
+    if (!(len > 0.0) || !isfinite(len) || !isfinite(w))
+        return 0.0;
+    r->origin[0] = lx, r->origin[1] = ly, r->origin[2] = 0.0;
+    r->dir[0] = d[0] / len, r->dir[1] = d[1] / len, r->dir[2] = d[2] / len;
+    return w;
+}
+
+static void thinlens_destroy(void *state)
+{
+    thinlens *c = state;
+    if (c)
+        lf_aperture_free(&c->aperture);
+    free(c);
+}
+
+static const char *aperture_name(const lf_aperture *a)
+{
+    switch (a->kind) {
+    case LF_APERTURE_CIRCLE:
+        return "circular";
+    case LF_APERTURE_POLYGON:
+        return "polygon";
+    case LF_APERTURE_STAR:
+        return "star";
+    case LF_APERTURE_IMAGE:
+        return "image";
+    }
+    return "?";
+}
+
+/* Appends with snprintf semantics; keeps n the would-be length. */
+#define APPEND(...)                                                                   \
+    do {                                                                              \
+        int k_ = snprintf(buf + (n < (int)size ? n : (int)size), n < (int)size ? size - n : 0, __VA_ARGS__); \
+        if (k_ > 0)                                                                   \
+            n += k_;                                                                  \
+    } while (0)
+
+static int thinlens_describe(const void *state, char *buf, size_t size)
+{
+    const thinlens *c = state;
+    int n = 0;
+    if (size == 0)
+        buf = NULL;
+    double f = c->focal_length, N = c->fstop, s = c->focus_distance, zs = c->sensor_distance;
+    double A = f / N;
+    double m = zs / s;
+    double pitch = c->sensor_w / c->width;
+    double coc = c->coc_mm * 1e-3;
+    double H = f * f / (N * coc) + f;
+    double near = s * (H - f) / (H + s - 2.0 * f);
+    APPEND("model: physical thin lens (lens at the origin, sensor at z = -z_s; pixel values are exposure)\n");
+    APPEND("focal length f: %g mm\n", f * 1e3);
+    APPEND("f-number N: %g\n", N);
+    APPEND("aperture diameter A = f/N: %.6g mm\n", A * 1e3);
+    APPEND("aperture: %s, %d blades, rotation %g deg, anamorphic %g, open area %.6g mm^2\n",
+           aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
+           c->aperture.rotation_rad * 180.0 / M_PI, c->aperture.anamorphic, c->open_area * 1e6);
+    APPEND("focus distance z_o: %.9g m\n", s);
+    APPEND("sensor distance z_s (= z_i of the focus plane): %.9g mm\n", zs * 1e3);
+    APPEND("magnification m = z_s/z_o: %.6g\n", m);
+    APPEND("sensor: %s %g x %g mm, imaged as %g x %.6g mm, pixel pitch %.6g um, crop factor %.4g\n", c->sensor_name,
+           c->nominal_w_mm, c->nominal_h_mm, c->sensor_w * 1e3, c->sensor_h * 1e3, pitch * 1e6,
+           43.2666 / hypot(c->nominal_w_mm, c->nominal_h_mm));
+    APPEND("horizontal FOV: %.6g deg\n", 2.0 * atan(c->sensor_w / (2.0 * zs)) * 180.0 / M_PI);
+    APPEND("vertical FOV: %.6g deg\n", 2.0 * atan(c->sensor_h / (2.0 * zs)) * 180.0 / M_PI);
+    APPEND("diagonal FOV: %.6g deg\n", 2.0 * atan(hypot(c->sensor_w, c->sensor_h) / (2.0 * zs)) * 180.0 / M_PI);
+    APPEND("circle of confusion c: %.6g mm\n", c->coc_mm);
+    APPEND("hyperfocal distance H = f^2/(N c) + f: %.6g m\n", H);
+    APPEND("near limit of acceptable sharpness: %.6g m\n", near);
+    if (s >= H)
+        APPEND("far limit of acceptable sharpness: infinity\n");
+    else
+        APPEND("far limit of acceptable sharpness: %.6g m\n", s * (H - f) / (H - s));
+    /* C = A z_s |1/d - 1/z| (PHYSICS.md), in pixels of the sensor pitch */
+    static const double factors[] = {0.5, 0.8, 2.0, 10.0};
+    for (int i = 0; i < 4; i++) {
+        double z = factors[i] * s;
+        double C = A * zs * fabs(1.0 / s - 1.0 / z);
+        APPEND("blur diameter at %.6g m (%gx focus): %.6g px (%.6g mm)%s\n", z, factors[i], C / pitch, C * 1e3,
+               z <= f ? " [closer than f: no real image]" : "");
+    }
+    double Cinf = A * zs / s;
+    APPEND("blur diameter at infinity: %.6g px (%.6g mm)\n", Cinf / pitch, Cinf * 1e3);
+    APPEND("exposure: pixel = (1/z_s^2) int L cos^4 dA x shutter x ISO/100; on axis ~ pi/(4 N^2) L = %.6g L per "
+           "imaging ratio\n",
+           M_PI / (4.0 * N * N));
+    return n;
+}
+
+const lf_camera_type lf_camera_thinlens = {LF_CAMERA_ABI_VERSION, "thinlens", thinlens_create, thinlens_needs,
+                                           thinlens_generate_ray, thinlens_destroy, thinlens_describe};

@@ -49,6 +49,13 @@ void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, 
 float lf_sample_1d(lf_sample_stream *st);
 /* Next 2D value in [0,1)^2 (consumes a dimension pair). */
 void lf_sample_2d(lf_sample_stream *st, float *u0, float *u1);
+/* Advances past one dimension pair without computing it, so that a value
+ * a path does not need costs nothing while later dimensions keep their
+ * place (the layout per bounce stays fixed). */
+static inline void lf_sample_skip(lf_sample_stream *st)
+{
+    st->dim += 2;
+}
 /* The same as doubles, for camera coordinates. */
 void lf_sample_2d_d(lf_sample_stream *st, double *u0, double *u1);
 

@@ -92,6 +92,18 @@ typedef struct lf_camera_create_args {
     size_t warning_size;
 } lf_camera_create_args;
 
+/* Where a camera writes the attributes that describe its image (the
+ * renderer stores them in the EXR header).  Names should be
+ * "lensfield:<key>"; light-field cameras describe their full layout here so
+ * that lftool needs nothing else (docs/lightfield-format.md). */
+typedef struct lf_camera_attr_sink {
+    void *ctx;
+    void (*set_string)(void *ctx, const char *name, const char *value);
+    void (*set_int)(void *ctx, const char *name, int value);
+    void (*set_double)(void *ctx, const char *name, double value);
+    void (*set_doubles)(void *ctx, const char *name, const double *values, int n);
+} lf_camera_attr_sink;
+
 typedef struct lf_camera_type {
     uint32_t abi_version; /* LF_CAMERA_ABI_VERSION */
     const char *name;     /* the Camera "name" in scene files */
@@ -105,6 +117,8 @@ typedef struct lf_camera_type {
     /* Optional (may be NULL): human-readable description for --explain,
      * one fact per line.  Returns the number of characters written. */
     int (*describe)(const void *state, char *buf, size_t size);
+    /* Optional (may be NULL): attributes describing the image layout. */
+    void (*metadata)(const void *state, const lf_camera_attr_sink *sink);
 } lf_camera_type;
 
 /* ---- registry (camera/registry.c) ---- */

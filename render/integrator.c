@@ -1,8 +1,12 @@
 /* Unidirectional path tracing with next-event estimation and multiple
  * importance sampling (power heuristic), Russian roulette and maxdepth,
  * following pbrt-v4's PathIntegrator so that scenes converge to the same
- * images.  Per bounce the sampler dimensions are: light choice, light
- * position, BSDF lobe, BSDF direction, roulette. */
+ * images.  Per bounce the sampler uses four dimension pairs, in this order:
+ *   (light choice, BSDF lobe choice), light position, BSDF direction,
+ *   (roulette, unused).
+ * A pair nobody needs (one light and a one-lobe BSDF; no roulette yet) is
+ * skipped without computing it: samples are the most expensive part of a
+ * path after ray casting. */
 #include <math.h>
 
 #include "render_internal.h"
@@ -20,14 +24,13 @@ static double light_pmf(const lf_scene *s, int light)
     return lf_distrib1d_pmf(&s->light_distrib, light);
 }
 
-/* Direct lighting at a non-specular surface: one light sample, MIS-weighted. */
-static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo,
+/* Direct lighting at a non-specular surface: one light sample, MIS-weighted.
+ * ul chooses the light; the light position pair comes from st. */
+static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo, float ul,
                              lf_sample_stream *st, long long *rays)
 {
-    float ul = lf_sample_1d(st), u0, u1;
+    float u0, u1;
     lf_sample_2d(st, &u0, &u1);
-    if (s->n_lights == 0)
-        return lf_v3(0, 0, 0);
     double pmf, ur;
     int li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
     (void)ur;
@@ -104,15 +107,19 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
             break;
         lf_bsdf bsdf;
         lf_material_bsdf(mat, &h.sc, &bsdf);
-        if (!lf_bsdf_is_specular(&bsdf))
-            L = lf_add(L, lf_mul(beta, sample_direct(s, &h, &bsdf, wo, st, rays)));
-        else {
-            /* keep the dimension layout fixed per bounce */
-            float a, b;
-            (void)lf_sample_1d(st);
-            lf_sample_2d(st, &a, &b);
-        }
-        float uc = lf_sample_1d(st), u0, u1;
+        int specular = lf_bsdf_is_specular(&bsdf);
+        int need_light_choice = !specular && s->n_lights > 1;
+        int need_lobe_choice = bsdf.kind != LF_LOBE_DIFFUSE;
+        float ul = 0.5f, uc = 0.5f;
+        if (need_light_choice || need_lobe_choice)
+            lf_sample_2d(st, &ul, &uc);
+        else
+            lf_sample_skip(st);
+        if (!specular && s->n_lights > 0)
+            L = lf_add(L, lf_mul(beta, sample_direct(s, &h, &bsdf, wo, ul, st, rays)));
+        else
+            lf_sample_skip(st);
+        float u0, u1;
         lf_sample_2d(st, &u0, &u1);
         struct lf_bsdf_sample bs;
         if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
@@ -127,14 +134,15 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
         d = bs.wi;
         /* Russian roulette (pbrt-v4: after depth 1, on beta * eta_scale). */
-        float rr = lf_sample_1d(st);
         lf_vec3 rr_beta = lf_scale(beta, eta_scale);
         float m = lf_maxc(rr_beta);
         if (m < 1.f && depth > 1) {
             float q = fmaxf(0.f, 1.f - m);
-            if (rr < q)
+            if (lf_sample_1d(st) < q)
                 break;
             beta = lf_scale(beta, 1.f / (1.f - q));
+        } else {
+            lf_sample_skip(st);
         }
         if (!(lf_maxc(beta) > 0))
             break;

@@ -37,6 +37,9 @@ typedef struct lf_render_opts {
     lf_progress_fn progress;
     void *progress_ctx;
     const char *scene_path; /* for metadata and the camera's scene_dir */
+    int white;            /* render the white image: the camera and film of the scene looking at
+                           * a uniform environment of radiance 1 and nothing else (flat field for
+                           * devignetting and light-field calibration) */
 } lf_render_opts;
 
 lf_render_opts lf_render_opts_default(void);

@@ -90,6 +90,8 @@ typedef struct lf_scene {
 } lf_scene;
 
 int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err);
+/* A scene with no geometry and a uniform environment of radiance 1. */
+int lf_scene_build_white(lf_scene *s, lf_error *err);
 void lf_scene_free(lf_scene *s);
 /* Appends a warning line to a malloc'ed buffer. */
 void lf_warn_append(char **buf, const char *fmt, ...)

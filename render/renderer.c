@@ -47,6 +47,7 @@ struct lf_renderer {
     int threads;
     lf_render_stats stats;
     lf_transform world_to_camera;
+    int white;
 };
 
 lf_render_opts lf_render_opts_default(void)
@@ -398,8 +399,17 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
                      r->px1, r->py0, r->py1, r->xres, r->yres);
         goto fail;
     }
-    if (lf_scene_build(d, &r->scene, err))
+    r->white = opts->white;
+    if (opts->white) {
+        /* The white image ignores the world: mark its parameters read. */
+        for (size_t i = 0; i < d->n_shapes; i++)
+            for (size_t k = 0; k < d->shapes[i].e.params.count; k++)
+                d->shapes[i].e.params.items[k].used = 1;
+        if (lf_scene_build_white(&r->scene, err))
+            goto fail;
+    } else if (lf_scene_build(d, &r->scene, err)) {
         goto fail;
+    }
     if (r->scene.warnings)
         lf_warn_append(&r->warnings, "%s", r->scene.warnings);
     if (d->accelerator.type)
@@ -644,6 +654,28 @@ static void *worker(void *arg)
     return NULL;
 }
 
+static void sink_string(void *ctx, const char *name, const char *value)
+{
+    lf_attrs_set_string(ctx, name, value);
+}
+static void sink_int(void *ctx, const char *name, int value)
+{
+    lf_attrs_set_int(ctx, name, value);
+}
+static void sink_double(void *ctx, const char *name, double value)
+{
+    lf_attrs_set_double(ctx, name, value);
+}
+static void sink_doubles(void *ctx, const char *name, const double *v, int n)
+{
+    float tmp[64];
+    if (n > 64)
+        n = 64;
+    for (int i = 0; i < n; i++)
+        tmp[i] = (float)v[i];
+    lf_attrs_set_floats(ctx, name, tmp, n);
+}
+
 static double now_seconds(void)
 {
     struct timespec ts;
@@ -713,6 +745,12 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
         for (int i = 0; i < 16; i++)
             m[i] = r->world_to_camera.m[i / 4][i % 4];
         lf_attrs_set_m44d(meta, "lensfield:world_to_camera", m);
+        if (r->white)
+            lf_attrs_set_int(meta, "lensfield:white", 1);
+        if (r->camera_type->metadata) {
+            lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
+            r->camera_type->metadata(r->camera, &sink);
+        }
     }
     return 0;
 }

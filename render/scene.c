@@ -638,6 +638,30 @@ fail:
     return err && err->code ? err->code : LF_ERR_INTERNAL;
 }
 
+int lf_scene_build_white(lf_scene *s, lf_error *err)
+{
+    memset(s, 0, sizeof *s);
+    s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
+    s->lights = calloc(1, sizeof *s->lights);
+    s->infinite_lights = malloc(sizeof(int));
+    s->device = rtcNewDevice("verbose=0");
+    if (!s->lights || !s->infinite_lights || !s->device) {
+        lf_scene_free(s);
+        return lf_error_set(err, LF_ERR_INTERNAL, "cannot set up the white scene");
+    }
+    s->rtc = rtcNewScene(s->device);
+    rtcCommitScene(s->rtc);
+    s->lights[0].kind = LF_LIGHT_INFINITE_UNIFORM;
+    s->lights[0].L = lf_v3(1, 1, 1);
+    s->lights[0].mesh = s->lights[0].sphere = -1;
+    s->n_lights = 1;
+    s->infinite_lights[0] = 0;
+    s->n_infinite = 1;
+    s->scene_radius = 1;
+    double one = 1;
+    return lf_distrib1d_init(&s->light_distrib, &one, 1, err);
+}
+
 void lf_scene_free(lf_scene *s)
 {
     if (s->rtc)

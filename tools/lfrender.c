@@ -1,7 +1,7 @@
 /* lfrender - render a pbrt-v4 scene through lensfield's camera pack.
  *
  * usage: lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [--spp N] [--threads N]
- *                 [--seed S] [--crop x0 x1 y0 y1] [--quiet] [--explain]
+ *                 [--seed S] [--crop x0 x1 y0 y1] [--quiet] [--explain] [--white]
  *                 [--camera-plugin LIB.so]...
  *
  * Exit codes: 0 success; 1 the scene or the render failed (message names
@@ -35,6 +35,8 @@ static void usage(FILE *f)
                "  --crop x0 x1 y0 y1  render only pixels [x0,x1) x [y0,y1) of the film\n"
                "  --quiet           no progress bar or summary\n"
                "  --explain         print the effect plan and exit without rendering\n"
+               "  --white           render the white image: same camera and film, a uniform\n"
+               "                    environment of radiance 1 and nothing else (flat field)\n"
                "  --camera-plugin L load camera types from the shared object L\n");
 }
 
@@ -175,6 +177,8 @@ int main(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(a, "--explain")) {
             explain = 1;
+        } else if (!strcmp(a, "--white")) {
+            o.white = 1;
         } else if (!strcmp(a, "--camera-plugin") && i + 1 < argc) {
             char msg[1024];
             if (lf_camera_load_plugin(argv[++i], msg, sizeof msg)) {

@@ -71,7 +71,15 @@ static int pano_describe(const void *state, char *buf, size_t size)
 }
 
 static const lf_camera_type panorama_type = {
-    LF_CAMERA_ABI_VERSION, "panorama", pano_create, pano_needs, pano_generate_ray, pano_destroy, pano_describe};
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "panorama",
+    .create = pano_create,
+    .needs = pano_needs,
+    .generate_ray = pano_generate_ray,
+    .destroy = pano_destroy,
+    .describe = pano_describe,
+    .metadata = NULL,
+};
 
 static const lf_camera_type *const types[] = {&panorama_type};
 

@@ -41,6 +41,7 @@ typedef struct lf_sample_stream {
     const lf_sampler *s;
     uint32_t pixel_hash;
     uint32_t index;
+    uint32_t rindex; /* index with its bits reversed (the Owen scramble works on it) */
     uint32_t dim;
 } lf_sample_stream;
 

@@ -84,6 +84,7 @@ void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, 
     st->s = s;
     st->pixel_hash = lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
     st->index = index;
+    st->rindex = reverse_bits(index);
     st->dim = 0;
 }
 
@@ -99,7 +100,7 @@ static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
          *   i = owen(index)            shuffled index
          *   a = owen(dim0(i)) = reverse(lk(i))           since dim0 = reverse
          *   b = owen(dim1(i)) = reverse(lk(reverse(dim1(i)))) */
-        uint32_t i = reverse_bits(lk_permute(reverse_bits(st->index), h));
+        uint32_t i = reverse_bits(lk_permute(st->rindex, h));
         *a = reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u)));
         *b = reverse_bits(lk_permute(sobol1_rev(i), lf_hash_u32(h ^ 0x63d83595u)));
         return;
@@ -137,7 +138,7 @@ float lf_sample_1d(lf_sample_stream *st)
         /* a 1D value needs only the first Sobol dimension of the pair */
         uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
         st->dim += 2;
-        uint32_t i = reverse_bits(lk_permute(reverse_bits(st->index), h));
+        uint32_t i = reverse_bits(lk_permute(st->rindex, h));
         return to_unit(reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u))));
     }
     uint32_t a, b;

@@ -105,6 +105,8 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         }
         if (depth++ == in->max_depth)
             break;
+        if (h.sphere >= 0 && lf_material_uses_textures(mat))
+            lf_scene_sphere_uv(s, &h);
         lf_bsdf bsdf;
         lf_material_bsdf(mat, &h.sc, &bsdf);
         int specular = lf_bsdf_is_specular(&bsdf);

@@ -165,6 +165,10 @@ const lf_texture *lf_materials_texture(const lf_materials *m, const char *name, 
 
 /* pbrt's "interface" (also Material "" and "none"): no surface, rays pass straight through. */
 int lf_material_is_interface(const lf_material *mat);
+/* Does any input of the material (or of a mix's components) come from a
+ * texture?  If not, the surface's (u,v) is never read and a renderer may
+ * skip computing it. */
+int lf_material_uses_textures(const lf_material *mat);
 /* A "mix" material picks one of its two materials: the second with
  * probability "amount" (pbrt-v4 MixMaterial::ChooseMaterial), using u in
  * [0,1); nested mixes are resolved with u re-stretched.  Any other material

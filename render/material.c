@@ -524,6 +524,24 @@ const lf_texture *lf_materials_texture(const lf_materials *ms, const char *name,
 /* --------------------------------------------------------- evaluation */
 
 int lf_material_is_interface(const lf_material *mat) { return mat->kind == MAT_INTERFACE; }
+
+int lf_material_uses_textures(const lf_material *mat)
+{
+    for (int depth = 0; depth < 64 && mat; depth++) {
+        const lf_tex_input *in[] = {&mat->reflectance, &mat->transmittance, &mat->eta_c,   &mat->k_c,
+                                    &mat->rough.u,     &mat->rough.v,       &mat->rough_b.u, &mat->rough_b.v,
+                                    &mat->amount};
+        for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
+            if (in[i]->tex)
+                return 1;
+        if (mat->kind != MAT_MIX)
+            return 0;
+        if (lf_material_uses_textures(mat->mix[0]))
+            return 1;
+        mat = mat->mix[1];
+    }
+    return 0;
+}
 const char *lf_material_type(const lf_material *mat) { return mat->type; }
 
 const lf_material *lf_material_resolve(const lf_material *mat, const lf_shading_ctx *ctx, float u)

@@ -106,6 +106,7 @@ typedef struct lf_hit {
     lf_shading_ctx sc; /* p, ng (facing the normal's side: not flipped to the ray), ns, dpdu, uv */
     int material;
     int light;         /* -1 if not emissive */
+    int sphere;        /* analytic sphere index, or -1; its uv is filled by lf_scene_sphere_uv */
 } lf_hit;
 
 /* ---- lights (render/lights.c) ---- */
@@ -134,6 +135,8 @@ void lf_equal_area_sphere_to_square(lf_vec3 d, float *u, float *v);
 /* ---- intersection (render/scene.c) ---- */
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_hit *hit);
 int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax);
+/* Fills hit->sc.uv for sphere hits (deferred: only textured materials read it). */
+void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit);
 /* Origin offset off a surface to avoid self-intersection, on the side of w. */
 lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w);
 

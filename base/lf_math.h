@@ -58,7 +58,11 @@ static inline lf_vec3 lf_normalize(lf_vec3 a)
     float l = lf_length(a);
     return l > 0.f ? lf_scale(a, 1.f / l) : a;
 }
-static inline float lf_maxc(lf_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+static inline float lf_maxc(lf_vec3 a)
+{
+    float m = a.x > a.y ? a.x : a.y;
+    return m > a.z ? m : a.z;
+}
 static inline float lf_luminance(lf_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline int lf_is_black(lf_vec3 c) { return c.x == 0.f && c.y == 0.f && c.z == 0.f; }
 static inline float lf_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }

@@ -77,6 +77,18 @@ static float to_unit(uint32_t x)
     return f;
 }
 
+/* Per-dimension scramble seeds from the pair's hash h: odd multipliers are
+ * bijections, so distinct h give distinct seeds, and h is already a
+ * well-mixed hash of (seed, pixel, pair). */
+static inline uint32_t seed_a(uint32_t h)
+{
+    return h * 0x2c1b3c6du + 0x68e31da4u;
+}
+static inline uint32_t seed_b(uint32_t h)
+{
+    return h * 0x297a2d39u + 0xb5297a4du;
+}
+
 void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
 {
     if (s->kind == LF_SAMPLER_SOBOL)
@@ -101,8 +113,8 @@ static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
          *   a = owen(dim0(i)) = reverse(lk(i))           since dim0 = reverse
          *   b = owen(dim1(i)) = reverse(lk(reverse(dim1(i)))) */
         uint32_t i = reverse_bits(lk_permute(st->rindex, h));
-        *a = reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u)));
-        *b = reverse_bits(lk_permute(sobol1_rev(i), lf_hash_u32(h ^ 0x63d83595u)));
+        *a = reverse_bits(lk_permute(i, seed_a(h)));
+        *b = reverse_bits(lk_permute(sobol1_rev(i), seed_b(h)));
         return;
     }
     case LF_SAMPLER_STRATIFIED: {
@@ -139,7 +151,7 @@ float lf_sample_1d(lf_sample_stream *st)
         uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
         st->dim += 2;
         uint32_t i = reverse_bits(lk_permute(st->rindex, h));
-        return to_unit(reverse_bits(lk_permute(i, lf_hash_u32(h ^ 0xa511e9b3u))));
+        return to_unit(reverse_bits(lk_permute(i, seed_a(h))));
     }
     uint32_t a, b;
     sample_pair(st, &a, &b);

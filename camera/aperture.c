@@ -181,19 +181,22 @@ double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, d
         int n = a->blades;
         double ur;
         int k = pick(u, n, &ur);
-        double t0 = M_PI / 2.0 + 2.0 * M_PI * k / n, t1 = t0 + 2.0 * M_PI / n;
-        fan_triangle(ur, v, cos(t0), sin(t0), cos(t1), sin(t1), &px, &py);
-        break;
+        /* the rotation goes into the corner angles: no rotation step */
+        double t0 = M_PI / 2.0 + a->rotation_rad + 2.0 * M_PI * k / n, t1 = t0 + 2.0 * M_PI / n;
+        fan_triangle(ur, v, cos(t0), sin(t0), cos(t1), sin(t1), x, y);
+        *x *= a->anamorphic;
+        return 1.0;
     }
     case LF_APERTURE_STAR: {
         int n = a->blades;
         double ur, ri = star_inner_radius(n);
         int k = pick(u, 2 * n, &ur);
         /* triangles alternate outer -> inner and inner -> next outer vertex */
-        double t0 = M_PI / 2.0 + M_PI * k / n, t1 = t0 + M_PI / n;
+        double t0 = M_PI / 2.0 + a->rotation_rad + M_PI * k / n, t1 = t0 + M_PI / n;
         double r0 = (k & 1) ? ri : 1.0, r1 = (k & 1) ? 1.0 : ri;
-        fan_triangle(ur, v, r0 * cos(t0), r0 * sin(t0), r1 * cos(t1), r1 * sin(t1), &px, &py);
-        break;
+        fan_triangle(ur, v, r0 * cos(t0), r0 * sin(t0), r1 * cos(t1), r1 * sin(t1), x, y);
+        *x *= a->anamorphic;
+        return 1.0;
     }
     case LF_APERTURE_IMAGE: {
         double iu, iv, pdf;

@@ -33,5 +33,9 @@ static inline void lf_cam_concentric_disk(double u, double v, double *x, double 
 
 extern const lf_camera_type lf_camera_perspective;
 extern const lf_camera_type lf_camera_orthographic;
+extern const lf_camera_type lf_camera_thinlens;
+extern const lf_camera_type lf_camera_realistic;
+extern const lf_camera_type lf_camera_lightfield;
+extern const lf_camera_type lf_camera_plenoptic;
 
 #endif

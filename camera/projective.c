@@ -197,9 +197,23 @@ static int projective_describe(const void *state, char *buf, size_t size)
 }
 
 const lf_camera_type lf_camera_perspective = {
-    LF_CAMERA_ABI_VERSION, "perspective", perspective_create, projective_needs, projective_generate_ray,
-    projective_destroy, projective_describe};
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "perspective",
+    .create = perspective_create,
+    .needs = projective_needs,
+    .generate_ray = projective_generate_ray,
+    .destroy = projective_destroy,
+    .describe = projective_describe,
+    .metadata = NULL,
+};
 
 const lf_camera_type lf_camera_orthographic = {
-    LF_CAMERA_ABI_VERSION, "orthographic", orthographic_create, projective_needs, projective_generate_ray,
-    projective_destroy, projective_describe};
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "orthographic",
+    .create = orthographic_create,
+    .needs = projective_needs,
+    .generate_ray = projective_generate_ray,
+    .destroy = projective_destroy,
+    .describe = projective_describe,
+    .metadata = NULL,
+};

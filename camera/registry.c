@@ -9,6 +9,10 @@
 static const lf_camera_type *const builtin[] = {
     &lf_camera_perspective,
     &lf_camera_orthographic,
+    &lf_camera_thinlens,
+    &lf_camera_realistic,
+    &lf_camera_lightfield,
+    &lf_camera_plenoptic,
 };
 #define N_BUILTIN ((int)(sizeof builtin / sizeof builtin[0]))
 

@@ -32,6 +32,7 @@
  * the natural cos^4 falloff off axis.
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,9 +70,17 @@ typedef struct thinlens {
     lf_aperture aperture;
 } thinlens;
 
-static int fail(const lf_camera_create_args *a, thinlens *c, const char *fmt, double v)
+static int fail(const lf_camera_create_args *a, thinlens *c, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static int fail(const lf_camera_create_args *a, thinlens *c, const char *fmt, ...)
 {
-    snprintf(a->error, a->error_size, fmt, v);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(a->error, a->error_size, fmt, ap);
+    va_end(ap);
     if (c) {
         lf_aperture_free(&c->aperture);
         free(c);
@@ -97,23 +106,24 @@ static int thinlens_create(const lf_camera_create_args *a, void **state)
     if (!(c->fstop > 0.0) || !isfinite(c->fstop))
         return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
     c->focal_length = f_mm * 1e-3;
-    if (!isfinite(c->focus_distance) || !(c->focus_distance > c->focal_length)) {
-        char msg[256];
-        snprintf(msg, sizeof msg,
-                 "\"focusdistance\" %g m is closer than the focal length (%g mm): a thin lens cannot focus there "
-                 "(1/f = 1/z_i + 1/z_o has no real image); it must exceed %g m",
-                 c->focus_distance, f_mm, c->focal_length);
-        return fail(a, c, "%s", 0.0) + (snprintf(a->error, a->error_size, "%s", msg), 0);
-    }
+    if (!isfinite(c->focus_distance))
+        return fail(a, c, "\"focusdistance\" must be finite (use e.g. 1e6 m for infinity)");
+    if (!(c->focus_distance > c->focal_length))
+        return fail(a, c,
+                    "\"focusdistance\" %g m is closer than the focal length (%g mm): a thin lens cannot focus there "
+                    "(1/f = 1/z_i + 1/z_o has no real image); it must exceed %g m",
+                    c->focus_distance, f_mm, c->focal_length);
 
     /* sensor: "float sensorsize" [w h] mm wins over "string sensor" */
     double wh[2] = {0, 0};
     int nsz = p->get_floats(p->ctx, "sensorsize", wh, 2);
-    const char *name = p->get_string(p->ctx, "sensor", "fullframe");
+    const char *given = p->get_string(p->ctx, "sensor", NULL);
+    const char *name = given ? given : "fullframe";
+    if (nsz != 0 && given)
+        return fail(a, c, "give either \"sensor\" \"%s\" or \"sensorsize\", not both", given);
     if (nsz != 0) {
         if (nsz != 2 || !(wh[0] > 0.0) || !(wh[1] > 0.0) || !isfinite(wh[0]) || !isfinite(wh[1]))
-            return fail(a, c, "\"sensorsize\" needs two positive values [width height] in mm (got %g values)",
-                        (double)nsz);
+            return fail(a, c, "\"sensorsize\" needs two positive values [width height] in mm (got %d values)", nsz);
         c->nominal_w_mm = wh[0];
         c->nominal_h_mm = wh[1];
         snprintf(c->sensor_name, sizeof c->sensor_name, "custom");
@@ -128,10 +138,8 @@ static int thinlens_create(const lf_camera_create_args *a, void **state)
                 strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
                 strncat(names, sensors[i].name, sizeof names - strlen(names) - 1);
             }
-            snprintf(a->error, a->error_size, "unknown \"sensor\" \"%s\" (known: %s; or give \"float sensorsize\" [w h] mm)",
-                     name, names);
-            free(c);
-            return -1;
+            return fail(a, c, "unknown \"sensor\" \"%s\" (known: %s; or give \"float sensorsize\" [w h] mm)", name,
+                        names);
         }
         c->nominal_w_mm = sensors[k].width_mm;
         c->nominal_h_mm = sensors[k].height_mm;
@@ -225,20 +233,22 @@ static const char *aperture_name(const lf_aperture *a)
     return "?";
 }
 
-/* Appends with snprintf semantics; keeps n the would-be length. */
-#define APPEND(...)                                                                   \
-    do {                                                                              \
-        int k_ = snprintf(buf + (n < (int)size ? n : (int)size), n < (int)size ? size - n : 0, __VA_ARGS__); \
-        if (k_ > 0)                                                                   \
-            n += k_;                                                                  \
+/* Appends with snprintf semantics; n stays the would-be length. */
+#define APPEND(...)                                                                     \
+    do {                                                                                \
+        size_t off_ = (size_t)n < size ? (size_t)n : size;                              \
+        int k_ = snprintf(buf + off_, size - off_, __VA_ARGS__);                         \
+        if (k_ > 0)                                                                     \
+            n += k_;                                                                    \
     } while (0)
 
 static int thinlens_describe(const void *state, char *buf, size_t size)
 {
     const thinlens *c = state;
     int n = 0;
-    if (size == 0)
-        buf = NULL;
+    char scratch[1];
+    if (size == 0) /* measuring only */
+        buf = scratch, size = 1;
     double f = c->focal_length, N = c->fstop, s = c->focus_distance, zs = c->sensor_distance;
     double A = f / N;
     double m = zs / s;
@@ -258,7 +268,7 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
     APPEND("magnification m = z_s/z_o: %.6g\n", m);
     APPEND("sensor: %s %g x %g mm, imaged as %g x %.6g mm, pixel pitch %.6g um, crop factor %.4g\n", c->sensor_name,
            c->nominal_w_mm, c->nominal_h_mm, c->sensor_w * 1e3, c->sensor_h * 1e3, pitch * 1e6,
-           43.2666 / hypot(c->nominal_w_mm, c->nominal_h_mm));
+           43.27 / hypot(c->nominal_w_mm, c->nominal_h_mm));
     APPEND("horizontal FOV: %.6g deg\n", 2.0 * atan(c->sensor_w / (2.0 * zs)) * 180.0 / M_PI);
     APPEND("vertical FOV: %.6g deg\n", 2.0 * atan(c->sensor_h / (2.0 * zs)) * 180.0 / M_PI);
     APPEND("diagonal FOV: %.6g deg\n", 2.0 * atan(hypot(c->sensor_w, c->sensor_h) / (2.0 * zs)) * 180.0 / M_PI);
@@ -285,5 +295,26 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
     return n;
 }
 
-const lf_camera_type lf_camera_thinlens = {LF_CAMERA_ABI_VERSION, "thinlens", thinlens_create, thinlens_needs,
-                                           thinlens_generate_ray, thinlens_destroy, thinlens_describe};
+/* EXR header facts: enough to reproduce the optics of the image. */
+static void thinlens_metadata(const void *state, const lf_camera_attr_sink *sink)
+{
+    const thinlens *c = state;
+    sink->set_double(sink->ctx, "lensfield:focal_length_mm", c->focal_length * 1e3);
+    sink->set_double(sink->ctx, "lensfield:fstop", c->fstop);
+    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance);
+    sink->set_double(sink->ctx, "lensfield:sensor_distance_mm", c->sensor_distance * 1e3);
+    double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
+    sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
+    sink->set_string(sink->ctx, "lensfield:aperture", aperture_name(&c->aperture));
+}
+
+const lf_camera_type lf_camera_thinlens = {
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "thinlens",
+    .create = thinlens_create,
+    .needs = thinlens_needs,
+    .generate_ray = thinlens_generate_ray,
+    .destroy = thinlens_destroy,
+    .describe = thinlens_describe,
+    .metadata = thinlens_metadata,
+};

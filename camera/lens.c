@@ -1,0 +1,1026 @@
+/* Real compound lenses (see lens.h): prescription parser, paraxial y-nu
+ * analysis, exact tracing with Snell's law, focusing, exit-pupil bounds.
+ *
+ * References: Kolb, Mitchell & Hanrahan 1995; pbrt-v4 RealisticCamera
+ * (TraceLensesFromFilm, FocusThickLens, FocusBinarySearch, BoundExitPupil,
+ * SampleExitPupil); W. Smith, Modern Lens Design (y-nu trace).
+ */
+#include "lens.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* ---------------------------------------------------------------- parsing */
+
+static int parse_number(const char *tok, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(tok, &end);
+    if (end == tok || *end || errno == ERANGE || !isfinite(v))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static void cauchy_fit(lf_lens_surface *s)
+{
+    /* n(lambda) = A + B / lambda^2 through n_d, with n_F - n_C = (n_d - 1) / V_d. */
+    s->cauchy_a = s->ior, s->cauchy_b = 0.0;
+    if (s->abbe > 0.0 && s->ior > 1.0) {
+        double lf = LF_LENS_LAMBDA_F * 1e-3, lc = LF_LENS_LAMBDA_C * 1e-3, ld = LF_LENS_LAMBDA_D * 1e-3;
+        s->cauchy_b = (s->ior - 1.0) / (s->abbe * (1.0 / (lf * lf) - 1.0 / (lc * lc)));
+        s->cauchy_a = s->ior - s->cauchy_b / (ld * ld);
+    }
+}
+
+int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *err, size_t err_size)
+{
+    memset(lens, 0, sizeof *lens);
+    lens->stop = -1;
+    snprintf(lens->path, sizeof lens->path, "%s", filename);
+    int cap = 0, line_no = 0;
+    const char *p = text;
+    while (*p) {
+        line_no++;
+        const char *eol = strchr(p, '\n');
+        size_t len = eol ? (size_t)(eol - p) : strlen(p);
+        char line[1024];
+        if (len >= sizeof line) {
+            snprintf(err, err_size, "%s:%d: line too long", filename, line_no);
+            goto fail;
+        }
+        memcpy(line, p, len);
+        line[len] = 0;
+        p = eol ? eol + 1 : p + len;
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = 0;
+        char *tok[8], *save = NULL;
+        int nt = 0;
+        for (char *t = strtok_r(line, " \t\r,", &save); t; t = strtok_r(NULL, " \t\r,", &save)) {
+            if (nt < 8)
+                tok[nt] = t;
+            nt++;
+        }
+        if (nt == 0)
+            continue;
+        if (nt != 4 && nt != 5) {
+            snprintf(err, err_size, "%s:%d: expected 4 or 5 columns (radius thickness ior aperture [abbe]), got %d",
+                     filename, line_no, nt);
+            goto fail;
+        }
+        double v[5] = {0, 0, 0, 0, 0};
+        static const char *const col[5] = {"radius", "thickness", "ior", "aperture", "abbe"};
+        for (int i = 0; i < nt; i++)
+            if (parse_number(tok[i], &v[i])) {
+                snprintf(err, err_size, "%s:%d: %s \"%s\" is not a number", filename, line_no, col[i], tok[i]);
+                goto fail;
+            }
+        if (v[1] < 0.0) {
+            snprintf(err, err_size, "%s:%d: thickness %g must be >= 0", filename, line_no, v[1]);
+            goto fail;
+        }
+        if (v[2] != 0.0 && v[2] < 1.0) {
+            snprintf(err, err_size, "%s:%d: ior %g must be >= 1 (0 or 1 = air)", filename, line_no, v[2]);
+            goto fail;
+        }
+        if (!(v[3] > 0.0)) {
+            snprintf(err, err_size, "%s:%d: aperture diameter %g must be > 0", filename, line_no, v[3]);
+            goto fail;
+        }
+        if (v[0] != 0.0 && v[3] > 2.0 * fabs(v[0])) {
+            snprintf(err, err_size, "%s:%d: aperture diameter %g exceeds the sphere's diameter 2|%g|", filename,
+                     line_no, v[3], v[0]);
+            goto fail;
+        }
+        if (v[4] < 0.0) {
+            snprintf(err, err_size, "%s:%d: Abbe number %g must be >= 0", filename, line_no, v[4]);
+            goto fail;
+        }
+        if (v[0] == 0.0 && lens->stop >= 0) {
+            snprintf(err, err_size, "%s:%d: a second aperture stop (radius 0); the first is on line %d", filename,
+                     line_no, lens->s[lens->stop].line);
+            goto fail;
+        }
+        if (lens->n == cap) {
+            cap = cap ? 2 * cap : 16;
+            lf_lens_surface *ns = realloc(lens->s, (size_t)cap * sizeof *ns);
+            if (!ns) {
+                snprintf(err, err_size, "out of memory");
+                goto fail;
+            }
+            lens->s = ns;
+        }
+        lf_lens_surface *s = &lens->s[lens->n];
+        memset(s, 0, sizeof *s);
+        s->radius_mm = v[0];
+        s->thickness_mm = v[1];
+        s->ior = v[2] == 0.0 ? 1.0 : v[2];
+        s->aperture_radius_mm = 0.5 * v[3];
+        s->abbe = s->ior > 1.0 ? v[4] : 0.0;
+        s->line = line_no;
+        cauchy_fit(s);
+        if (s->abbe > 0.0)
+            lens->has_abbe = 1;
+        if (v[0] == 0.0) {
+            lens->stop = lens->n;
+            lens->stop_max_radius_mm = s->aperture_radius_mm;
+        }
+        lens->n++;
+    }
+    if (lens->n == 0) {
+        snprintf(err, err_size, "%s: no lens surfaces (expected rows: radius thickness ior aperture [abbe])",
+                 filename);
+        goto fail;
+    }
+    if (lens->s[lens->n - 1].ior != 1.0) {
+        snprintf(err, err_size, "%s:%d: the last surface must leave into air (ior 0 or 1), got %g", filename,
+                 lens->s[lens->n - 1].line, lens->s[lens->n - 1].ior);
+        goto fail;
+    }
+    double z = 0.0;
+    for (int i = lens->n - 1; i >= 0; i--) {
+        lens->s[i].z_mm = z;
+        if (i > 0)
+            z -= lens->s[i - 1].thickness_mm;
+    }
+    lens->film_distance_mm = lens->s[lens->n - 1].thickness_mm;
+    return 0;
+fail:
+    free(lens->s);
+    lens->s = NULL;
+    lens->n = 0;
+    return -1;
+}
+
+int lf_lens_load(const char *path, lf_lens *lens, char *err, size_t err_size)
+{
+    memset(lens, 0, sizeof *lens);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_size, "%s: cannot open lens file: %s", path, strerror(errno));
+        return -1;
+    }
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    size_t got;
+    while (buf && (got = fread(buf + len, 1, cap - len - 1, f)) > 0) {
+        len += got;
+        if (len + 1 >= cap) {
+            if (cap > (1u << 24))
+                break;
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    fclose(f);
+    if (!buf) {
+        snprintf(err, err_size, "%s: out of memory", path);
+        return -1;
+    }
+    buf[len] = 0;
+    if (strlen(buf) != len) {
+        free(buf);
+        snprintf(err, err_size, "%s: not a text lens file (contains NUL bytes)", path);
+        return -1;
+    }
+    int rc = lf_lens_parse(buf, path, lens, err, err_size);
+    free(buf);
+    return rc;
+}
+
+void lf_lens_free(lf_lens *lens)
+{
+    if (!lens)
+        return;
+    free(lens->s);
+    lens->s = NULL;
+    lens->n = 0;
+}
+
+int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, char *warn, size_t warn_size)
+{
+    if (lens->stop < 0)
+        return 0;
+    double r = 0.5 * diameter_mm;
+    if (r > lens->stop_max_radius_mm) {
+        if (warn && warn_size)
+            snprintf(warn, warn_size, "aperture diameter %g mm is larger than the stop of %s (%g mm); clamping it",
+                     diameter_mm, lens->path, 2.0 * lens->stop_max_radius_mm);
+        lens->s[lens->stop].aperture_radius_mm = lens->stop_max_radius_mm;
+        return 1;
+    }
+    lens->s[lens->stop].aperture_radius_mm = r;
+    return 0;
+}
+
+static inline double ior_at(const lf_lens_surface *s, double inv_l2)
+{
+    return inv_l2 > 0.0 && s->cauchy_b != 0.0 ? s->cauchy_a + s->cauchy_b * inv_l2 : s->ior;
+}
+
+static inline double inv_lambda2(const lf_lens *lens, double lambda_nm)
+{
+    if (!lens->dispersive || !(lambda_nm > 0.0))
+        return 0.0;
+    double l = lambda_nm * 1e-3;
+    return 1.0 / (l * l);
+}
+
+double lf_lens_ior(const lf_lens *lens, int i, double lambda_nm)
+{
+    return ior_at(&lens->s[i], inv_lambda2(lens, lambda_nm));
+}
+
+double lf_lens_total_length_mm(const lf_lens *lens)
+{
+    return -lens->s[0].z_mm;
+}
+
+/* --------------------------------------------------------------- paraxial */
+
+static double n_after(const lf_lens *L, int i)
+{
+    return L->s[i].ior;
+}
+static double n_before(const lf_lens *L, int i)
+{
+    return i > 0 ? L->s[i - 1].ior : 1.0;
+}
+static double curvature(const lf_lens_surface *s)
+{
+    return s->radius_mm != 0.0 ? 1.0 / s->radius_mm : 0.0;
+}
+
+/* y-nu trace, light going toward the film, through surfaces a..b: (y, u)
+ * given at the vertex of a in the medium before it; returned at the vertex of
+ * b after refraction.  n'u' = nu - y (n' - n) / R, then y += t u'. */
+static void ynu_forward(const lf_lens *L, int a, int b, double *y, double *u)
+{
+    for (int i = a; i <= b; i++) {
+        double n = n_before(L, i), np = n_after(L, i);
+        *u = (n * *u - *y * (np - n) * curvature(&L->s[i])) / np;
+        if (i < b)
+            *y += L->s[i].thickness_mm * *u;
+    }
+}
+
+/* The same with light going toward the scene, through surfaces a..b (a >= b):
+ * seen from behind, every radius changes sign and the media swap. */
+static void ynu_reverse(const lf_lens *L, int a, int b, double *y, double *u)
+{
+    for (int i = a; i >= b; i--) {
+        double n = n_after(L, i), np = n_before(L, i);
+        *u = (n * *u + *y * (np - n) * curvature(&L->s[i])) / np;
+        if (i > b)
+            *y += L->s[i - 1].thickness_mm * *u;
+    }
+}
+
+int lf_lens_paraxial_analyse(const lf_lens *L, lf_lens_paraxial *px)
+{
+    memset(px, 0, sizeof *px);
+    int last = L->n - 1;
+    px->total_length_mm = lf_lens_total_length_mm(L);
+    double y = 1.0, u = 0.0;
+    ynu_forward(L, 0, last, &y, &u);
+    if (!(fabs(u) > 1e-15))
+        return -1; /* afocal */
+    px->efl_mm = -1.0 / u;
+    px->bfl_mm = -y / u;
+    double yr = 1.0, ur = 0.0;
+    ynu_reverse(L, last, 0, &yr, &ur);
+    if (!(fabs(ur) > 1e-15))
+        return -1;
+    px->ffl_mm = -yr / ur;
+    px->front_principal_mm = px->efl_mm - px->ffl_mm;
+    px->rear_principal_mm = px->bfl_mm - px->efl_mm;
+    /* The stop: the radius-0 row, else the surface that limits the axial beam. */
+    int s = L->stop;
+    if (s < 0) {
+        double best = INFINITY;
+        y = 1.0, u = 0.0;
+        for (int i = 0; i <= last; i++) {
+            double ratio = L->s[i].aperture_radius_mm / fabs(y);
+            if (ratio < best)
+                best = ratio, s = i;
+            ynu_forward(L, i, i, &y, &u);
+            if (i < last)
+                y += L->s[i].thickness_mm * u;
+        }
+    }
+    px->stop = s;
+    double a = L->s[s].aperture_radius_mm;
+    /* Entrance pupil: the stop seen through the surfaces in front of it,
+     * located by the ray from the stop's centre; size from n u / n' u'. */
+    if (s == 0) {
+        px->entrance_pupil_mm = 0.0;
+        px->entrance_pupil_diameter_mm = 2.0 * a;
+    } else {
+        y = L->s[s - 1].thickness_mm, u = 1.0;
+        ynu_reverse(L, s - 1, 0, &y, &u);
+        px->entrance_pupil_mm = y / u;
+        px->entrance_pupil_diameter_mm = 2.0 * a * fabs(n_before(L, s) / u);
+    }
+    if (s == last) {
+        px->exit_pupil_mm = 0.0;
+        px->exit_pupil_diameter_mm = 2.0 * a;
+    } else {
+        y = L->s[s].thickness_mm, u = 1.0;
+        ynu_forward(L, s + 1, last, &y, &u);
+        px->exit_pupil_mm = -y / u;
+        px->exit_pupil_diameter_mm = 2.0 * a * fabs(n_after(L, s) / u);
+    }
+    px->fnumber = px->efl_mm / px->entrance_pupil_diameter_mm;
+    return 0;
+}
+
+static double hiatus(const lf_lens_paraxial *px)
+{
+    /* H' - H along the light, both measured from the front vertex. */
+    return px->total_length_mm + px->rear_principal_mm - px->front_principal_mm;
+}
+
+double lf_lens_paraxial_focus_distance(const lf_lens *L, const lf_lens_paraxial *px, double film_distance_mm)
+{
+    (void)L;
+    double f = px->efl_mm, v = film_distance_mm - px->rear_principal_mm;
+    if (!(v > f))
+        return INFINITY;
+    double s = 1.0 / (1.0 / f - 1.0 / v);
+    return s + v + hiatus(px);
+}
+
+double lf_lens_working_fnumber(const lf_lens *L, const lf_lens_paraxial *px, double focus_distance_mm,
+                               double film_distance_mm)
+{
+    int last = L->n - 1, s = px->stop;
+    double y, u;
+    if (isinf(focus_distance_mm)) {
+        y = 1.0, u = 0.0;
+    } else {
+        double l = focus_distance_mm - film_distance_mm - px->total_length_mm; /* object to front vertex */
+        u = 1.0, y = l;
+    }
+    /* Height at the stop, then scale the ray to fill it. */
+    double ys = y, us = u;
+    if (s > 0) {
+        ynu_forward(L, 0, s - 1, &ys, &us);
+        ys += L->s[s - 1].thickness_mm * us;
+    }
+    ynu_forward(L, 0, last, &y, &u);
+    if (!(fabs(ys) > 0.0) || !(fabs(u) > 0.0))
+        return INFINITY;
+    double scale = L->s[s].aperture_radius_mm / fabs(ys);
+    return 1.0 / (2.0 * fabs(u) * scale);
+}
+
+/* --------------------------------------------------------------- focusing */
+
+double lf_lens_closest_focus_mm(const lf_lens_paraxial *px)
+{
+    return 4.0 * px->efl_mm + hiatus(px);
+}
+
+int lf_lens_focus_thick(const lf_lens *L, double D, double *film_distance_mm, char *err, size_t err_size)
+{
+    lf_lens_paraxial px;
+    if (lf_lens_paraxial_analyse(L, &px)) {
+        snprintf(err, err_size, "%s: the lens has no focal power (afocal): it cannot focus", L->path);
+        return -1;
+    }
+    double f = px.efl_mm;
+    if (!(f > 0.0)) {
+        snprintf(err, err_size, "%s: negative focal length %g mm: the lens forms no real image", L->path, f);
+        return -1;
+    }
+    if (isinf(D)) {
+        *film_distance_mm = px.bfl_mm;
+        return 0;
+    }
+    /* Thin lens between the principal planes: 1/s + 1/s' = 1/f with
+     * s + s' = D - hiatus; the root with the film nearer the lens (pbrt-v4
+     * FocusThickLens). */
+    double e = D - hiatus(&px), c = e * (e - 4.0 * f);
+    if (!(D > 0.0) || !(e > 4.0 * f) || !(c > 0.0)) {
+        snprintf(err, err_size,
+                 "focus distance %g m is closer than %s can focus: the closest is %.4g m from the film "
+                 "(unit magnification)",
+                 D * 1e-3, L->path, lf_lens_closest_focus_mm(&px) * 1e-3);
+        return -1;
+    }
+    double v = 2.0 * f * e / (e + sqrt(c)); /* the smaller root, without cancellation */
+    *film_distance_mm = px.rear_principal_mm + v;
+    if (!(*film_distance_mm > 0.0)) {
+        snprintf(err, err_size, "%s: focusing at %g m would put the film inside the lens (%g mm)", L->path, D * 1e-3,
+                 *film_distance_mm);
+        return -1;
+    }
+    return 0;
+}
+
+static double spot_rms(const lf_lens *L0, const lf_lens_paraxial *px, double D, double film_d, int *n_pass)
+{
+    lf_lens L = *L0;
+    L.film_distance_mm = film_d;
+    L.dispersive = 0;
+    double z_front = -(film_d + px->total_length_mm);
+    double z_ep = z_front + px->entrance_pupil_mm;
+    double r_ep = 0.5 * px->entrance_pupil_diameter_mm;
+    double z_start = z_front - L.s[0].aperture_radius_mm - 1.0; /* in front of any rim */
+    enum { K = 128 };
+    double sw = 0, sy2 = 0;
+    *n_pass = 0;
+    for (int k = 0; k < K; k++) {
+        double h = (k + 0.5) / K * 2.0 * r_ep;
+        lf_lens_ray in, out;
+        if (isinf(D)) { /* parallel light at height h */
+            in = (lf_lens_ray){{0, h, z_start}, {0, 0, 1}};
+        } else {
+            in = (lf_lens_ray){{0, 0, -D}, {0, h, z_ep + D}};
+            double l = sqrt(in.d[1] * in.d[1] + in.d[2] * in.d[2]);
+            in.d[1] /= l, in.d[2] /= l;
+        }
+        if (lf_lens_trace_from_scene(&L, &in, &out, NULL) != LF_LENS_PASSED)
+            continue;
+        double t = -out.o[2] / out.d[2];
+        double yf = out.o[1] + t * out.d[1];
+        sw += h, sy2 += h * yf * yf; /* weight: the annulus' area */
+        (*n_pass)++;
+    }
+    return sw > 0 ? sqrt(sy2 / sw) : INFINITY;
+}
+
+int lf_lens_focus_search(const lf_lens *L, double D, double *film_distance_mm, char *err, size_t err_size)
+{
+    double d0;
+    if (lf_lens_focus_thick(L, D, &d0, err, err_size))
+        return -1;
+    lf_lens_paraxial px;
+    lf_lens_paraxial_analyse(L, &px);
+    double Dm = D;
+    double lo = d0 - 0.05 * px.efl_mm, hi = d0 + 0.05 * px.efl_mm;
+    if (lo < 1e-3)
+        lo = 1e-3;
+    int np;
+    if (!isfinite(spot_rms(L, &px, Dm, d0, &np)) || np < 3) {
+        snprintf(err, err_size, "%s: no real ray from the axial object point at %g m reaches the film", L->path,
+                 Dm * 1e-3);
+        /* (INFINITY prints as inf m) */
+        return -1;
+    }
+    /* Golden-section search for the smallest RMS spot. */
+    const double g = 0.5 * (sqrt(5.0) - 1.0);
+    double a = lo, b = hi, c = b - g * (b - a), d = a + g * (b - a);
+    double fc = spot_rms(L, &px, Dm, c, &np), fd = spot_rms(L, &px, Dm, d, &np);
+    for (int it = 0; it < 80 && b - a > 1e-9; it++) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = b - g * (b - a);
+            fc = spot_rms(L, &px, Dm, c, &np);
+        } else {
+            a = c, c = d, fc = fd;
+            d = a + g * (b - a);
+            fd = spot_rms(L, &px, Dm, d, &np);
+        }
+    }
+    *film_distance_mm = 0.5 * (a + b);
+    return 0;
+}
+
+/* ---------------------------------------------------------- exact tracing */
+
+static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray *out, lf_lens_trace_opts *opts,
+                            int from_film)
+{
+    double o[3] = {in->o[0], in->o[1], in->o[2]}, d[3] = {in->d[0], in->d[1], in->d[2]};
+    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    double inv_l2 = opts ? inv_lambda2(L, opts->lambda_nm) : 0.0;
+    if (opts) {
+        opts->path_count = 0;
+        opts->transmission = 1.0;
+    }
+    if (!(dl > 0.0) || !isfinite(dl))
+        return LF_LENS_BACKWARDS;
+    d[0] /= dl, d[1] /= dl, d[2] /= dl;
+    const double dir = from_film ? -1.0 : 1.0; /* sign of d.z the system needs */
+    if (!(d[2] * dir > 0.0))
+        return LF_LENS_BACKWARDS;
+    int n = L->n;
+    for (int k = 0; k < n; k++) {
+        int i = from_film ? n - 1 - k : k;
+        const lf_lens_surface *s = &L->s[i];
+        double zv = s->z_mm - L->film_distance_mm;
+        double p[3];
+        if (s->radius_mm == 0.0) {
+            double t = (zv - o[2]) / d[2];
+            if (!(t >= 0.0))
+                return LF_LENS_MISSED;
+            p[0] = o[0] + t * d[0], p[1] = o[1] + t * d[1], p[2] = zv;
+            double r2 = p[0] * p[0] + p[1] * p[1], ap = s->aperture_radius_mm;
+            if (r2 > ap * ap)
+                return LF_LENS_STOPPED;
+            if (opts && opts->stop_shape) {
+                double tr = opts->stop_shape(opts->stop_ctx, p[0] / ap, p[1] / ap);
+                if (!(tr > 0.0))
+                    return LF_LENS_STOPPED;
+                opts->transmission = tr;
+            }
+        } else {
+            double R = s->radius_mm, zc = zv + R;
+            double oc[3] = {o[0], o[1], o[2] - zc};
+            double b = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
+            double c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - R * R;
+            double disc = b * b - c;
+            if (!(disc >= 0.0))
+                return LF_LENS_MISSED;
+            double sq = sqrt(disc);
+            /* The vertex cap: the nearer root when the ray meets the sphere's
+             * convex side first (pbrt: (d.z > 0) xor (R < 0)). */
+            int closer = (d[2] > 0.0) ^ (R < 0.0);
+            double t = closer ? -b - sq : -b + sq;
+            if (!(t >= 0.0))
+                return LF_LENS_MISSED;
+            p[0] = o[0] + t * d[0], p[1] = o[1] + t * d[1], p[2] = o[2] + t * d[2];
+            if ((p[2] - zc) * R > 0.0) /* on the far side of the sphere */
+                return LF_LENS_MISSED;
+            double ap = s->aperture_radius_mm;
+            if (p[0] * p[0] + p[1] * p[1] > ap * ap)
+                return LF_LENS_CLIPPED;
+            /* Snell's law: n_i sin(theta_i) = n_t sin(theta_t). */
+            double nrm[3] = {(p[0]) / R, (p[1]) / R, (p[2] - zc) / R};
+            double nl = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+            nrm[0] /= nl, nrm[1] /= nl, nrm[2] /= nl;
+            double cos_i = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
+            if (cos_i < 0.0) {
+                nrm[0] = -nrm[0], nrm[1] = -nrm[1], nrm[2] = -nrm[2];
+                cos_i = -cos_i;
+            }
+            /* Incident medium: after surface i going toward the scene,
+             * before it going toward the film. */
+            double n_before_i = i > 0 ? ior_at(&L->s[i - 1], inv_l2) : 1.0, n_after_i = ior_at(s, inv_l2);
+            double eta_i = from_film ? n_after_i : n_before_i, eta_t = from_film ? n_before_i : n_after_i;
+            double eta = eta_i / eta_t;
+            double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+            if (sin2_t >= 1.0)
+                return LF_LENS_TIR;
+            double cos_t = sqrt(1.0 - sin2_t);
+            for (int j = 0; j < 3; j++)
+                d[j] = eta * d[j] + (eta * cos_i - cos_t) * nrm[j];
+            dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            d[0] /= dl, d[1] /= dl, d[2] /= dl;
+            if (!(d[2] * dir > 0.0))
+                return LF_LENS_BACKWARDS;
+        }
+        o[0] = p[0], o[1] = p[1], o[2] = p[2];
+        if (opts && opts->path) {
+            memcpy(opts->path[opts->path_count], p, sizeof p);
+            opts->path_count++;
+        }
+    }
+    if (out) {
+        memcpy(out->o, o, sizeof o);
+        memcpy(out->d, d, sizeof d);
+    }
+    return LF_LENS_PASSED;
+}
+
+lf_lens_status lf_lens_trace_from_film(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray *out,
+                                       lf_lens_trace_opts *opts)
+{
+    return trace(L, in, out, opts, 1);
+}
+
+lf_lens_status lf_lens_trace_from_scene(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray *out,
+                                        lf_lens_trace_opts *opts)
+{
+    return trace(L, in, out, opts, 0);
+}
+
+/* ----------------------------------------------------- exit-pupil bounds */
+
+double lf_lens_rear_disk_radius(const lf_lens *L, double film_radius_mm)
+{
+    const lf_lens_surface *r = &L->s[L->n - 1];
+    double R = r->aperture_radius_mm, sag = 0.0;
+    if (r->radius_mm != 0.0)
+        sag = fabs(r->radius_mm) - sqrt(r->radius_mm * r->radius_mm - R * R);
+    double Z = L->film_distance_mm;
+    double zmin = Z - sag > 1e-6 ? Z - sag : 1e-6;
+    /* A ray through the rear surface inside R crosses the vertex plane at
+     * most sag * tan(theta) further out, tan(theta) <= (r_film + R) / zmin. */
+    return (R + sag * (film_radius_mm + R) / zmin) * 1.001 + 1e-6;
+}
+
+typedef struct pupil_ctx {
+    const lf_lens *L;
+    double fx;     /* film point (fx, 0, 0) */
+    double Z;      /* rear plane at z = -Z */
+    const double *lambda;
+    int n_lambda;
+    long long traces;
+} pupil_ctx;
+
+static int passes(pupil_ctx *c, double x, double y)
+{
+    lf_lens_ray in = {{c->fx, 0, 0}, {x - c->fx, y, -c->Z}};
+    for (int k = 0; k < c->n_lambda; k++) {
+        lf_lens_trace_opts o = {0};
+        o.lambda_nm = c->lambda[k];
+        c->traces++;
+        if (trace(c->L, &in, NULL, &o, 1) == LF_LENS_PASSED)
+            return 1;
+    }
+    return 0;
+}
+
+enum { BISECT = 16 };
+
+/* Edge between a passing x and a failing x on the line y. */
+static double bisect_x(pupil_ctx *c, double y, double x_pass, double x_fail)
+{
+    for (int i = 0; i < BISECT; i++) {
+        double m = 0.5 * (x_pass + x_fail);
+        if (passes(c, m, y))
+            x_pass = m;
+        else
+            x_fail = m;
+    }
+    return x_pass;
+}
+
+static double bisect_y(pupil_ctx *c, double x, double y_pass, double y_fail)
+{
+    for (int i = 0; i < BISECT; i++) {
+        double m = 0.5 * (y_pass + y_fail);
+        if (passes(c, x, m))
+            y_pass = m;
+        else
+            y_fail = m;
+    }
+    return y_pass;
+}
+
+/* The passing interval on the meridional line y = 0; 0 if none. */
+static int meridional_interval(pupil_ctx *c, double rs, double *xlo, double *xhi)
+{
+    enum { M = 96 };
+    int first = -1, last = -1;
+    double step = 2.0 * rs / (M - 1);
+    for (int i = 0; i < M; i++)
+        if (passes(c, -rs + i * step, 0.0)) {
+            if (first < 0)
+                first = i;
+            last = i;
+        }
+    if (first < 0)
+        return 0;
+    *xlo = first > 0 ? bisect_x(c, 0.0, -rs + first * step, -rs + (first - 1) * step) : -rs;
+    *xhi = last < M - 1 ? bisect_x(c, 0.0, -rs + last * step, -rs + (last + 1) * step) : rs;
+    return 1;
+}
+
+typedef struct film_region {
+    int lit;
+    double xlo0, xhi0; /* interval on y = 0 */
+    double y_max, x_top; /* highest passing point */
+} film_region;
+
+/* The region of the rear plane lit from film point (fx, 0): on the
+ * mirror-symmetric, (nearly) convex region every horizontal line meets an
+ * interval that shrinks away from y = 0, so its outline follows from the
+ * y = 0 interval and the top edge h(x). */
+static void film_region_find(pupil_ctx *c, double rs, film_region *fr)
+{
+    memset(fr, 0, sizeof *fr);
+    if (!meridional_interval(c, rs, &fr->xlo0, &fr->xhi0))
+        return;
+    fr->lit = 1;
+    enum { K = 16 };
+    double w = fr->xhi0 - fr->xlo0, best = -1.0, bx = 0.5 * (fr->xlo0 + fr->xhi0);
+    int bk = 0;
+    for (int k = 0; k < K; k++) {
+        double x = fr->xlo0 + (k + 0.5) / K * w;
+        if (!passes(c, x, 0.0))
+            continue;
+        double h = bisect_y(c, x, 0.0, rs);
+        if (h > best)
+            best = h, bx = x, bk = k;
+    }
+    if (best < 0.0) {
+        fr->y_max = 0.0, fr->x_top = bx;
+        return;
+    }
+    /* Golden-section refinement of the top around the best column. */
+    double a = fr->xlo0 + (bk - 0.5) / K * w, b = fr->xlo0 + (bk + 1.5) / K * w;
+    if (a < fr->xlo0)
+        a = fr->xlo0;
+    if (b > fr->xhi0)
+        b = fr->xhi0;
+    const double g = 0.5 * (sqrt(5.0) - 1.0);
+    double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    double h1 = passes(c, x1, 0) ? bisect_y(c, x1, 0.0, rs) : 0.0;
+    double h2 = passes(c, x2, 0) ? bisect_y(c, x2, 0.0, rs) : 0.0;
+    for (int it = 0; it < 10; it++) {
+        if (h1 > h2) {
+            b = x2, x2 = x1, h2 = h1;
+            x1 = b - g * (b - a);
+            h1 = passes(c, x1, 0) ? bisect_y(c, x1, 0.0, rs) : 0.0;
+        } else {
+            a = x1, x1 = x2, h1 = h2;
+            x2 = a + g * (b - a);
+            h2 = passes(c, x2, 0) ? bisect_y(c, x2, 0.0, rs) : 0.0;
+        }
+        if (h1 > best)
+            best = h1, bx = x1;
+        if (h2 > best)
+            best = h2, bx = x2;
+    }
+    fr->y_max = best, fr->x_top = bx;
+}
+
+int lf_lens_pupil_build(const lf_lens *L, double film_radius_mm, int lambda_spread, lf_lens_pupil *P)
+{
+    memset(P, 0, sizeof *P);
+    P->film_radius_mm = film_radius_mm;
+    P->n_bins = LF_LENS_PUPIL_BINS;
+    P->rear_disk_radius_mm = lf_lens_rear_disk_radius(L, film_radius_mm);
+    if (lambda_spread && L->dispersive) {
+        P->lambda_nm[0] = 360.0, P->lambda_nm[1] = 0.0, P->lambda_nm[2] = 830.0;
+        P->n_lambda = 3;
+    } else {
+        P->lambda_nm[0] = 0.0;
+        P->n_lambda = 1;
+    }
+    double rs = P->rear_disk_radius_mm;
+    pupil_ctx c = {L, 0.0, L->film_distance_mm, P->lambda_nm, P->n_lambda, 0};
+    enum { NR = 3 }; /* film radii per bin: both ends and the middle */
+    film_region prev_end;
+    int have_prev = 0, lit_bins = 0;
+    const double margin = 2e-3 * rs;
+    for (int b = 0; b < P->n_bins; b++) {
+        lf_lens_pupil_bin *bin = &P->bin[b];
+        memset(bin, 0, sizeof *bin);
+        double r0 = (double)b / P->n_bins * film_radius_mm, r1 = (double)(b + 1) / P->n_bins * film_radius_mm;
+        film_region fr[NR];
+        double fx[NR];
+        for (int k = 0; k < NR; k++) {
+            fx[k] = r0 + (r1 - r0) * k / (NR - 1);
+            if (k == 0 && have_prev) {
+                fr[0] = prev_end;
+                continue;
+            }
+            c.fx = fx[k];
+            film_region_find(&c, rs, &fr[k]);
+        }
+        prev_end = fr[NR - 1];
+        have_prev = 1;
+        double ymax = 0.0;
+        int lit = 0;
+        for (int k = 0; k < NR; k++)
+            if (fr[k].lit) {
+                lit = 1;
+                if (fr[k].y_max > ymax)
+                    ymax = fr[k].y_max;
+            }
+        if (!lit)
+            continue;
+        ymax = ymax * 1.002 + margin;
+        double h = ymax / LF_LENS_PUPIL_STRIPS;
+        for (int j = 0; j < LF_LENS_PUPIL_STRIPS; j++)
+            bin->xlo[j] = INFINITY, bin->xhi[j] = -INFINITY;
+        for (int k = 0; k < NR; k++) {
+            if (!fr[k].lit)
+                continue;
+            c.fx = fx[k];
+            for (int j = 0; j < LF_LENS_PUPIL_STRIPS; j++) {
+                double y = j * h; /* the strip's edge nearest the axis holds its widest line */
+                double lo, hi;
+                if (j == 0) {
+                    lo = fr[k].xlo0, hi = fr[k].xhi0;
+                } else {
+                    if (y > fr[k].y_max)
+                        break;
+                    double seed = fr[k].x_top;
+                    if (!passes(&c, seed, y)) {
+                        /* not quite convex: fall back to a scan of the line */
+                        int found = 0;
+                        for (int q = 0; q < 32 && !found; q++) {
+                            double x = fr[k].xlo0 + (q + 0.5) / 32 * (fr[k].xhi0 - fr[k].xlo0);
+                            if (passes(&c, x, y))
+                                seed = x, found = 1;
+                        }
+                        if (!found)
+                            continue;
+                    }
+                    lo = bisect_x(&c, y, seed, fr[k].xlo0 - 1e-9);
+                    hi = bisect_x(&c, y, seed, fr[k].xhi0 + 1e-9);
+                }
+                if (lo < bin->xlo[j])
+                    bin->xlo[j] = lo;
+                if (hi > bin->xhi[j])
+                    bin->xhi[j] = hi;
+            }
+        }
+        /* The strip above the last computed line inherits it (convexity). */
+        double area = 0.0;
+        bin->cdf[0] = 0.0;
+        for (int j = 0; j < LF_LENS_PUPIL_STRIPS; j++) {
+            if (bin->xhi[j] >= bin->xlo[j]) {
+                bin->xlo[j] -= margin, bin->xhi[j] += margin;
+            } else {
+                bin->xlo[j] = bin->xhi[j] = 0.0;
+            }
+            area += (bin->xhi[j] - bin->xlo[j]) * h;
+            bin->cdf[j + 1] = area;
+        }
+        if (!(area > 0.0))
+            continue;
+        for (int j = 1; j <= LF_LENS_PUPIL_STRIPS; j++)
+            bin->cdf[j] /= area;
+        bin->y_max = ymax;
+        bin->area = 2.0 * area;
+        lit_bins++;
+    }
+    P->traces = c.traces;
+    return lit_bins;
+}
+
+double lf_lens_pupil_sample(const lf_lens_pupil *P, double film_x, double film_y, double u, double v, double *rx,
+                            double *ry)
+{
+    double r = sqrt(film_x * film_x + film_y * film_y);
+    int b = (int)(r / P->film_radius_mm * P->n_bins);
+    if (b >= P->n_bins)
+        b = P->n_bins - 1;
+    if (b < 0)
+        b = 0;
+    const lf_lens_pupil_bin *bin = &P->bin[b];
+    if (!(bin->area > 0.0))
+        return 0.0;
+    /* v picks the half, then the strip by area, then the height in it. */
+    double sign = 1.0;
+    v *= 2.0;
+    if (v >= 1.0)
+        v -= 1.0, sign = -1.0;
+    int j = 0;
+    while (j < LF_LENS_PUPIL_STRIPS - 1 && v >= bin->cdf[j + 1])
+        j++;
+    double span = bin->cdf[j + 1] - bin->cdf[j];
+    double t = span > 0.0 ? (v - bin->cdf[j]) / span : 0.5;
+    if (t < 0.0)
+        t = 0.0;
+    if (t > 1.0)
+        t = 1.0;
+    double h = bin->y_max / LF_LENS_PUPIL_STRIPS;
+    double x = bin->xlo[j] + u * (bin->xhi[j] - bin->xlo[j]);
+    double y = sign * (j + t) * h;
+    /* Rotate the bound of the film point (r, 0) to the film point's angle. */
+    double cs = r > 0.0 ? film_x / r : 1.0, sn = r > 0.0 ? film_y / r : 0.0;
+    *rx = cs * x - sn * y;
+    *ry = sn * x + cs * y;
+    return 1.0 / bin->area;
+}
+
+int lf_lens_pupil_contains(const lf_lens_pupil *P, double film_x, double film_y, double rx, double ry)
+{
+    double r = sqrt(film_x * film_x + film_y * film_y);
+    int b = (int)(r / P->film_radius_mm * P->n_bins);
+    b = b >= P->n_bins ? P->n_bins - 1 : b < 0 ? 0 : b;
+    const lf_lens_pupil_bin *bin = &P->bin[b];
+    if (!(bin->area > 0.0))
+        return 0;
+    double cs = r > 0.0 ? film_x / r : 1.0, sn = r > 0.0 ? film_y / r : 0.0;
+    double x = cs * rx + sn * ry, y = fabs(-sn * rx + cs * ry); /* rotate back to the film point (r, 0) */
+    if (y > bin->y_max)
+        return 0;
+    int j = (int)(y / (bin->y_max / LF_LENS_PUPIL_STRIPS));
+    if (j >= LF_LENS_PUPIL_STRIPS)
+        j = LF_LENS_PUPIL_STRIPS - 1;
+    return x >= bin->xlo[j] && x <= bin->xhi[j];
+}
+
+static void concentric_disk(double u, double v, double *x, double *y)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        *x = *y = 0.0;
+        return;
+    }
+    double r, th;
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        th = (M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        th = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
+    }
+    *x = r * cos(th);
+    *y = r * sin(th);
+}
+
+double lf_lens_sample_ray(const lf_lens *L, const lf_lens_pupil *P, int use_bounds, double fx, double fy, double u,
+                          double v, lf_lens_trace_opts *opts, lf_lens_ray *out)
+{
+    double rx, ry, pdf;
+    if (use_bounds) {
+        pdf = lf_lens_pupil_sample(P, fx, fy, u, v, &rx, &ry);
+        if (!(pdf > 0.0))
+            return 0.0;
+    } else {
+        double R = P->rear_disk_radius_mm;
+        concentric_disk(u, v, &rx, &ry);
+        rx *= R, ry *= R;
+        pdf = 1.0 / (M_PI * R * R);
+    }
+    double Z = L->film_distance_mm;
+    lf_lens_ray in = {{fx, fy, 0.0}, {rx - fx, ry - fy, -Z}};
+    double l = sqrt(in.d[0] * in.d[0] + in.d[1] * in.d[1] + Z * Z);
+    double cos_t = Z / l;
+    lf_lens_trace_opts local = {0};
+    if (!opts)
+        opts = &local;
+    if (trace(L, &in, out, opts, 1) != LF_LENS_PASSED)
+        return 0.0;
+    double c2 = cos_t * cos_t;
+    double w = opts->transmission * c2 * c2 / (pdf * Z * Z);
+    return isfinite(w) && w > 0.0 ? w : 0.0;
+}
+
+/* ------------------------------------------------------------------ field */
+
+int lf_lens_field_angle(const lf_lens *L, double film_r, double *theta)
+{
+    double rs = lf_lens_rear_disk_radius(L, film_r);
+    pupil_ctx c = {L, film_r, L->film_distance_mm, NULL, 1, 0};
+    double lam = 0.0;
+    c.lambda = &lam;
+    double lo, hi;
+    if (!meridional_interval(&c, rs, &lo, &hi))
+        return -1;
+    double xm = 0.5 * (lo + hi);
+    lf_lens_ray in = {{film_r, 0, 0}, {xm - film_r, 0, -L->film_distance_mm}}, out;
+    if (trace(L, &in, &out, NULL, 1) != LF_LENS_PASSED)
+        return -1;
+    double dz = -out.d[2];
+    *theta = atan2(sqrt(out.d[0] * out.d[0] + out.d[1] * out.d[1]), dz);
+    return 0;
+}
+
+double lf_lens_image_circle_radius(const lf_lens *L, double r_max)
+{
+    double th;
+    if (lf_lens_field_angle(L, r_max, &th) == 0)
+        return r_max;
+    double lo = 0.0, hi = r_max;
+    if (lf_lens_field_angle(L, 0.0, &th) != 0)
+        return 0.0;
+    for (int i = 0; i < 40; i++) {
+        double m = 0.5 * (lo + hi);
+        if (lf_lens_field_angle(L, m, &th) == 0)
+            lo = m;
+        else
+            hi = m;
+    }
+    return lo;
+}
+
+/* ---------------------------------------------------------------- sensors */
+
+static const struct {
+    const char *name;
+    double w, h;
+} sensors[] = {
+    {"fullframe", 36.0, 24.0},   {"apsc", 23.6, 15.8},    {"apsh", 27.9, 18.6},
+    {"mediumformat", 53.7, 40.2}, {"fourthirds", 17.3, 13.0}, {"1inch", 13.2, 8.8},
+    {"1/1.63in", 8.38, 5.59},    {"1/2.3in", 6.16, 4.62}, {"1/3.2in", 4.54, 3.42},
+};
+
+int lf_lens_sensor_size(const char *name, double *w, double *h)
+{
+    for (size_t i = 0; i < sizeof sensors / sizeof sensors[0]; i++)
+        if (!strcmp(sensors[i].name, name)) {
+            *w = sensors[i].w, *h = sensors[i].h;
+            return 0;
+        }
+    return -1;
+}
+
+const char *lf_lens_sensor_names(void)
+{
+    return "fullframe, apsc, apsh, mediumformat, fourthirds, 1inch, 1/1.63in, 1/2.3in, 1/3.2in";
+}

@@ -1,0 +1,530 @@
+/* The microlens-array light-field camera "plenoptic" (Ng et al. 2005,
+ * "Light Field Photography with a Hand-held Plenoptic Camera"; plenoptic
+ * 2.0 with "sensoroffset", Lumsdaine & Georgiev 2009).  docs/lightfield.md is
+ * the user's page; docs/lightfield-format.md fixes the EXR attributes.
+ *
+ * Geometry (camera space, metres; pbrt's: +z into the scene):
+ *   - a thin main lens at the origin, focal length f, aperture radius
+ *     R = f / 2N;
+ *   - the microlens array (MLA) at z = -z_i, z_i the image distance of the
+ *     focus plane (1/f = 1/z_i + 1/z_o; z_i = f focused at infinity);
+ *   - the sensor at z = -(z_i + d), d = f_mla + sensoroffset behind the MLA.
+ * Lateral geometry is done in "upright" sensor coordinates (x right, y up
+ * as the image is viewed), which are camera space point-reflected through
+ * the axis (the lens images the scene upside down and reversed, so reading
+ * the sensor through the point reflection gives pbrt's orientation, as the
+ * thinlens camera does).  Every map below is linear through the axis, so it
+ * commutes with that reflection.
+ *
+ * Microlens images: the chief ray through a microlens centre c comes from
+ * the main-lens centre, so microlens (i, j)'s image on the sensor is centred
+ * on G = c (z_i + d)/z_i: the images are spaced P = p (z_i + d)/z_i, a little
+ * more than the physical pitch p.  The layout attributes (pitch, offset)
+ * describe these image centres, which is what a decoder needs; the physical
+ * pitch is written too.  Matched f-numbers (the default microlens focal
+ * length f_mla = p N_image, N_image = z_i / D the main lens's image-side
+ * f-number, D = 2R): light through one microlens reaches the sensor (d =
+ * f_mla) within the main aperture's image, D f_mla / z_i across, widened by
+ * the microlens's own width p f_mla / z_i; along the grid axes that is
+ * (D + p) f_mla / z_i = p (z_i + f_mla) / z_i = P, the spacing: images touch
+ * and do not overlap (square grid: gaps at the corners only, hex: at the
+ * three-lens junctions).  "overlap_ratio" is that width over the spacing.
+ *
+ * A camera ray for sensor point p_s:
+ *   1. candidates: the microlenses through which some ray from p_s can pass
+ *      the main aperture.  A ray from p_s through the point m of microlens
+ *      c meets the main-lens plane at
+ *        h(m) = m a + c z_i/f_mla - p_s z_i/d,   a = 1 + z_i/d - z_i/f_mla,
+ *      the cell scaled by a about (G - p_s) z_i/d; so c is a candidate when
+ *      |G - p_s| < (R + |a| r_cell) d / z_i (r_cell: the cell's circumradius).
+ *      One candidate is chosen uniformly with lens_u (pdf 1/K).  Sampling a
+ *      neighbourhood rather than only the nearest microlens is what lets
+ *      crosstalk (overlapping images with a fast main lens) and the partial
+ *      shadowing at image borders come out of the geometry; with matched
+ *      f-numbers almost every pixel has one candidate, so it costs nothing.
+ *   2. m uniform over the chosen microlens's cell (square, or hexagon as
+ *      three rhombi), the microlenses fill their cells (100 % fill factor);
+ *   3. ideal thin microlens: slopes (lateral per unit distance towards the
+ *      scene) s_in = (m - p_s)/d, s_out = s_in - (m - c)/f_mla;
+ *   4. h = m + s_out z_i on the main lens; |h| > R: vignetted, weight 0;
+ *   5. thin main lens: s = s_out - h/f; the ray leaves h along (s, 1).
+ * Radiometry (PHYSICS.md "Exposure and radiometry"): the irradiance at p_s
+ * is E = (1/d^2) \int_{microlenses} L cos^4(theta) dA over the MLA plane,
+ * theta the angle of m - p_s to the axis (ideal thin lenses conserve
+ * radiance), so the weight is K A_cell cos^4(theta) / d^2.  Like thinlens,
+ * pixel values are exposure: with matched f-numbers the flux through one
+ * microlens, spread over its image, equals what a thin lens of the same
+ * f-number puts on the microlens's cell (tests/test_camera_lightfield.c).
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera_internal.h"
+
+typedef struct sensor_size {
+    const char *name;
+    double width_mm, height_mm;
+} sensor_size;
+
+/* The thinlens camera's table (docs/thinlens.md). */
+static const sensor_size sensors[] = {
+    {"mediumformat", 53.7, 40.2}, {"fullframe", 36.0, 24.0}, {"apsh", 27.9, 18.6},    {"apsc", 23.6, 15.8},
+    {"fourthirds", 17.3, 13.0},   {"1inch", 13.2, 8.8},      {"1/1.63in", 8.38, 5.59}, {"1/2.3in", 6.16, 4.62},
+    {"1/3.2in", 4.54, 3.42},
+};
+#define N_SENSORS ((int)(sizeof sensors / sizeof sensors[0]))
+
+/* Rays from one sensor point can reach the main aperture through at most
+ * this many microlenses (plenoptic 2.0 designs see each point several
+ * times; beyond this the design is rejected at create). */
+enum { MAX_CANDIDATES = 256 };
+
+typedef struct plenoptic {
+    /* main lens */
+    double focal_length, fstop, aperture_radius; /* f, N, R = f/2N (metres) */
+    double focus_distance;                        /* z_o; INFINITY allowed */
+    double mla_distance;                          /* z_i */
+    /* sensor */
+    int width, height;
+    double sensor_w, sensor_h, pixel;            /* metres; pixel pitch */
+    double nominal_w_mm, nominal_h_mm;
+    char sensor_name[32];
+    /* microlens array */
+    int hex;
+    double rotation_rad, cos_r, sin_r;
+    double pitch;                 /* physical pitch p (metres) */
+    double mla_focal;             /* f_mla */
+    double sensor_offset;         /* d - f_mla */
+    double mla_sensor;            /* d */
+    double image_pitch_px;        /* P: spacing of microlens image centres, pixels */
+    double row_px;                /* P, or P sqrt(3)/2 for hex */
+    double origin_px[2];          /* image centre of microlens (0, 0), pixels */
+    int nx, ny;                   /* microlenses per row, rows (partial ones included) */
+    double phys_per_px;           /* metres on the MLA per pixel of the image lattice: pixel z_i/(z_i+d) */
+    double cell_area;             /* physical cell area */
+    double cell_radius;           /* physical circumradius */
+    double search_px;             /* candidate radius around p_s, pixels */
+    double weight_scale;          /* A_cell / d^2 */
+    double overlap_ratio;         /* main aperture image diameter / image spacing (1 = matched) */
+} plenoptic;
+
+static int fail(const lf_camera_create_args *a, plenoptic *c, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static int fail(const lf_camera_create_args *a, plenoptic *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(a->error, a->error_size, fmt, ap);
+    va_end(ap);
+    free(c);
+    return -1;
+}
+
+static void warn(const lf_camera_create_args *a, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static void warn(const lf_camera_create_args *a, const char *fmt, ...)
+{
+    if (!a->warning || !a->warning_size)
+        return;
+    size_t n = strlen(a->warning);
+    if (n + 2 >= a->warning_size)
+        return;
+    if (n)
+        a->warning[n++] = '\n', a->warning[n] = '\0';
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(a->warning + n, a->warning_size - n, fmt, ap);
+    va_end(ap);
+}
+
+/* Image centre of microlens (i, j), in pixels (docs/lightfield-format.md). */
+static void lens_centre_px(const plenoptic *c, int i, int j, double *x, double *y)
+{
+    double a = i * c->image_pitch_px + (c->hex && (j & 1) ? 0.5 * c->image_pitch_px : 0.0);
+    double b = j * c->row_px;
+    *x = c->origin_px[0] + c->cos_r * a - c->sin_r * b;
+    *y = c->origin_px[1] + c->sin_r * a + c->cos_r * b;
+}
+
+/* Pixel coordinates -> lattice frame (unrotated, relative to lens (0, 0)). */
+static void to_lattice(const plenoptic *c, double x, double y, double *a, double *b)
+{
+    double dx = x - c->origin_px[0], dy = y - c->origin_px[1];
+    *a = c->cos_r * dx + c->sin_r * dy;
+    *b = -c->sin_r * dx + c->cos_r * dy;
+}
+
+/* Places the lattice: centred on the sensor, then the index range of every
+ * microlens whose cell reaches the sensor, re-based so it starts at (0, 0)
+ * with an even first row (the hex row shift keeps its parity). */
+static void place_lattice(plenoptic *c)
+{
+    double P = c->image_pitch_px, Pr = c->row_px;
+    int nx0 = (int)ceil(c->width / P - 1e-9), ny0 = (int)ceil(c->height / Pr - 1e-9);
+    double la = 0.5 * (nx0 - 1) * P, lb = 0.5 * (ny0 - 1) * Pr;
+    c->origin_px[0] = 0.5 * c->width - (c->cos_r * la - c->sin_r * lb);
+    c->origin_px[1] = 0.5 * c->height - (c->sin_r * la + c->cos_r * lb);
+    double amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY;
+    for (int k = 0; k < 4; k++) {
+        double a, b;
+        to_lattice(c, k & 1 ? c->width : 0, k & 2 ? c->height : 0, &a, &b);
+        amin = fmin(amin, a), amax = fmax(amax, a), bmin = fmin(bmin, b), bmax = fmax(bmax, b);
+    }
+    double ha = 0.5 * P, hb = c->hex ? P / sqrt(3.0) : 0.5 * P, shift = c->hex ? 0.5 * P : 0.0;
+    double eps = 1e-7;
+    int imin = (int)floor((amin - ha - shift) / P + eps) + 1, imax = (int)ceil((amax + ha) / P - eps) - 1;
+    int jmin = (int)floor((bmin - hb) / Pr + eps) + 1, jmax = (int)ceil((bmax + hb) / Pr - eps) - 1;
+    if (c->hex && (jmin & 1))
+        jmin--;
+    double ox, oy;
+    lens_centre_px(c, imin, jmin, &ox, &oy);
+    c->origin_px[0] = ox, c->origin_px[1] = oy;
+    c->nx = imax - imin + 1;
+    c->ny = jmax - jmin + 1;
+}
+
+static int plenoptic_create(const lf_camera_create_args *a, void **state)
+{
+    const lf_camera_params *p = a->params;
+    plenoptic *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(a->error, a->error_size, "out of memory");
+        return -1;
+    }
+    c->width = a->image_width;
+    c->height = a->image_height;
+    double f_mm = p->get_float(p->ctx, "focallength", 50.0);
+    c->fstop = p->get_float(p->ctx, "fstop", 2.8);
+    double zo = p->get_float(p->ctx, "focusdistance", 1.0);
+    const char *grid = p->get_string(p->ctx, "grid", "square");
+    double pitch_um = p->get_float(p->ctx, "pitch", 0.0);
+    int count = p->get_int(p->ctx, "microlenses", 0);
+    double fmla_mm = p->get_float(p->ctx, "microlensfocallength", 0.0);
+    double rot_deg = p->get_float(p->ctx, "rotation", 0.0);
+    double offset_mm = p->get_float(p->ctx, "sensoroffset", 0.0);
+
+    if (!(f_mm > 0.0) || !isfinite(f_mm))
+        return fail(a, c, "\"focallength\" must be > 0 mm, got %g", f_mm);
+    if (!(c->fstop > 0.0) || !isfinite(c->fstop))
+        return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
+    c->focal_length = f_mm * 1e-3;
+    c->aperture_radius = c->focal_length / (2.0 * c->fstop);
+    /* 0 (or inf) means infinity: the MLA then sits in the focal plane */
+    if (zo == 0.0 || zo == INFINITY) {
+        c->focus_distance = INFINITY;
+        c->mla_distance = c->focal_length;
+    } else if (!(zo > c->focal_length) || !isfinite(zo)) {
+        return fail(a, c,
+                    "\"focusdistance\" %g m must exceed the focal length (%g mm) for a real image (or be 0 for "
+                    "infinity)",
+                    zo, f_mm);
+    } else {
+        c->focus_distance = zo;
+        c->mla_distance = c->focal_length / (1.0 - c->focal_length / zo);
+    }
+    if (!strcmp(grid, "square"))
+        c->hex = 0;
+    else if (!strcmp(grid, "hex"))
+        c->hex = 1;
+    else
+        return fail(a, c, "unknown \"grid\" \"%s\" (square or hex)", grid);
+    if (!isfinite(rot_deg))
+        return fail(a, c, "\"rotation\" must be finite, got %g", rot_deg);
+    c->rotation_rad = rot_deg * M_PI / 180.0;
+    c->cos_r = cos(c->rotation_rad);
+    c->sin_r = sin(c->rotation_rad);
+
+    /* sensor: "float sensorsize" [w h] mm wins over "string sensor" (as thinlens) */
+    double wh[2] = {0, 0};
+    int nsz = p->get_floats(p->ctx, "sensorsize", wh, 2);
+    const char *given = p->get_string(p->ctx, "sensor", NULL);
+    if (nsz != 0 && given)
+        return fail(a, c, "give either \"sensor\" \"%s\" or \"sensorsize\", not both", given);
+    if (nsz != 0) {
+        if (nsz != 2 || !(wh[0] > 0.0) || !(wh[1] > 0.0) || !isfinite(wh[0]) || !isfinite(wh[1]))
+            return fail(a, c, "\"sensorsize\" needs two positive values [width height] in mm (got %d values)", nsz);
+        c->nominal_w_mm = wh[0], c->nominal_h_mm = wh[1];
+        snprintf(c->sensor_name, sizeof c->sensor_name, "custom");
+    } else {
+        const char *name = given ? given : "fullframe";
+        int k = -1;
+        for (int i = 0; i < N_SENSORS; i++)
+            if (!strcmp(name, sensors[i].name))
+                k = i;
+        if (k < 0) {
+            char names[512] = "";
+            for (int i = 0; i < N_SENSORS; i++) {
+                strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
+                strncat(names, sensors[i].name, sizeof names - strlen(names) - 1);
+            }
+            return fail(a, c, "unknown \"sensor\" \"%s\" (known: %s; or give \"float sensorsize\" [w h] mm)", name,
+                        names);
+        }
+        c->nominal_w_mm = sensors[k].width_mm, c->nominal_h_mm = sensors[k].height_mm;
+        snprintf(c->sensor_name, sizeof c->sensor_name, "%s", sensors[k].name);
+    }
+    c->sensor_w = c->nominal_w_mm * 1e-3;
+    c->sensor_h = c->sensor_w * c->height / c->width; /* square pixels */
+    c->pixel = c->sensor_w / c->width;
+    if (fabs(c->sensor_h * 1e3 - c->nominal_h_mm) > 0.01 * c->nominal_h_mm)
+        warn(a,
+             "plenoptic: the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to "
+             "the image width, pixels are square)",
+             c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm, c->sensor_h * 1e3);
+
+    /* microlens pitch and focal length */
+    if (pitch_um != 0.0 && count != 0)
+        return fail(a, c, "give either \"pitch\" (um) or \"microlenses\" (count across the width), not both");
+    if (pitch_um == 0.0 && count == 0)
+        count = (int)lround(c->width / 14.0) > 0 ? (int)lround(c->width / 14.0) : 1; /* ~Ng 2005: 14 px per lens */
+    if (count < 0 || count > c->width * 4)
+        return fail(a, c, "\"microlenses\" must be in 1..%d (4 per pixel), got %d", c->width * 4, count);
+    if (pitch_um < 0.0 || !isfinite(pitch_um))
+        return fail(a, c, "\"pitch\" must be > 0 um, got %g", pitch_um);
+    if (!(fmla_mm >= 0.0) || !isfinite(fmla_mm))
+        return fail(a, c, "\"microlensfocallength\" must be > 0 mm, got %g", fmla_mm);
+    if (!isfinite(offset_mm))
+        return fail(a, c, "\"sensoroffset\" must be finite, got %g", offset_mm);
+    double zi = c->mla_distance, D = 2.0 * c->aperture_radius, off = offset_mm * 1e-3;
+    c->sensor_offset = off;
+    if (count > 0) {
+        /* the images tile the width: spacing P = W / count pixels = p (z_i + d) / z_i */
+        double P = c->sensor_w / count; /* metres on the sensor */
+        if (fmla_mm > 0.0) {
+            c->mla_focal = fmla_mm * 1e-3;
+            c->pitch = P * zi / (zi + c->mla_focal + off);
+        } else {
+            /* matched: f_mla = p z_i / D, so P = p (1 + off/z_i) + p^2 / D */
+            double b = 1.0 + off / zi;
+            c->pitch = 0.5 * D * (sqrt(b * b + 4.0 * P / D) - b);
+            c->mla_focal = c->pitch * zi / D;
+        }
+    } else {
+        c->pitch = pitch_um * 1e-6;
+        c->mla_focal = fmla_mm > 0.0 ? fmla_mm * 1e-3 : c->pitch * zi / D;
+    }
+    c->mla_sensor = c->mla_focal + off;
+    if (!(c->mla_sensor > 0.0))
+        return fail(a, c, "\"sensoroffset\" %g mm puts the sensor in front of the microlenses (f_mla = %g mm)",
+                    offset_mm, c->mla_focal * 1e3);
+    double d = c->mla_sensor, Zs = zi + d;
+    c->phys_per_px = c->pixel * zi / Zs;
+    c->image_pitch_px = c->pitch / c->phys_per_px;
+    c->row_px = c->hex ? c->image_pitch_px * sqrt(3.0) / 2.0 : c->image_pitch_px;
+    if (!(c->image_pitch_px >= 0.25) || !isfinite(c->image_pitch_px))
+        return fail(a, c, "the microlens pitch is %g pixels: at least 0.25 pixel is needed", c->image_pitch_px);
+    c->cell_area = c->hex ? sqrt(3.0) / 2.0 * c->pitch * c->pitch : c->pitch * c->pitch;
+    c->cell_radius = c->hex ? c->pitch / sqrt(3.0) : c->pitch / sqrt(2.0);
+    double alpha = 1.0 + zi / d - zi / c->mla_focal;
+    c->search_px = (c->aperture_radius + fabs(alpha) * c->cell_radius) * d / zi / c->pixel;
+    double cell_px = c->hex ? sqrt(3.0) / 2.0 * c->image_pitch_px * c->image_pitch_px
+                            : c->image_pitch_px * c->image_pitch_px;
+    double max_cand = M_PI * pow(c->search_px + c->image_pitch_px, 2.0) / cell_px;
+    if (max_cand > MAX_CANDIDATES)
+        return fail(a, c,
+                    "each sensor point would see the main lens through up to %.0f microlenses (limit %d): the "
+                    "microlens focal length or sensor offset is too far from the matched design",
+                    max_cand, MAX_CANDIDATES);
+    c->weight_scale = c->cell_area / (d * d);
+    place_lattice(c);
+
+    /* f-number matching (plenoptic 1.0 geometry, d = f_mla) */
+    double Nimg = zi / D, Nmla = c->mla_focal / c->pitch;
+    c->overlap_ratio = (D + c->pitch) * c->mla_focal / (c->pitch * (zi + c->mla_focal));
+    if (c->overlap_ratio > 1.01)
+        warn(a,
+             "plenoptic: f-number mismatch: the main lens (image side f/%.3g) is faster than the microlenses (f/%.3g): "
+             "microlens images overlap (each is %.1f%% of their spacing; neighbours cross-talk)",
+             Nimg, Nmla, 100.0 * c->overlap_ratio);
+    else if (c->overlap_ratio < 0.99)
+        warn(a,
+             "plenoptic: f-number mismatch: the main lens (image side f/%.3g) is slower than the microlenses (f/%.3g): "
+             "microlens images leave gaps (each is %.1f%% of their spacing; pixels between them stay dark)",
+             Nimg, Nmla, 100.0 * c->overlap_ratio);
+    *state = c;
+    return 0;
+}
+
+static uint32_t plenoptic_needs(const void *state)
+{
+    (void)state;
+    return LF_CAMERA_NEEDS_LENS;
+}
+
+/* Counts (pick < 0) or finds the pick-th candidate microlens for a sensor
+ * point given in pixels; see the header comment, step 1. */
+static int candidates(const plenoptic *c, double x, double y, int pick, int *ci, int *cj)
+{
+    double a, b;
+    to_lattice(c, x, y, &a, &b);
+    double r = c->search_px, r2 = r * r, P = c->image_pitch_px, Pr = c->row_px;
+    int j0 = (int)ceil((b - r) / Pr), j1 = (int)floor((b + r) / Pr);
+    if (j0 < 0)
+        j0 = 0;
+    if (j1 > c->ny - 1)
+        j1 = c->ny - 1;
+    int k = 0;
+    for (int j = j0; j <= j1; j++) {
+        double sh = c->hex && (j & 1) ? 0.5 * P : 0.0, db = b - j * Pr;
+        int i0 = (int)ceil((a - sh - r) / P), i1 = (int)floor((a - sh + r) / P);
+        if (i0 < 0)
+            i0 = 0;
+        if (i1 > c->nx - 1)
+            i1 = c->nx - 1;
+        for (int i = i0; i <= i1; i++) {
+            double da = a - (i * P + sh);
+            if (da * da + db * db >= r2)
+                continue;
+            if (k == pick) {
+                *ci = i, *cj = j;
+                return k + 1;
+            }
+            k++;
+        }
+    }
+    return k;
+}
+
+static double plenoptic_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+{
+    const plenoptic *c = state;
+    int K = candidates(c, s->film_x, s->film_y, -1, NULL, NULL);
+    if (K <= 0)
+        return 0.0;
+    double uk = s->lens_u * K;
+    int k = (int)uk;
+    if (k > K - 1)
+        k = K - 1;
+    double u = uk - k, v = s->lens_v;
+    int i = 0, j = 0;
+    candidates(c, s->film_x, s->film_y, k, &i, &j);
+
+    /* a point of the cell, lattice frame, in image-lattice pixels */
+    double la, lb;
+    double P = c->image_pitch_px;
+    if (!c->hex) {
+        la = (u - 0.5) * P, lb = (v - 0.5) * P;
+    } else {
+        /* hexagon (flat sides left and right) = three rhombi on vertices 30 + 60 m degrees */
+        double u3 = u * 3.0;
+        int q = (int)u3;
+        if (q > 2)
+            q = 2;
+        double t = u3 - q, rad = P / sqrt(3.0);
+        double a0 = (30.0 + 120.0 * q) * M_PI / 180.0, a1 = a0 + 120.0 * M_PI / 180.0;
+        la = rad * (t * cos(a0) + v * cos(a1));
+        lb = rad * (t * sin(a0) + v * sin(a1));
+    }
+    double gx, gy;
+    lens_centre_px(c, i, j, &gx, &gy);
+    double mx_px = gx + c->cos_r * la - c->sin_r * lb, my_px = gy + c->sin_r * la + c->cos_r * lb;
+    /* to upright metres: image-lattice pixels -> the MLA scales by z_i/(z_i+d) */
+    double cx = (gx - 0.5 * c->width) * c->phys_per_px, cy = (0.5 * c->height - gy) * c->phys_per_px;
+    double mx = (mx_px - 0.5 * c->width) * c->phys_per_px, my = (0.5 * c->height - my_px) * c->phys_per_px;
+    double psx = (s->film_x - 0.5 * c->width) * c->pixel, psy = (0.5 * c->height - s->film_y) * c->pixel;
+
+    double d = c->mla_sensor, zi = c->mla_distance;
+    double dx = mx - psx, dy = my - psy;
+    double cos2 = d * d / (d * d + dx * dx + dy * dy);
+    /* ideal thin microlens, then on to the main lens */
+    double sx = dx / d - (mx - cx) / c->mla_focal, sy = dy / d - (my - cy) / c->mla_focal;
+    double hx = mx + sx * zi, hy = my + sy * zi;
+    if (hx * hx + hy * hy > c->aperture_radius * c->aperture_radius)
+        return 0.0; /* vignetted by the main aperture */
+    sx -= hx / c->focal_length, sy -= hy / c->focal_length;
+    /* upright -> camera space: point reflection of the lateral coordinates */
+    double dir[3] = {-sx, -sy, 1.0};
+    double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + 1.0);
+    double w = K * c->weight_scale * cos2 * cos2;
+    if (!isfinite(len) || !isfinite(w))
+        return 0.0;
+    r->origin[0] = -hx, r->origin[1] = -hy, r->origin[2] = 0.0;
+    r->dir[0] = dir[0] / len, r->dir[1] = dir[1] / len, r->dir[2] = dir[2] / len;
+    return w;
+}
+
+static void plenoptic_destroy(void *state)
+{
+    free(state);
+}
+
+#define APPEND(...)                                                \
+    do {                                                           \
+        size_t off_ = (size_t)n < size ? (size_t)n : size;         \
+        int k_ = snprintf(buf + off_, size - off_, __VA_ARGS__);   \
+        if (k_ > 0)                                                \
+            n += k_;                                               \
+    } while (0)
+
+static int plenoptic_describe(const void *state, char *buf, size_t size)
+{
+    const plenoptic *c = state;
+    int n = 0;
+    char scratch[1];
+    if (size == 0)
+        buf = scratch, size = 1;
+    double D = 2.0 * c->aperture_radius, zi = c->mla_distance;
+    APPEND("model: plenoptic camera (Ng 2005): thin main lens, microlens array at its image plane, sensor behind\n");
+    APPEND("main lens: f %g mm, f/%g (aperture %.6g mm), focused at %.6g m\n", c->focal_length * 1e3, c->fstop,
+           D * 1e3, c->focus_distance);
+    APPEND("main lens to microlens array z_i: %.6g mm (image-side f-number z_i/D = %.4g)\n", zi * 1e3, zi / D);
+    APPEND("microlenses: %s grid, pitch %.6g um, focal length %.6g mm (f/%.4g), rotation %g deg\n",
+           c->hex ? "hex" : "square", c->pitch * 1e6, c->mla_focal * 1e3, c->mla_focal / c->pitch,
+           c->rotation_rad * 180.0 / M_PI);
+    APPEND("microlens images: %.6g px apart, %d x %d lenses (partial border lenses included), lens (0,0) at (%.6g, "
+           "%.6g) px\n",
+           c->image_pitch_px, c->nx, c->ny, c->origin_px[0], c->origin_px[1]);
+    APPEND("aperture image / image spacing: %.4g (%s)\n", c->overlap_ratio,
+           c->overlap_ratio > 1.01   ? "overlap: crosstalk"
+           : c->overlap_ratio < 0.99 ? "gaps between images"
+                                     : "matched");
+    APPEND("sensor: %s %g x %g mm as %g x %.6g mm, %.6g um pixels, %.6g mm behind the microlenses (offset %g mm%s)\n",
+           c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->sensor_w * 1e3, c->sensor_h * 1e3, c->pixel * 1e6,
+           c->mla_sensor * 1e3, c->sensor_offset * 1e3, c->sensor_offset == 0.0 ? ": plenoptic 1.0" : ": focused plenoptic 2.0");
+    APPEND("sub-aperture views: %d x %d pixels, %.4g x %.4g views\n", c->nx, c->ny, c->image_pitch_px,
+           c->image_pitch_px);
+    APPEND("pixel values are exposure: (1/d^2) int L cos^4 dA over the microlenses x shutter x ISO/100\n");
+    return n;
+}
+
+/* docs/lightfield-format.md, "plenoptic" */
+static void plenoptic_metadata(const void *state, const lf_camera_attr_sink *sink)
+{
+    const plenoptic *c = state;
+    sink->set_string(sink->ctx, "lensfield:kind", "plenoptic");
+    sink->set_string(sink->ctx, "lensfield:grid", c->hex ? "hex" : "square");
+    sink->set_double(sink->ctx, "lensfield:microlens_pitch_px", c->image_pitch_px);
+    sink->set_double(sink->ctx, "lensfield:microlens_rotation_rad", c->rotation_rad);
+    sink->set_doubles(sink->ctx, "lensfield:microlens_offset_px", c->origin_px, 2);
+    double count[2] = {c->nx, c->ny};
+    sink->set_doubles(sink->ctx, "lensfield:microlens_count", count, 2);
+    sink->set_double(sink->ctx, "lensfield:microlens_pitch_um", c->pitch * 1e6);
+    sink->set_double(sink->ctx, "lensfield:microlens_focal_mm", c->mla_focal * 1e3);
+    sink->set_double(sink->ctx, "lensfield:main_focal_mm", c->focal_length * 1e3);
+    sink->set_double(sink->ctx, "lensfield:main_fstop", c->fstop);
+    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance);
+    sink->set_double(sink->ctx, "lensfield:mla_distance_mm", c->mla_distance * 1e3);
+    double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
+    sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
+    sink->set_double(sink->ctx, "lensfield:sensor_offset_mm", c->sensor_offset * 1e3);
+}
+
+const lf_camera_type lf_camera_plenoptic = {
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "plenoptic",
+    .create = plenoptic_create,
+    .needs = plenoptic_needs,
+    .generate_ray = plenoptic_generate_ray,
+    .destroy = plenoptic_destroy,
+    .describe = plenoptic_describe,
+    .metadata = plenoptic_metadata,
+};

@@ -1,0 +1,293 @@
+/* pbrt-v4's "realistic" camera: rays traced from the film through a real
+ * lens prescription (Kolb, Mitchell & Hanrahan 1995).
+ *
+ * Parameters (pbrt-v4 names and defaults):
+ *   "string lensfile"        .dat prescription, relative to the scene file (required)
+ *   "float aperturediameter" stop diameter in mm (default 1), clamped to the file's stop
+ *   "float focusdistance"    metres from the film to the plane in focus (default 10)
+ *   "string aperture"        circular | square | pentagon | star | polygon | image file
+ *                            (camera/aperture.h; also "blades", "aperturerotation", "anamorphic")
+ *   "bool dispersion"        lensfield extension (default false): with Abbe numbers in the
+ *                            lens file, n depends on wavelength and rays sample it
+ * The film's physical size comes from Film "diagonal" (mm) and the image aspect.
+ *
+ * Camera space is pbrt's: the film centre at the origin, the lens in front of
+ * it along +z; a ray starts on the front element (metres).  Film point
+ * (-x, y) in lens space for raster (x, y), as pbrt-v4, so the inverted image
+ * comes out upright.  The lens work (tracing, focusing, exit-pupil bounds)
+ * is camera/lens.c.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../base/lf_color.h"
+#include "aperture.h"
+#include "camera_internal.h"
+#include "lens.h"
+
+typedef struct realistic {
+    lf_lens lens;
+    lf_lens_paraxial px;
+    lf_lens_pupil pupil;
+    lf_aperture aperture;
+    int shaped; /* aperture other than the plain circle */
+    int width, height;
+    double film_w_mm, film_h_mm, diagonal_mm;
+    double focus_distance_mm, film_distance_search_mm, working_fnumber;
+    double useful_fraction, lit_film_fraction, setup_seconds;
+} realistic;
+
+static double stop_shape(const void *ctx, double x, double y)
+{
+    return lf_aperture_transmission(ctx, x, y);
+}
+
+static void film_point(const realistic *c, double raster_x, double raster_y, double *fx, double *fy)
+{
+    /* pbrt-v4: pFilm = (-p.x, p.y) with p the raster point mapped onto the
+     * physical extent [-w/2, w/2] x [-h/2, h/2]. */
+    *fx = -(-0.5 * c->film_w_mm + raster_x / c->width * c->film_w_mm);
+    *fy = -0.5 * c->film_h_mm + raster_y / c->height * c->film_h_mm;
+}
+
+static void realistic_free(realistic *c)
+{
+    lf_lens_free(&c->lens);
+    lf_aperture_free(&c->aperture);
+    free(c);
+}
+
+static double seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Fraction of traced rays that get through, from a fixed stratified set of
+ * film and pupil samples (deterministic, a few thousand traces). */
+static void estimate_useful_fraction(realistic *c)
+{
+    enum { N = 48 };
+    long traced = 0, passed = 0, film_lit = 0;
+    uint32_t s = 12345u;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            double rx, ry, fx, fy;
+            film_point(c, (i + 0.5) / N * c->width, (j + 0.5) / N * c->height, &fx, &fy);
+            int lit = 0;
+            for (int k = 0; k < 2; k++) {
+                s = s * 1664525u + 1013904223u;
+                double u = (s >> 8) * (1.0 / 16777216.0);
+                s = s * 1664525u + 1013904223u;
+                double v = (s >> 8) * (1.0 / 16777216.0);
+                if (!(lf_lens_pupil_sample(&c->pupil, fx, fy, u, v, &rx, &ry) > 0.0))
+                    continue;
+                lit = 1;
+                traced++;
+                lf_lens_ray out;
+                if (lf_lens_sample_ray(&c->lens, &c->pupil, 1, fx, fy, u, v, NULL, &out) > 0.0)
+                    passed++;
+            }
+            film_lit += lit;
+        }
+    c->useful_fraction = traced ? (double)passed / traced : 0.0;
+    c->lit_film_fraction = (double)film_lit / (N * N);
+}
+
+static int realistic_create(const lf_camera_create_args *a, void **state)
+{
+    const lf_camera_params *p = a->params;
+    double t0 = seconds();
+    realistic *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(a->error, a->error_size, "out of memory");
+        return -1;
+    }
+    c->width = a->image_width;
+    c->height = a->image_height;
+    const char *lensfile = p->get_string(p->ctx, "lensfile", "");
+    double aperture_diameter = p->get_float(p->ctx, "aperturediameter", 1.0);
+    double focus_m = p->get_float(p->ctx, "focusdistance", 10.0);
+    int dispersion = p->get_bool(p->ctx, "dispersion", 0);
+    if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
+        free(c);
+        return -1;
+    }
+    c->shaped = c->aperture.kind != LF_APERTURE_CIRCLE || c->aperture.anamorphic != 1.0;
+    if (!lensfile[0]) {
+        snprintf(a->error, a->error_size,
+                 "\"string lensfile\" is required: the realistic camera has no default lens (pbrt-v4: \"No lens "
+                 "description file supplied!\"); see scenes/lenses/");
+        goto fail;
+    }
+    if (!(aperture_diameter > 0.0) || !isfinite(aperture_diameter)) {
+        snprintf(a->error, a->error_size, "\"aperturediameter\" must be > 0 mm, got %g", aperture_diameter);
+        goto fail;
+    }
+    if (!(focus_m > 0.0) || !isfinite(focus_m)) {
+        snprintf(a->error, a->error_size, "\"focusdistance\" must be > 0 m, got %g", focus_m);
+        goto fail;
+    }
+    if (!(a->film_diagonal_mm > 0.0) || !isfinite(a->film_diagonal_mm) || a->image_width <= 0 ||
+        a->image_height <= 0) {
+        snprintf(a->error, a->error_size, "film diagonal (%g mm) and resolution must be positive",
+                 a->film_diagonal_mm);
+        goto fail;
+    }
+    char path[4096];
+    if (lensfile[0] == '/' || !a->scene_dir || !a->scene_dir[0])
+        snprintf(path, sizeof path, "%s", lensfile);
+    else
+        snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
+    if (lf_lens_load(path, &c->lens, a->error, a->error_size))
+        goto fail;
+    size_t wlen = a->warning && a->warning_size ? strlen(a->warning) : 0;
+#define WARN(...)                                                                                 \
+    do {                                                                                          \
+        if (a->warning && wlen + 1 < a->warning_size) {                                           \
+            int n_ = snprintf(a->warning + wlen, a->warning_size - wlen, "%s", wlen ? "; " : ""); \
+            wlen += n_ > 0 ? (size_t)n_ : 0;                                                      \
+            if (wlen < a->warning_size) {                                                         \
+                n_ = snprintf(a->warning + wlen, a->warning_size - wlen, __VA_ARGS__);            \
+                wlen += n_ > 0 ? (size_t)n_ : 0;                                                  \
+            }                                                                                     \
+            if (wlen >= a->warning_size)                                                          \
+                wlen = a->warning_size - 1;                                                       \
+        }                                                                                         \
+    } while (0)
+    if (dispersion && !c->lens.has_abbe)
+        WARN("\"dispersion\" is on but %s has no Abbe numbers (5th column): rendering without dispersion", path);
+    c->lens.dispersive = dispersion && c->lens.has_abbe;
+    if (c->lens.stop < 0) {
+        WARN("%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
+    } else {
+        char msg[600] = "";
+        if (lf_lens_set_stop_diameter(&c->lens, aperture_diameter, msg, sizeof msg))
+            WARN("%s", msg);
+    }
+    if (lf_lens_paraxial_analyse(&c->lens, &c->px)) {
+        snprintf(a->error, a->error_size, "%s: the lens has no focal power (afocal)", path);
+        goto fail;
+    }
+    c->focus_distance_mm = focus_m * 1000.0;
+    if (lf_lens_focus_thick(&c->lens, c->focus_distance_mm, &c->lens.film_distance_mm, a->error, a->error_size))
+        goto fail;
+    char scratch[256];
+    if (lf_lens_focus_search(&c->lens, c->focus_distance_mm, &c->film_distance_search_mm, scratch, sizeof scratch))
+        c->film_distance_search_mm = NAN;
+    c->working_fnumber =
+        lf_lens_working_fnumber(&c->lens, &c->px, c->focus_distance_mm, c->lens.film_distance_mm);
+    /* pbrt-v4: physical film extent from the diagonal and the aspect ratio. */
+    double aspect = (double)a->image_height / a->image_width;
+    c->diagonal_mm = a->film_diagonal_mm;
+    c->film_w_mm = sqrt(c->diagonal_mm * c->diagonal_mm / (1.0 + aspect * aspect));
+    c->film_h_mm = aspect * c->film_w_mm;
+    if (lf_lens_pupil_build(&c->lens, 0.5 * c->diagonal_mm, c->lens.dispersive, &c->pupil) == 0) {
+        snprintf(a->error, a->error_size,
+                 "%s admits no light: no ray from the film gets through all %d surfaces (stop diameter %g mm, "
+                 "film %g mm behind the rear vertex)",
+                 path, c->lens.n, c->lens.stop >= 0 ? 2.0 * c->lens.s[c->lens.stop].aperture_radius_mm : 0.0,
+                 c->lens.film_distance_mm);
+        goto fail;
+    }
+    estimate_useful_fraction(c);
+    c->setup_seconds = seconds() - t0;
+#undef WARN
+    *state = c;
+    return 0;
+fail:
+    realistic_free(c);
+    return -1;
+}
+
+static uint32_t realistic_needs(const void *state)
+{
+    const realistic *c = state;
+    return LF_CAMERA_NEEDS_LENS | (c->lens.dispersive ? LF_CAMERA_NEEDS_WAVELENGTH : 0u);
+}
+
+static double realistic_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+{
+    const realistic *c = state;
+    double fx, fy;
+    film_point(c, s->film_x, s->film_y, &fx, &fy);
+    lf_lens_trace_opts opts = {0};
+    if (c->lens.dispersive) {
+        opts.lambda_nm = LF_LAMBDA_MIN + s->wavelength_u * (LF_LAMBDA_MAX - LF_LAMBDA_MIN);
+        r->wavelength_nm = opts.lambda_nm;
+    }
+    if (c->shaped) {
+        opts.stop_shape = stop_shape;
+        opts.stop_ctx = &c->aperture;
+    }
+    lf_lens_ray out;
+    double w = lf_lens_sample_ray(&c->lens, &c->pupil, 1, fx, fy, s->lens_u, s->lens_v, &opts, &out);
+    if (!(w > 0.0)) {
+        r->origin[0] = r->origin[1] = r->origin[2] = 0.0;
+        r->dir[0] = r->dir[1] = 0.0, r->dir[2] = 1.0;
+        return 0.0;
+    }
+    /* lens space (mm, z toward the film) -> camera space (m, z into the scene) */
+    r->origin[0] = out.o[0] * 1e-3, r->origin[1] = out.o[1] * 1e-3, r->origin[2] = -out.o[2] * 1e-3;
+    double l = sqrt(out.d[0] * out.d[0] + out.d[1] * out.d[1] + out.d[2] * out.d[2]);
+    r->dir[0] = out.d[0] / l, r->dir[1] = out.d[1] / l, r->dir[2] = -out.d[2] / l;
+    return w;
+}
+
+static void realistic_destroy(void *state)
+{
+    if (state)
+        realistic_free(state);
+}
+
+static int realistic_describe(const void *state, char *buf, size_t size)
+{
+    const realistic *c = state;
+    const lf_lens *L = &c->lens;
+    double stop_d = L->stop >= 0 ? 2.0 * L->s[L->stop].aperture_radius_mm : 0.0;
+    double stop_max = L->stop >= 0 ? 2.0 * L->stop_max_radius_mm : 0.0;
+    static const char *const shapes[] = {"circular", "polygon", "star", "image"};
+    int n = snprintf(
+        buf, size,
+        "model: real compound lens traced from the film (Kolb et al. 1995; pbrt-v4 \"realistic\"): %s, %d surfaces\n"
+        "effective focal length: %.4g mm (paraxial y-nu trace)\n"
+        "f-number: working f/%.3g at the focus distance, f/%.3g at infinity (stop %.4g mm of %.4g mm)\n"
+        "focus distance: %.4g m from the film; film %.4f mm behind the rear vertex (thick-lens model, as pbrt-v4; "
+        "exact best-focus search: %.4f mm)\n"
+        "film: %.4g x %.4g mm (diagonal %.4g mm)\n"
+        "pupils: entrance %.4g mm wide, %.4g mm behind the front vertex; exit %.4g mm wide, %.4g mm from the rear "
+        "vertex\n"
+        "exit-pupil bounds: %d film-radius bins x %d strips, %lld rays traced; camera set-up %.3f s\n"
+        "expected useful-ray fraction: %.1f%% of traced camera rays (%.1f%% of the film receives light)\n"
+        "aperture: %s%s\n"
+        "dispersion: %s\n",
+        L->path, L->n, c->px.efl_mm, c->working_fnumber, c->px.fnumber, stop_d, stop_max,
+        c->focus_distance_mm * 1e-3, L->film_distance_mm, c->film_distance_search_mm, c->film_w_mm, c->film_h_mm,
+        c->diagonal_mm, c->px.entrance_pupil_diameter_mm, c->px.entrance_pupil_mm, c->px.exit_pupil_diameter_mm,
+        c->px.exit_pupil_mm, c->pupil.n_bins, LF_LENS_PUPIL_STRIPS, c->pupil.traces, c->setup_seconds,
+        100.0 * c->useful_fraction, 100.0 * c->lit_film_fraction, shapes[c->aperture.kind],
+        c->aperture.anamorphic != 1.0 ? " (anamorphic)" : "",
+        L->dispersive ? "on (Cauchy n(lambda) = A + B/lambda^2 through n_d and V_d; rays sample 360-830 nm)"
+        : L->has_abbe ? "off (the lens has Abbe numbers: \"bool dispersion\" true turns it on)"
+                      : "off (no Abbe numbers in the lens file)");
+    return n;
+}
+
+static void realistic_metadata(const void *state, const lf_camera_attr_sink *sink)
+{
+    const realistic *c = state;
+    sink->set_string(sink->ctx, "lensfield:lens_file", c->lens.path);
+    sink->set_double(sink->ctx, "lensfield:lens_efl_mm", c->px.efl_mm);
+    sink->set_double(sink->ctx, "lensfield:lens_working_fnumber", c->working_fnumber);
+    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance_mm * 1e-3);
+    sink->set_double(sink->ctx, "lensfield:lens_film_distance_mm", c->lens.film_distance_mm);
+    sink->set_int(sink->ctx, "lensfield:lens_dispersion", c->lens.dispersive);
+}
+
+const lf_camera_type lf_camera_realistic = {LF_CAMERA_ABI_VERSION,  "realistic",       realistic_create,
+                                            realistic_needs,        realistic_generate_ray, realistic_destroy,
+                                            realistic_describe,     realistic_metadata};

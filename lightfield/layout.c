@@ -1,0 +1,314 @@
+/* Layout of a raw light-field image: from lensfield:* attributes
+ * (docs/lightfield-format.md), from explicit parameters, merged and checked. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lf_lightfield.h"
+
+void lf_lf_layout_init(lf_lf_layout *lay)
+{
+    memset(lay, 0, sizeof *lay);
+}
+
+static int attr_num(const lf_attrs *a, const char *name, double *v, lf_error *err)
+{
+    const lf_attr *at = lf_attrs_get(a, name);
+    if (!at)
+        return 0;
+    switch (at->type) {
+    case LF_ATTR_INT: *v = at->i; return 1;
+    case LF_ATTR_FLOAT:
+    case LF_ATTR_DOUBLE: *v = at->d; return 1;
+    case LF_ATTR_FLOATS:
+        if (at->n == 1) {
+            *v = at->v[0];
+            return 1;
+        }
+        break;
+    default: break;
+    }
+    lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected a number", name);
+    return -1;
+}
+
+static int attr_vec(const lf_attrs *a, const char *name, int n, double *v, lf_error *err)
+{
+    const lf_attr *at = lf_attrs_get(a, name);
+    if (!at)
+        return 0;
+    if (at->type != LF_ATTR_FLOATS || at->n != n) {
+        lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected %d floats", name, n);
+        return -1;
+    }
+    for (int i = 0; i < n; i++)
+        v[i] = at->v[i];
+    return 1;
+}
+
+int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
+{
+    lf_lf_layout_init(lay);
+    const lf_attr *k = lf_attrs_get(a, "lensfield:kind");
+    if (k) {
+        if (k->type != LF_ATTR_STRING)
+            return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:kind: expected a string");
+        if (!strcmp(k->s, "camera-array"))
+            lay->kind = LF_LF_CAMERA_ARRAY;
+        else if (!strcmp(k->s, "plenoptic"))
+            lay->kind = LF_LF_PLENOPTIC;
+        else
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "attribute lensfield:kind is \"%s\" (expected camera-array or plenoptic)", k->s);
+        lay->have |= LF_LF_HAVE_KIND;
+    }
+    double v[4];
+    int r;
+    if ((r = attr_vec(a, "lensfield:cameras_per_dim", 2, v, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r) {
+        lay->cams_x = (int)lrint(v[0]);
+        lay->cams_y = (int)lrint(v[1]);
+        lay->have |= LF_LF_HAVE_CAMS;
+    }
+    if ((r = attr_vec(a, "lensfield:camera_grid_bounds", 4, lay->grid_bounds, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r)
+        lay->have |= LF_LF_HAVE_BOUNDS;
+    if ((r = attr_num(a, "lensfield:fov_deg", &lay->fov_deg, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r)
+        lay->have |= LF_LF_HAVE_FOV;
+    if ((r = attr_vec(a, "lensfield:tile_size", 2, v, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r) {
+        lay->tile_w = (int)lrint(v[0]);
+        lay->tile_h = (int)lrint(v[1]);
+        lay->have |= LF_LF_HAVE_TILE;
+    }
+    int lr = attr_num(a, "lensfield:lens_radius", &lay->lens_radius, err);
+    int fd = attr_num(a, "lensfield:focal_distance", &lay->focal_distance, err);
+    if (lr < 0 || fd < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (lr || fd)
+        lay->have |= LF_LF_HAVE_CAM_LENS;
+
+    const lf_attr *g = lf_attrs_get(a, "lensfield:grid");
+    if (g) {
+        if (g->type != LF_ATTR_STRING || (strcmp(g->s, "square") && strcmp(g->s, "hex")))
+            return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:grid: expected \"square\" or \"hex\"");
+        lay->grid = strcmp(g->s, "hex") ? LF_LF_GRID_SQUARE : LF_LF_GRID_HEX;
+        lay->have |= LF_LF_HAVE_GRID;
+    }
+    if ((r = attr_num(a, "lensfield:microlens_pitch_px", &lay->pitch_px, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r)
+        lay->have |= LF_LF_HAVE_PITCH;
+    if ((r = attr_num(a, "lensfield:microlens_rotation_rad", &lay->rotation_rad, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r)
+        lay->have |= LF_LF_HAVE_ROTATION;
+    if ((r = attr_vec(a, "lensfield:microlens_offset_px", 2, lay->offset_px, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r)
+        lay->have |= LF_LF_HAVE_OFFSET;
+    if ((r = attr_vec(a, "lensfield:microlens_count", 2, v, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r) {
+        lay->lens_x = (int)lrint(v[0]);
+        lay->lens_y = (int)lrint(v[1]);
+        lay->have |= LF_LF_HAVE_LENS_COUNT;
+    }
+    int n = 0;
+    n += attr_num(a, "lensfield:main_focal_mm", &lay->main_focal_mm, err) > 0;
+    n += attr_num(a, "lensfield:main_fstop", &lay->main_fstop, err) > 0;
+    n += attr_num(a, "lensfield:mla_distance_mm", &lay->mla_distance_mm, err) > 0;
+    n += attr_num(a, "lensfield:microlens_pitch_um", &lay->pitch_um, err) > 0;
+    attr_num(a, "lensfield:focus_distance_m", &lay->focus_distance_m, err);
+    attr_num(a, "lensfield:microlens_focal_mm", &lay->microlens_focal_mm, err);
+    if (err && err->code)
+        return err->code;
+    if (n == 4)
+        lay->have |= LF_LF_HAVE_MAIN_LENS;
+    return LF_OK;
+}
+
+static int differs(double a, double b)
+{
+    return fabs(a - b) > 1e-6 * fmax(1.0, fmax(fabs(a), fabs(b)));
+}
+
+int lf_lf_layout_resolve(const lf_lf_layout *file, const lf_lf_layout *flags, int raw_w, int raw_h,
+                         lf_lf_layout *out, lf_error *err)
+{
+    lf_lf_layout_init(out);
+    lf_lf_layout f = flags ? *flags : *out;
+    *out = *file;
+    /* each flag that the file also gives must agree with it */
+#define MERGE(bit, cond, what)                                                                       \
+    if (f.have & (bit)) {                                                                            \
+        if ((file->have & (bit)) && (cond))                                                          \
+            return lf_error_set(err, LF_ERR_PARAM, "%s contradicts the file's attribute", what);     \
+    }
+    MERGE(LF_LF_HAVE_KIND, f.kind != file->kind, "--kind (lensfield:kind)")
+    MERGE(LF_LF_HAVE_CAMS, f.cams_x != file->cams_x || f.cams_y != file->cams_y,
+          "--camsperdim (lensfield:cameras_per_dim)")
+    MERGE(LF_LF_HAVE_BOUNDS,
+          differs(f.grid_bounds[0], file->grid_bounds[0]) || differs(f.grid_bounds[1], file->grid_bounds[1]) ||
+              differs(f.grid_bounds[2], file->grid_bounds[2]) || differs(f.grid_bounds[3], file->grid_bounds[3]),
+          "--griddim (lensfield:camera_grid_bounds)")
+    MERGE(LF_LF_HAVE_FOV, differs(f.fov_deg, file->fov_deg), "--inputfov (lensfield:fov_deg)")
+    MERGE(LF_LF_HAVE_TILE, f.tile_w != file->tile_w || f.tile_h != file->tile_h, "--tilesize (lensfield:tile_size)")
+    MERGE(LF_LF_HAVE_GRID, f.grid != file->grid, "--grid (lensfield:grid)")
+    MERGE(LF_LF_HAVE_PITCH, differs(f.pitch_px, file->pitch_px), "--pitch (lensfield:microlens_pitch_px)")
+    MERGE(LF_LF_HAVE_ROTATION, differs(f.rotation_rad, file->rotation_rad),
+          "--rotation (lensfield:microlens_rotation_rad)")
+    MERGE(LF_LF_HAVE_OFFSET, differs(f.offset_px[0], file->offset_px[0]) || differs(f.offset_px[1], file->offset_px[1]),
+          "--offset (lensfield:microlens_offset_px)")
+    MERGE(LF_LF_HAVE_LENS_COUNT, f.lens_x != file->lens_x || f.lens_y != file->lens_y,
+          "--lenscount (lensfield:microlens_count)")
+#undef MERGE
+    if (f.have & LF_LF_HAVE_KIND)
+        out->kind = f.kind;
+    if (f.have & LF_LF_HAVE_CAMS)
+        out->cams_x = f.cams_x, out->cams_y = f.cams_y;
+    if (f.have & LF_LF_HAVE_BOUNDS)
+        memcpy(out->grid_bounds, f.grid_bounds, sizeof f.grid_bounds);
+    if (f.have & LF_LF_HAVE_FOV)
+        out->fov_deg = f.fov_deg;
+    if (f.have & LF_LF_HAVE_TILE)
+        out->tile_w = f.tile_w, out->tile_h = f.tile_h;
+    if (f.have & LF_LF_HAVE_GRID)
+        out->grid = f.grid;
+    if (f.have & LF_LF_HAVE_PITCH)
+        out->pitch_px = f.pitch_px;
+    if (f.have & LF_LF_HAVE_ROTATION)
+        out->rotation_rad = f.rotation_rad;
+    if (f.have & LF_LF_HAVE_OFFSET)
+        memcpy(out->offset_px, f.offset_px, sizeof f.offset_px);
+    if (f.have & LF_LF_HAVE_LENS_COUNT)
+        out->lens_x = f.lens_x, out->lens_y = f.lens_y;
+    if ((f.have & LF_LF_HAVE_MAIN_LENS) && !(file->have & LF_LF_HAVE_MAIN_LENS)) {
+        out->main_focal_mm = f.main_focal_mm, out->main_fstop = f.main_fstop;
+        out->mla_distance_mm = f.mla_distance_mm, out->pitch_um = f.pitch_um;
+    }
+    out->have = file->have | f.have;
+
+    if (!(out->have & LF_LF_HAVE_KIND))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "no light-field layout: missing lensfield:kind (--kind camera-array|plenoptic); "
+                            "a camera-array also needs lensfield:cameras_per_dim (--camsperdim NX NY), "
+                            "a plenoptic raw lensfield:microlens_pitch_px (--pitch PX) and "
+                            "lensfield:microlens_offset_px (--offset X Y) (or run lftool calibrate on a white image)");
+    char missing[512] = "";
+    if (out->kind == LF_LF_CAMERA_ARRAY) {
+        if (!(out->have & LF_LF_HAVE_CAMS))
+            strcat(missing, " lensfield:cameras_per_dim (--camsperdim NX NY)");
+        if (missing[0])
+            return lf_error_set(err, LF_ERR_PARAM, "camera-array layout incomplete, missing:%s", missing);
+        if (out->cams_x < 1 || out->cams_y < 1)
+            return lf_error_set(err, LF_ERR_PARAM, "cameras per dimension must be >= 1 (got %d %d)", out->cams_x,
+                                out->cams_y);
+        if (!(out->have & LF_LF_HAVE_TILE)) {
+            if (raw_w % out->cams_x || raw_h % out->cams_y)
+                return lf_error_set(err, LF_ERR_PARAM,
+                                    "image %dx%d does not divide into %dx%d tiles; give lensfield:tile_size", raw_w,
+                                    raw_h, out->cams_x, out->cams_y);
+            out->tile_w = raw_w / out->cams_x;
+            out->tile_h = raw_h / out->cams_y;
+            out->have |= LF_LF_HAVE_TILE;
+        }
+        if (out->tile_w < 1 || out->tile_h < 1 || (long)out->tile_w * out->cams_x > raw_w ||
+            (long)out->tile_h * out->cams_y > raw_h)
+            return lf_error_set(err, LF_ERR_PARAM, "%dx%d tiles of %dx%d do not fit the %dx%d image", out->cams_x,
+                                out->cams_y, out->tile_w, out->tile_h, raw_w, raw_h);
+    } else {
+        if (!(out->have & LF_LF_HAVE_PITCH))
+            strcat(missing, " lensfield:microlens_pitch_px (--pitch PX)");
+        if (!(out->have & LF_LF_HAVE_OFFSET))
+            strcat(missing, " lensfield:microlens_offset_px (--offset X Y)");
+        if (missing[0])
+            return lf_error_set(err, LF_ERR_PARAM,
+                                "plenoptic layout incomplete, missing:%s (or run lftool calibrate on a white image)",
+                                missing);
+        if (!(out->pitch_px >= 2.0) || !isfinite(out->pitch_px))
+            return lf_error_set(err, LF_ERR_PARAM, "microlens pitch %g px is too small (need >= 2)", out->pitch_px);
+        if (!(out->have & LF_LF_HAVE_LENS_COUNT)) {
+            double py = out->pitch_px * (out->grid == LF_LF_GRID_HEX ? sqrt(3.0) / 2 : 1.0);
+            out->lens_x = (int)floor((raw_w - out->offset_px[0]) / out->pitch_px) + 1;
+            out->lens_y = (int)floor((raw_h - out->offset_px[1]) / py) + 1;
+            out->have |= LF_LF_HAVE_LENS_COUNT;
+        }
+        if (out->lens_x < 1 || out->lens_y < 1)
+            return lf_error_set(err, LF_ERR_PARAM, "microlens count %d x %d is empty", out->lens_x, out->lens_y);
+    }
+    return LF_OK;
+}
+
+int lf_lf_layout_to_attrs(const lf_lf_layout *lay, lf_attrs *a, lf_error *err)
+{
+    int r = 0;
+    float v[4];
+    if (lay->kind == LF_LF_CAMERA_ARRAY) {
+        r |= lf_attrs_set_string(a, "lensfield:kind", "camera-array");
+        v[0] = (float)lay->cams_x, v[1] = (float)lay->cams_y;
+        r |= lf_attrs_set_floats(a, "lensfield:cameras_per_dim", v, 2);
+        if (lay->have & LF_LF_HAVE_BOUNDS) {
+            for (int i = 0; i < 4; i++)
+                v[i] = (float)lay->grid_bounds[i];
+            r |= lf_attrs_set_floats(a, "lensfield:camera_grid_bounds", v, 4);
+        }
+        if (lay->have & LF_LF_HAVE_FOV)
+            r |= lf_attrs_set_double(a, "lensfield:fov_deg", lay->fov_deg);
+        v[0] = (float)lay->tile_w, v[1] = (float)lay->tile_h;
+        r |= lf_attrs_set_floats(a, "lensfield:tile_size", v, 2);
+    } else if (lay->kind == LF_LF_PLENOPTIC) {
+        r |= lf_attrs_set_string(a, "lensfield:kind", "plenoptic");
+        r |= lf_attrs_set_string(a, "lensfield:grid", lay->grid == LF_LF_GRID_HEX ? "hex" : "square");
+        r |= lf_attrs_set_double(a, "lensfield:microlens_pitch_px", lay->pitch_px);
+        r |= lf_attrs_set_double(a, "lensfield:microlens_rotation_rad", lay->rotation_rad);
+        v[0] = (float)lay->offset_px[0], v[1] = (float)lay->offset_px[1];
+        r |= lf_attrs_set_floats(a, "lensfield:microlens_offset_px", v, 2);
+        v[0] = (float)lay->lens_x, v[1] = (float)lay->lens_y;
+        r |= lf_attrs_set_floats(a, "lensfield:microlens_count", v, 2);
+        if (lay->have & LF_LF_HAVE_MAIN_LENS) {
+            r |= lf_attrs_set_double(a, "lensfield:main_focal_mm", lay->main_focal_mm);
+            r |= lf_attrs_set_double(a, "lensfield:main_fstop", lay->main_fstop);
+            r |= lf_attrs_set_double(a, "lensfield:mla_distance_mm", lay->mla_distance_mm);
+            r |= lf_attrs_set_double(a, "lensfield:microlens_pitch_um", lay->pitch_um);
+        }
+    }
+    return r ? lf_error_set(err, LF_ERR_NOMEM, "out of memory writing layout attributes") : LF_OK;
+}
+
+void lf_lf_layout_describe(const lf_lf_layout *l, char *buf, size_t n)
+{
+    if (l->kind == LF_LF_CAMERA_ARRAY) {
+        int k = snprintf(buf, n, "kind camera-array\ngrid %d x %d cameras\nviews %d\nview resolution %d x %d\n",
+                         l->cams_x, l->cams_y, l->cams_x * l->cams_y, l->tile_w, l->tile_h);
+        if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_BOUNDS))
+            k += snprintf(buf + k, n - (size_t)k, "camera grid bounds x [%g, %g] y [%g, %g]\n", l->grid_bounds[0],
+                          l->grid_bounds[1], l->grid_bounds[2], l->grid_bounds[3]);
+        if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_FOV))
+            k += snprintf(buf + k, n - (size_t)k, "fov %g deg\n", l->fov_deg);
+        if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_CAM_LENS))
+            snprintf(buf + k, n - (size_t)k, "data camera lens radius %g, focal distance %g\n", l->lens_radius,
+                     l->focal_distance);
+    } else {
+        int views = 2 * (int)floor((l->pitch_px - 1) / 2) + 1;
+        int nt = l->grid == LF_LF_GRID_HEX ? (int)floor((l->lens_y - 1) * sqrt(3.0) / 2) + 1 : l->lens_y;
+        int k = snprintf(buf, n,
+                         "kind plenoptic\ngrid %s, %d x %d microlenses, pitch %g px, rotation %g rad, offset (%g, %g) px\n"
+                         "views %d x %d\nview resolution %d x %d\n",
+                         l->grid == LF_LF_GRID_HEX ? "hex" : "square", l->lens_x, l->lens_y, l->pitch_px,
+                         l->rotation_rad, l->offset_px[0], l->offset_px[1], views, views, l->lens_x, nt);
+        if (k > 0 && (size_t)k < n) {
+            if (l->have & LF_LF_HAVE_MAIN_LENS)
+                snprintf(buf + k, n - (size_t)k,
+                         "main lens f = %g mm, f/%g, focus %g m, microlens array at %g mm, microlens pitch %g um\n",
+                         l->main_focal_mm, l->main_fstop, l->focus_distance_m, l->mla_distance_mm, l->pitch_um);
+            else
+                snprintf(buf + k, n - (size_t)k, "main lens: unknown (alpha/depth refocus unavailable)\n");
+        }
+    }
+}

@@ -1,0 +1,197 @@
+/* lf_lightfield.h - 4D light fields: layout, decode, refocus, views, synthesis.
+ *
+ * lightfield/ knows nothing of the renderer: it works on any raw image plus a
+ * layout, read from the `lensfield:*` attributes of docs/lightfield-format.md
+ * or given explicitly (tools pass flags).  Uses image/ and base/ only.
+ *
+ *   lf_lf_layout file, flags, lay; lf_lightfield lf = {0}; lf_error err = {0};
+ *   lf_lf_layout_from_attrs(&attrs, &file);        // what the file says
+ *   lf_lf_layout_init(&flags); ...set flags.*, flags.have |= LF_LF_HAVE_...;
+ *   if (lf_lf_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err)) fail(err.msg);
+ *   lf_lf_decode(&raw, &lay, NULL, &lf, &err);      // or a white image to devignet
+ *   lf_lf_refocus_opts o = lf_lf_refocus_defaults(); o.disparity_px = 1.5;
+ *   lf_image out; lf_lf_refocus(&lf, &o, &out, &err);
+ *   lf_lf_free(&lf);
+ *
+ * Conventions (docs/lftool.md has the long form):
+ *   - Views (iu, iv): iu grows with the viewpoint's camera-space x (right),
+ *     iv grows with decreasing camera-space y (down), so view (0,0) is the
+ *     top-left camera seen from behind, as tile (0,0) of a camera-array raw.
+ *     Centred view coordinates are u = iu - (nu-1)/2, v = iv - (nv-1)/2.
+ *   - (s, t): pixel column and row in a view, row 0 at the top.
+ *   - Disparity d (pixels per view step): a scene point's image moves by -d
+ *     pixels in s when the viewpoint moves one view step to +u (likewise t, v).
+ *     A camera array sees d = F_px * b / Z > 0; a plenoptic capture has d = 0
+ *     at the focus distance, d > 0 nearer, d < 0 farther.  Refocusing at d
+ *     averages L(u, v, s - d u, t - d v): points with disparity d come out sharp.
+ *   - alpha (Ng 2005): d = (1 - 1/alpha) * du / p, du the lens distance between
+ *     views, p the microlens pitch (metres); depth z: 1/z + 1/(alpha F) = 1/f.
+ *     Ng's x'/alpha magnification is left out: outputs stay on the (s,t) grid.
+ */
+#ifndef LF_LIGHTFIELD_H
+#define LF_LIGHTFIELD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../base/lf_error.h"
+#include "../image/lf_image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum lf_lf_kind { LF_LF_KIND_UNKNOWN = 0, LF_LF_CAMERA_ARRAY, LF_LF_PLENOPTIC } lf_lf_kind;
+typedef enum lf_lf_grid { LF_LF_GRID_SQUARE = 0, LF_LF_GRID_HEX } lf_lf_grid;
+
+/* Which fields of an lf_lf_layout are known. */
+enum {
+    LF_LF_HAVE_KIND = 1u << 0,
+    LF_LF_HAVE_CAMS = 1u << 1,        /* cams_x, cams_y */
+    LF_LF_HAVE_BOUNDS = 1u << 2,      /* grid_bounds */
+    LF_LF_HAVE_FOV = 1u << 3,         /* fov_deg */
+    LF_LF_HAVE_TILE = 1u << 4,        /* tile_w, tile_h */
+    LF_LF_HAVE_CAM_LENS = 1u << 5,    /* lens_radius, focal_distance */
+    LF_LF_HAVE_GRID = 1u << 6,        /* grid */
+    LF_LF_HAVE_PITCH = 1u << 7,       /* pitch_px */
+    LF_LF_HAVE_ROTATION = 1u << 8,    /* rotation_rad */
+    LF_LF_HAVE_OFFSET = 1u << 9,      /* offset_px */
+    LF_LF_HAVE_LENS_COUNT = 1u << 10, /* lens_x, lens_y */
+    LF_LF_HAVE_MAIN_LENS = 1u << 11   /* main_focal_mm, main_fstop, mla_distance_mm, pitch_um */
+};
+
+typedef struct lf_lf_layout {
+    unsigned have; /* LF_LF_HAVE_* bits */
+    lf_lf_kind kind;
+    /* camera-array (CS348B Camera "lightfield") */
+    int cams_x, cams_y;
+    double grid_bounds[4]; /* minx maxx miny maxy on the z = 0 plane */
+    double fov_deg;        /* per data camera, across the tile's shorter side */
+    int tile_w, tile_h;
+    double lens_radius, focal_distance;
+    /* plenoptic (Ng 2005) */
+    lf_lf_grid grid;
+    double pitch_px, rotation_rad, offset_px[2];
+    int lens_x, lens_y;
+    double pitch_um, microlens_focal_mm, main_focal_mm, main_fstop, focus_distance_m, mla_distance_mm;
+} lf_lf_layout;
+
+void lf_lf_layout_init(lf_lf_layout *lay);
+/* Fills what the lensfield:* attributes give; never fails on missing ones
+ * (returns LF_ERR_PARSE only for an attribute of the wrong type or value). */
+int lf_lf_layout_from_attrs(const lf_attrs *attrs, lf_lf_layout *lay, lf_error *err);
+/* Merges the file's layout with explicit parameters (flags): a field in both
+ * must agree (else LF_ERR_PARAM naming the attribute and the flag); then
+ * derives what follows from the raw size (tile size, lens count) and fails
+ * with LF_ERR_PARAM listing every missing attribute with its flag. */
+int lf_lf_layout_resolve(const lf_lf_layout *file, const lf_lf_layout *flags, int raw_w, int raw_h,
+                         lf_lf_layout *out, lf_error *err);
+/* Writes the layout as lensfield:* attributes (the format decode reads). */
+int lf_lf_layout_to_attrs(const lf_lf_layout *lay, lf_attrs *attrs, lf_error *err);
+/* One-paragraph human description (info). */
+void lf_lf_layout_describe(const lf_lf_layout *lay, char *buf, size_t n);
+
+/* A decoded 4D light field L(u, v, s, t), RGB float. */
+typedef struct lf_lightfield {
+    int nu, nv; /* views */
+    int ns, nt; /* view width, height */
+    float *data;  /* view (iu,iv) at data + (iv*nu + iu) * ns*nt*3, rows top first */
+    float *valid; /* NULL when every sample is valid, else ns*nt per view, 1 or 0 */
+    size_t missing;   /* samples marked invalid */
+    size_t nonfinite; /* raw values that were NaN/Inf (their samples are invalid) */
+    /* geometry for parameter conversions (0 when unknown) */
+    double disp_v_per_u;    /* d_v / d_u for one depth (camera arrays with unequal baselines) */
+    double disp_per_inv_m;  /* d = disp_at_inf + disp_per_inv_m / Z */
+    double disp_at_inf;
+    double disp_per_alpha;  /* d = disp_per_alpha * (1 - 1/alpha); 0: alpha unavailable */
+    lf_lf_layout layout;
+} lf_lightfield;
+
+static inline float *lf_lf_view(const lf_lightfield *lf, int iu, int iv)
+{
+    return lf->data + ((size_t)iv * (size_t)lf->nu + (size_t)iu) * (size_t)lf->ns * (size_t)lf->nt * 3;
+}
+
+int lf_lf_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err);
+void lf_lf_free(lf_lightfield *lf); /* accepts a zeroed struct */
+
+/* Decodes a raw image (any channel count: 1 is grey, RGB(A) used as RGB).
+ * white may be NULL; when given (same layout) every sample is divided by the
+ * white sample, and samples where white < 5% of its maximum are
+ * marked missing.  Non-finite raw values are counted and marked missing. */
+/* Views per side of a plenoptic decode: the odd count 2*floor((pitch-1)/2)+1. */
+int lf_lf_plenoptic_views(const lf_lf_layout *lay);
+int lf_lf_decode(const lf_image *raw, const lf_lf_layout *lay, const lf_image *white, lf_lightfield *lf,
+                 lf_error *err);
+
+/* Conversions; fail with LF_ERR_PARAM when the layout lacks what they need. */
+int lf_lf_alpha_to_disparity(const lf_lightfield *lf, double alpha, double *disp, lf_error *err);
+int lf_lf_depth_to_disparity(const lf_lightfield *lf, double depth_m, double *disp, lf_error *err);
+
+/* Shift-and-add refocusing with bilinear sub-pixel interpolation (clamped at
+ * view borders).  Views weighted by the synthetic aperture: a disk of radius
+ * aperture_radius (view units, centred; < 0: all views) intersected with the
+ * view window [u0,u1]x[v0,v1] (indices, inclusive; u1 < 0: all). */
+typedef struct lf_lf_refocus_opts {
+    double disparity_px; /* along u; along v it is scaled by lf->disp_v_per_u */
+    double aperture_radius;
+    int u0, u1, v0, v1;
+    int threads; /* <= 0: 2 */
+} lf_lf_refocus_opts;
+lf_lf_refocus_opts lf_lf_refocus_defaults(void);
+int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image *out, lf_error *err);
+
+/* A view at centred view coordinates (u, v) inside the captured aperture,
+ * blended bilinearly from the 4 nearest views after reprojecting them to the
+ * plane of disparity disparity_px (0: plain blending).  At a view position it
+ * returns that view exactly. */
+int lf_lf_view_at(const lf_lightfield *lf, double u, double v, double disparity_px, lf_image *out, lf_error *err);
+
+/* Fourier slice refocusing (Ng 2005 SIGGRAPH).  Precompute: per-view 2D FFT
+ * (views zero-padded to powers of two), DFT over (u,v) zero-padded to
+ * P = oversample * n (rounded up), pre-divided by the Kaiser-Bessel kernel's
+ * transform; per frame: 4x4-tap Kaiser-Bessel slice, inverse 2D FFT. */
+typedef struct lf_lf_fourier lf_lf_fourier;
+int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *aperture, double oversample,
+                      lf_lf_fourier **out, lf_error *err);
+int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disparity_px, lf_image *out, lf_error *err);
+void lf_lf_fourier_release(lf_lf_fourier *f);
+
+/* Focal stack, all-in-focus image and disparity map from a stack over
+ * [d0, d1] in n steps: per pixel the slice with the largest local contrast
+ * (squared Laplacian of luminance over a (2r+1)^2 window). */
+int lf_lf_allfocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
+                   lf_image *allfocus, lf_image *disparity, lf_error *err);
+
+/* CS348B virtual camera (Levoy & Hanrahan 1996, Isaksen et al. 2000).  Each
+ * ray meets the camera plane z = 0 (4 nearest data cameras, bilinear weights)
+ * and the virtual focal plane (the thin lens's plane of focus, at
+ * focal_distance along the view axis); each data camera is looked up where it
+ * sees that focal point, bilinearly inside its own tile (never a neighbour's). */
+typedef struct lf_lf_synth_opts {
+    int width, height;       /* outputdim */
+    double fov_deg;          /* outputfov (shorter side, pbrt) */
+    double pos[3];           /* camerapos, camera space of the grid */
+    double rot_deg[3];       /* camerarot: R = Rz * Ry * Rx (x applied first) */
+    double lens_radius;      /* 0: pinhole */
+    double focal_distance;   /* <= 0: infinity (pinhole only) */
+    int spp;                 /* 1: pixel and lens centre; else stratified jitter */
+    uint32_t seed;
+    int threads;             /* <= 0: 2 */
+} lf_lf_synth_opts;
+lf_lf_synth_opts lf_lf_synth_defaults(void);
+/* coverage may be NULL; else a 1-channel image: fraction of samples whose ray
+ * stayed inside the captured aperture and the data cameras' fields of view.
+ * uncovered (may be NULL) gets the count of pixels with no covered sample. */
+int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *out, lf_image *coverage,
+                size_t *uncovered, lf_error *err);
+
+/* Microlens-grid estimate from a white plenoptic image: pitch, rotation,
+ * offset, square or hex (peak detection + lattice fit).  Sets kind, grid,
+ * pitch, rotation, offset and lens count in *lay. */
+int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

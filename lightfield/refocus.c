@@ -1,0 +1,326 @@
+/* Shift-and-add refocusing (Ng 2005, sub-aperture form), view interpolation,
+ * focal stacks, all-in-focus and disparity maps. */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lf_lightfield.h"
+
+lf_lf_refocus_opts lf_lf_refocus_defaults(void)
+{
+    lf_lf_refocus_opts o;
+    memset(&o, 0, sizeof o);
+    o.aperture_radius = -1;
+    o.u1 = o.v1 = -1;
+    return o;
+}
+
+/* Synthetic-aperture weight of view (iu, iv): 1 inside the disk and window. */
+static float view_weight(const lf_lightfield *lf, const lf_lf_refocus_opts *o, int iu, int iv)
+{
+    if (o->u1 >= 0 && (iu < o->u0 || iu > o->u1))
+        return 0.f;
+    if (o->v1 >= 0 && (iv < o->v0 || iv > o->v1))
+        return 0.f;
+    if (o->aperture_radius >= 0) {
+        double u = iu - (lf->nu - 1) / 2.0, v = iv - (lf->nv - 1) / 2.0;
+        if (u * u + v * v > o->aperture_radius * o->aperture_radius + 1e-9)
+            return 0.f;
+    }
+    return 1.f;
+}
+
+typedef struct view_shift {
+    const float *data, *valid;
+    int ix, iy;          /* integer part of the source offset */
+    float fx, fy, w;     /* fractional part, aperture weight */
+} view_shift;
+
+typedef struct refocus_job {
+    const lf_lightfield *lf;
+    const view_shift *views;
+    int nviews;
+    float inv_wsum;
+    lf_image *out;
+    int y0, y1;
+    float *wacc; /* masked path: accumulated weights, ns per row in band */
+} refocus_job;
+
+enum { BLOCK_ROWS = 16 };
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/* acc[k] += a*r0[k] + b*r0[k+3] + c*r1[k] + e*r1[k+3], k over n floats */
+static void accumulate_row(float *restrict acc, const float *restrict r0, const float *restrict r1, float a, float b,
+                           float c, float e, int n)
+{
+    if (b == 0.f && c == 0.f && e == 0.f) {
+        for (int k = 0; k < n; k++)
+            acc[k] += a * r0[k];
+    } else if (c == 0.f && e == 0.f) {
+        for (int k = 0; k < n; k++)
+            acc[k] += a * r0[k] + b * r0[k + 3];
+    } else {
+        for (int k = 0; k < n; k++)
+            acc[k] += a * r0[k] + b * r0[k + 3] + c * r1[k] + e * r1[k + 3];
+    }
+}
+
+static void *refocus_worker(void *arg)
+{
+    refocus_job *j = arg;
+    const lf_lightfield *lf = j->lf;
+    const int ns = lf->ns, nt = lf->nt;
+    const size_t row = (size_t)ns * 3;
+    for (int yb = j->y0; yb < j->y1; yb += BLOCK_ROWS) {
+        int ye = yb + BLOCK_ROWS < j->y1 ? yb + BLOCK_ROWS : j->y1;
+        for (int vi = 0; vi < j->nviews; vi++) {
+            const view_shift *v = &j->views[vi];
+            float w00 = v->w * (1 - v->fx) * (1 - v->fy), w10 = v->w * v->fx * (1 - v->fy);
+            float w01 = v->w * (1 - v->fx) * v->fy, w11 = v->w * v->fx * v->fy;
+            /* interior columns: x + ix and x + ix + 1 both inside the view */
+            int xa = clampi(-v->ix, 0, ns), xb = clampi(ns - 1 - v->ix, xa, ns);
+            for (int y = yb; y < ye; y++) {
+                float *acc = j->out->data + (size_t)y * row;
+                int sy0 = clampi(y + v->iy, 0, nt - 1), sy1 = clampi(y + v->iy + 1, 0, nt - 1);
+                const float *r0 = v->data + (size_t)sy0 * row, *r1 = v->data + (size_t)sy1 * row;
+                if (!v->valid) {
+                    if (xb > xa)
+                        accumulate_row(acc + 3 * xa, r0 + 3 * (xa + v->ix), r1 + 3 * (xa + v->ix), w00, w10, w01,
+                                       w11, 3 * (xb - xa));
+                    for (int x = 0; x < ns; x++) {
+                        if (x == xa && xb > xa)
+                            x = xb;
+                        if (x >= ns)
+                            break;
+                        int sx0 = clampi(x + v->ix, 0, ns - 1), sx1 = clampi(x + v->ix + 1, 0, ns - 1);
+                        for (int c = 0; c < 3; c++)
+                            acc[3 * x + c] += w00 * r0[3 * sx0 + c] + w10 * r0[3 * sx1 + c] + w01 * r1[3 * sx0 + c] +
+                                              w11 * r1[3 * sx1 + c];
+                    }
+                } else {
+                    /* masked: every tap weighted by its validity, weights accumulated */
+                    const float *m0 = v->valid + (size_t)sy0 * ns, *m1 = v->valid + (size_t)sy1 * ns;
+                    float *wa = j->wacc + (size_t)(y - j->y0) * ns;
+                    for (int x = 0; x < ns; x++) {
+                        int sx0 = clampi(x + v->ix, 0, ns - 1), sx1 = clampi(x + v->ix + 1, 0, ns - 1);
+                        float a = w00 * m0[sx0], b = w10 * m0[sx1], c = w01 * m1[sx0], e = w11 * m1[sx1];
+                        wa[x] += a + b + c + e;
+                        for (int ch = 0; ch < 3; ch++)
+                            acc[3 * x + ch] += a * r0[3 * sx0 + ch] + b * r0[3 * sx1 + ch] + c * r1[3 * sx0 + ch] +
+                                               e * r1[3 * sx1 + ch];
+                    }
+                }
+            }
+        }
+        for (int y = yb; y < ye; y++) {
+            float *acc = j->out->data + (size_t)y * row;
+            if (j->wacc) {
+                const float *wa = j->wacc + (size_t)(y - j->y0) * ns;
+                for (int x = 0; x < ns; x++) {
+                    float s = wa[x] > 1e-6f ? 1.f / wa[x] : 0.f;
+                    acc[3 * x] *= s, acc[3 * x + 1] *= s, acc[3 * x + 2] *= s;
+                }
+            } else {
+                for (size_t k = 0; k < row; k++)
+                    acc[k] *= j->inv_wsum;
+            }
+        }
+    }
+    return NULL;
+}
+
+int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image *out, lf_error *err)
+{
+    lf_lf_refocus_opts def = lf_lf_refocus_defaults();
+    if (!o)
+        o = &def;
+    if (!isfinite(o->disparity_px))
+        return lf_error_set(err, LF_ERR_PARAM, "disparity must be finite");
+    view_shift *vs = malloc(sizeof *vs * (size_t)lf->nu * lf->nv);
+    if (!vs)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    int n = 0;
+    double wsum = 0;
+    double dx = o->disparity_px, dy = o->disparity_px * lf->disp_v_per_u;
+    for (int iv = 0; iv < lf->nv; iv++)
+        for (int iu = 0; iu < lf->nu; iu++) {
+            float w = view_weight(lf, o, iu, iv);
+            if (w == 0.f)
+                continue;
+            /* L(u, v, s - d u, t - d v) */
+            double sx = -dx * (iu - (lf->nu - 1) / 2.0), sy = -dy * (iv - (lf->nv - 1) / 2.0);
+            view_shift *v = &vs[n++];
+            v->data = lf_lf_view(lf, iu, iv);
+            v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * lf->ns * lf->nt : NULL;
+            v->ix = (int)floor(sx), v->iy = (int)floor(sy);
+            v->fx = (float)(sx - v->ix), v->fy = (float)(sy - v->iy);
+            v->w = w;
+            wsum += w;
+        }
+    if (n == 0) {
+        free(vs);
+        return lf_error_set(err, LF_ERR_PARAM, "the synthetic aperture selects no view");
+    }
+    if (lf_image_alloc(out, lf->ns, lf->nt, 3, err)) {
+        free(vs);
+        return err ? err->code : LF_ERR_NOMEM;
+    }
+    int nth = o->threads > 0 ? o->threads : 2;
+    if (nth > 64)
+        nth = 64;
+    refocus_job jobs[64];
+    pthread_t tid[64];
+    int rc = LF_OK;
+    for (int t = 0; t < nth; t++) {
+        jobs[t] = (refocus_job){lf, vs, n, (float)(1.0 / wsum), out, lf->nt * t / nth, lf->nt * (t + 1) / nth, NULL};
+        if (lf->valid) {
+            jobs[t].wacc = calloc((size_t)(jobs[t].y1 - jobs[t].y0 + 1) * lf->ns, sizeof(float));
+            if (!jobs[t].wacc)
+                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        }
+    }
+    int created[64] = {0};
+    for (int t = 1; t < nth && !rc; t++)
+        created[t] = pthread_create(&tid[t], NULL, refocus_worker, &jobs[t]) == 0;
+    if (!rc) {
+        refocus_worker(&jobs[0]);
+        for (int t = 1; t < nth; t++) {
+            if (created[t])
+                pthread_join(tid[t], NULL);
+            else
+                refocus_worker(&jobs[t]); /* no thread: do its rows here */
+        }
+    }
+    for (int t = 0; t < nth; t++)
+        free(jobs[t].wacc);
+    free(vs);
+    if (rc)
+        lf_image_free(out);
+    return rc;
+}
+
+/* Bilinear sample of one view at continuous (x, y) (pixel-index space),
+ * clamped to the view; validity-weighted. Returns the weight used. */
+static float sample_view(const lf_lightfield *lf, int iu, int iv, double x, double y, float rgb[3])
+{
+    const float *d = lf_lf_view(lf, iu, iv);
+    const float *m = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * lf->ns * lf->nt : NULL;
+    int x0 = (int)floor(x), y0 = (int)floor(y);
+    float fx = (float)(x - x0), fy = (float)(y - y0);
+    float acc[3] = {0, 0, 0}, wsum = 0;
+    for (int k = 0; k < 4; k++) {
+        float w = (k & 1 ? fx : 1 - fx) * (k & 2 ? fy : 1 - fy);
+        if (w == 0.f)
+            continue;
+        int xx = clampi(x0 + (k & 1), 0, lf->ns - 1), yy = clampi(y0 + (k >> 1), 0, lf->nt - 1);
+        size_t i = (size_t)yy * lf->ns + xx;
+        if (m)
+            w *= m[i];
+        for (int c = 0; c < 3; c++)
+            acc[c] += w * d[i * 3 + c];
+        wsum += w;
+    }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = wsum > 0 ? acc[c] / wsum : 0.f;
+    return wsum;
+}
+
+int lf_lf_view_at(const lf_lightfield *lf, double u, double v, double disp, lf_image *out, lf_error *err)
+{
+    double fu = u + (lf->nu - 1) / 2.0, fv = v + (lf->nv - 1) / 2.0;
+    if (!(fu >= -1e-9 && fu <= lf->nu - 1 + 1e-9 && fv >= -1e-9 && fv <= lf->nv - 1 + 1e-9))
+        return lf_error_set(err, LF_ERR_PARAM, "view (%g, %g) is outside the captured aperture u in [%g, %g], v in [%g, %g]",
+                            u, v, -(lf->nu - 1) / 2.0, (lf->nu - 1) / 2.0, -(lf->nv - 1) / 2.0, (lf->nv - 1) / 2.0);
+    int u0 = clampi((int)floor(fu), 0, lf->nu > 1 ? lf->nu - 2 : 0), v0 = clampi((int)floor(fv), 0, lf->nv > 1 ? lf->nv - 2 : 0);
+    double au = fu - u0, av = fv - v0;
+    if (lf_image_alloc(out, lf->ns, lf->nt, 3, err))
+        return err ? err->code : LF_ERR_NOMEM;
+    double dy = disp * lf->disp_v_per_u;
+    for (int y = 0; y < lf->nt; y++)
+        for (int x = 0; x < lf->ns; x++) {
+            double acc[3] = {0, 0, 0}, wsum = 0;
+            for (int k = 0; k < 4; k++) {
+                int iu = u0 + (k & 1), iv = v0 + (k >> 1);
+                double w = (k & 1 ? au : 1 - au) * (k & 2 ? av : 1 - av);
+                if (w == 0 || iu >= lf->nu || iv >= lf->nv)
+                    continue;
+                /* a point of disparity d seen at x from (fu,fv) is at x - d (iu - fu) in view iu */
+                float c[3];
+                float vw = sample_view(lf, iu, iv, x - disp * (iu - fu), y - dy * (iv - fv), c);
+                if (vw <= 0)
+                    continue;
+                for (int ch = 0; ch < 3; ch++)
+                    acc[ch] += w * c[ch];
+                wsum += w;
+            }
+            float *p = lf_image_px(out, x, y);
+            for (int ch = 0; ch < 3; ch++)
+                p[ch] = wsum > 0 ? (float)(acc[ch] / wsum) : 0.f;
+        }
+    return LF_OK;
+}
+
+/* Local contrast: squared Laplacian of luminance, box-summed over (2r+1)^2. */
+static void contrast(const lf_image *img, float *out, int r)
+{
+    int w = img->width, h = img->height;
+    float *lap = calloc((size_t)w * h, sizeof(float));
+    if (!lap)
+        return;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+#define LUM(xx, yy)                                                                                          \
+    (0.2126f * lf_image_px(img, clampi(xx, 0, w - 1), clampi(yy, 0, h - 1))[0] +                             \
+     0.7152f * lf_image_px(img, clampi(xx, 0, w - 1), clampi(yy, 0, h - 1))[1] +                             \
+     0.0722f * lf_image_px(img, clampi(xx, 0, w - 1), clampi(yy, 0, h - 1))[2])
+            float l = 4 * LUM(x, y) - LUM(x - 1, y) - LUM(x + 1, y) - LUM(x, y - 1) - LUM(x, y + 1);
+#undef LUM
+            lap[(size_t)y * w + x] = l * l;
+        }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float s = 0;
+            for (int dy = -r; dy <= r; dy++)
+                for (int dx = -r; dx <= r; dx++)
+                    s += lap[(size_t)clampi(y + dy, 0, h - 1) * w + clampi(x + dx, 0, w - 1)];
+            out[(size_t)y * w + x] = s;
+        }
+    free(lap);
+}
+
+int lf_lf_allfocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
+                   lf_image *allfocus, lf_image *disparity, lf_error *err)
+{
+    if (n < 2)
+        return lf_error_set(err, LF_ERR_PARAM, "a focal stack needs at least 2 slices (got %d)", n);
+    size_t np = (size_t)lf->ns * lf->nt;
+    float *best = malloc(np * sizeof(float)), *c = malloc(np * sizeof(float));
+    if (!best || !c || lf_image_alloc(allfocus, lf->ns, lf->nt, 3, err) ||
+        (disparity && lf_image_alloc(disparity, lf->ns, lf->nt, 1, err))) {
+        free(best), free(c);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < np; i++)
+        best[i] = -1.f;
+    lf_lf_refocus_opts ro = o ? *o : lf_lf_refocus_defaults();
+    int rc = LF_OK;
+    for (int k = 0; k < n && !rc; k++) {
+        ro.disparity_px = d0 + (d1 - d0) * k / (n - 1);
+        lf_image slice;
+        if ((rc = lf_lf_refocus(lf, &ro, &slice, err)))
+            break;
+        contrast(&slice, c, 2);
+        for (size_t i = 0; i < np; i++)
+            if (c[i] > best[i]) {
+                best[i] = c[i];
+                memcpy(allfocus->data + i * 3, slice.data + i * 3, 3 * sizeof(float));
+                if (disparity)
+                    disparity->data[i] = (float)ro.disparity_px;
+            }
+        lf_image_free(&slice);
+    }
+    free(best), free(c);
+    return rc;
+}

@@ -1,0 +1,618 @@
+/* Real compound lenses (camera/lens.c, camera/realistic.c): paraxial values
+ * against independent computations (published EFLs, the lensmaker's
+ * equation, ray-transfer matrices), Snell's law and total internal
+ * reflection, focusing, unbiased exit-pupil sampling, dispersion, and the
+ * hard cases (bad files, impossible focus, no light). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "camera/lens.h"
+#include "camera/lf_camera.h"
+#include "lf_test.h"
+
+#define LENSES LF_SOURCE_DIR "/scenes/lenses/"
+
+static int load(const char *name, lf_lens *L)
+{
+    char err[1024];
+    char path[1024];
+    snprintf(path, sizeof path, "%s%s", LENSES, name);
+    if (lf_lens_load(path, L, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse(const char *text, lf_lens *L)
+{
+    char err[1024];
+    if (lf_lens_parse(text, "test.dat", L, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- independent paraxial optics: 2x2 ray-transfer matrices on (y, n u) ---- */
+typedef struct m2 {
+    double a, b, c, d;
+} m2;
+static m2 mul(m2 x, m2 y) /* x * y: y acts first */
+{
+    return (m2){x.a * y.a + x.b * y.c, x.a * y.b + x.b * y.d, x.c * y.a + x.d * y.c, x.c * y.b + x.d * y.d};
+}
+/* Surfaces i0..i1 (vertex of i0 to vertex of i1, refraction at both ends). */
+static m2 system_matrix(const lf_lens *L, int i0, int i1)
+{
+    m2 m = {1, 0, 0, 1};
+    for (int i = i0; i <= i1; i++) {
+        double n = i > 0 ? L->s[i - 1].ior : 1.0, np = L->s[i].ior;
+        double power = L->s[i].radius_mm != 0.0 ? (np - n) / L->s[i].radius_mm : 0.0;
+        m = mul((m2){1, 0, -power, 1}, m);
+        if (i < i1)
+            m = mul((m2){1, L->s[i].thickness_mm / np, 0, 1}, m);
+    }
+    return m;
+}
+
+static void test_shipped_efl(void)
+{
+    /* Independent paraxial values from the issue (published designs, scaled). */
+    static const struct {
+        const char *file;
+        double efl;
+    } lenses[] = {{"dgauss.50mm.dat", 50.36},
+                  {"wide.22mm.dat", 22.02},
+                  {"telephoto.250mm.dat", 249.57},
+                  {"fisheye.10mm.dat", 9.99},
+                  {"dgauss.100mm.dat", 100.72}};
+    for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
+        lf_lens L;
+        if (load(lenses[k].file, &L))
+            continue;
+        lf_lens_paraxial px;
+        CHECK(lf_lens_paraxial_analyse(&L, &px) == 0);
+        CHECK_MSG(fabs(px.efl_mm - lenses[k].efl) <= 0.005 * lenses[k].efl, "%s: efl %g, want %g",
+                  lenses[k].file, px.efl_mm, lenses[k].efl);
+        /* The same lens through matrices: EFL = -1/C, BFL = -A/C, FFL = -D/C. */
+        m2 m = system_matrix(&L, 0, L.n - 1);
+        CHECK_NEAR(px.efl_mm, -1.0 / m.c, 1e-9 * lenses[k].efl);
+        CHECK_NEAR(px.bfl_mm, -m.a / m.c, 1e-9 * lenses[k].efl);
+        CHECK_NEAR(px.ffl_mm, -m.d / m.c, 1e-9 * lenses[k].efl);
+        /* Pupils: the planes conjugate to the stop (B = 0), magnification A or 1/D. */
+        int s = px.stop;
+        CHECK(s == L.stop);
+        if (s > 0) {
+            m2 f = system_matrix(&L, 0, s - 1);
+            f = mul((m2){1, L.s[s - 1].thickness_mm / L.s[s - 1].ior, 0, 1}, f); /* to the stop plane */
+            CHECK_NEAR(px.entrance_pupil_mm, f.b / f.a, 1e-9 * lenses[k].efl);
+            CHECK_NEAR(px.entrance_pupil_diameter_mm, 2 * L.s[s].aperture_radius_mm / fabs(f.a), 1e-9 * lenses[k].efl);
+        }
+        if (s < L.n - 1) {
+            m2 r = system_matrix(&L, s + 1, L.n - 1);
+            r = mul(r, (m2){1, L.s[s].thickness_mm / L.s[s].ior, 0, 1});
+            CHECK_NEAR(px.exit_pupil_mm, -r.b / r.d, 1e-9 * lenses[k].efl);
+            CHECK_NEAR(px.exit_pupil_diameter_mm, 2 * L.s[s].aperture_radius_mm / fabs(r.d), 1e-9 * lenses[k].efl);
+        }
+        CHECK_NEAR(px.fnumber, px.efl_mm / px.entrance_pupil_diameter_mm, 1e-12);
+        /* Exact tracing agrees with paraxial optics near the axis: a parallel
+         * ray at 1 um crosses the axis at the back focal distance. */
+        L.film_distance_mm = px.bfl_mm;
+        lf_lens_ray in = {{0, 1e-3, L.s[0].z_mm - L.film_distance_mm - 5.0}, {0, 0, 1}}, out;
+        CHECK(lf_lens_trace_from_scene(&L, &in, &out, NULL) == LF_LENS_PASSED);
+        double t = -out.o[1] / out.d[1];
+        double z_cross = out.o[2] + t * out.d[2]; /* film at 0: should be ~0 */
+        CHECK_MSG(fabs(z_cross) < 1e-4 * lenses[k].efl, "%s: paraxial focus off by %g mm", lenses[k].file, z_cross);
+        lf_lens_free(&L);
+    }
+}
+
+static void test_singlet(void)
+{
+    /* Lensmaker's equation for a thick singlet:
+     * 1/f = (n-1) (1/R1 - 1/R2 + (n-1) d / (n R1 R2)),  BFL = f (1 - (n-1) d / (n R1)). */
+    const double R1 = 50, R2 = -80, d = 6, n = 1.5;
+    char text[256];
+    snprintf(text, sizeof text, "# singlet\n%g %g %g 20\n%g 40 1 20\n", R1, d, n, R2);
+    lf_lens L;
+    if (parse(text, &L))
+        return;
+    lf_lens_paraxial px;
+    CHECK(lf_lens_paraxial_analyse(&L, &px) == 0);
+    double f = 1.0 / ((n - 1) * (1 / R1 - 1 / R2 + (n - 1) * d / (n * R1 * R2)));
+    CHECK_NEAR(px.efl_mm, f, 1e-9 * f);
+    CHECK_NEAR(px.bfl_mm, f * (1 - (n - 1) * d / (n * R1)), 1e-9 * f);
+    CHECK_NEAR(px.ffl_mm, f * (1 + (n - 1) * d / (n * R2)), 1e-9 * f);
+    lf_lens_free(&L);
+    /* Thin-lens limit: d -> 0 gives 1/f = (n-1)(1/R1 - 1/R2) and BFL = f. */
+    snprintf(text, sizeof text, "%g 1e-6 %g 20\n%g 40 1 20\n", R1, n, R2);
+    if (parse(text, &L))
+        return;
+    CHECK(lf_lens_paraxial_analyse(&L, &px) == 0);
+    double thin = 1.0 / ((n - 1) * (1 / R1 - 1 / R2));
+    CHECK_NEAR(px.efl_mm, thin, 1e-6 * thin);
+    CHECK_NEAR(px.bfl_mm, thin, 1e-6 * thin);
+    /* Thin lens with no explicit stop: the lens rim is the stop, so f/N = f / 20 mm. */
+    CHECK(L.stop == -1);
+    CHECK_NEAR(px.entrance_pupil_diameter_mm, 20.0, 1e-6);
+    CHECK_NEAR(px.fnumber, thin / 20.0, 1e-6);
+    /* Thin lens focus: 1/u + 1/v = 1/f with D = u + v (distances from the film). */
+    double D = 1000, v;
+    char err[256];
+    CHECK(lf_lens_focus_thick(&L, D, &v, err, sizeof err) == 0);
+    double u = D - v;
+    CHECK_NEAR(1 / u + 1 / v, 1 / thin, 1e-6 / thin);
+    lf_lens_free(&L);
+}
+
+/* Snell's law at each surface of a traced path: n1 sin(t1) = n2 sin(t2). */
+static void test_snell(void)
+{
+    lf_lens L;
+    if (parse("40 8 1.7 30\n-60 50 1 30\n", &L))
+        return;
+    L.film_distance_mm = 50;
+    double path[3][3];
+    lf_lens_trace_opts o = {0};
+    o.path = path;
+    double dir[3] = {0.1, 0.2, 1.0};
+    double l = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    lf_lens_ray in = {{-3, -6, -100}, {dir[0] / l, dir[1] / l, dir[2] / l}}, out;
+    CHECK(lf_lens_trace_from_scene(&L, &in, &out, &o) == LF_LENS_PASSED);
+    CHECK(o.path_count == 2);
+    /* directions before/inside/after from the path points */
+    double d0[3], d1[3], d2[3] = {out.d[0], out.d[1], out.d[2]};
+    for (int k = 0; k < 3; k++)
+        d0[k] = in.d[k], d1[k] = path[1][k] - path[0][k];
+    l = sqrt(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]);
+    for (int k = 0; k < 3; k++)
+        d1[k] /= l;
+    const double *dirs[3] = {d0, d1, d2};
+    const double ior[3] = {1.0, 1.7, 1.0};
+    for (int sidx = 0; sidx < 2; sidx++) {
+        double R = L.s[sidx].radius_mm, zc = L.s[sidx].z_mm - L.film_distance_mm + R;
+        double nrm[3] = {path[sidx][0] / R, path[sidx][1] / R, (path[sidx][2] - zc) / R};
+        double sin_in, sin_out, c;
+        c = nrm[0] * dirs[sidx][0] + nrm[1] * dirs[sidx][1] + nrm[2] * dirs[sidx][2];
+        sin_in = sqrt(1 - c * c);
+        c = nrm[0] * dirs[sidx + 1][0] + nrm[1] * dirs[sidx + 1][1] + nrm[2] * dirs[sidx + 1][2];
+        sin_out = sqrt(1 - c * c);
+        CHECK_NEAR(ior[sidx] * sin_in, ior[sidx + 1] * sin_out, 1e-12);
+        /* hit points lie on the spheres */
+        double r2 = path[sidx][0] * path[sidx][0] + path[sidx][1] * path[sidx][1] +
+                    (path[sidx][2] - zc) * (path[sidx][2] - zc);
+        CHECK_NEAR(sqrt(r2), fabs(R), 1e-9);
+    }
+    /* The refracted ray stays in the plane of incidence: (d0 x n) . d1 = 0. */
+    lf_lens_free(&L);
+}
+
+static void test_tir_grazing_stop(void)
+{
+    /* n = 1.8 meniscus with a near-flat rear: a ray from the film parallel to
+     * the axis meets the front surface (R = 10) at sin(i) = h / 10 and is
+     * totally reflected when 1.8 h / 10 > 1. */
+    lf_lens L;
+    if (parse("10 4 1.8 19\n-1e6 20 1 19\n", &L))
+        return;
+    L.film_distance_mm = 20;
+    lf_lens_ray out;
+    lf_lens_ray in = {{0, 7, 0}, {0, 0, -1}}; /* 1.8 * 0.7 = 1.26 > 1 */
+    CHECK(lf_lens_trace_from_film(&L, &in, &out, NULL) == LF_LENS_TIR);
+    in.o[1] = 3; /* 1.8 * 0.3 = 0.54 */
+    CHECK(lf_lens_trace_from_film(&L, &in, &out, NULL) == LF_LENS_PASSED);
+    /* Grazing incidence on a full hemisphere (R = 10, clear diameter 20):
+     * rays tangent to the sphere and just inside it never give NaN. */
+    lf_lens G;
+    if (parse("10 10 1.5 20\n-10 30 1 20\n", &G))
+        return;
+    G.film_distance_mm = 30;
+    double zfront = G.s[0].z_mm - G.film_distance_mm;
+    int finite = 1, n_pass = 0;
+    for (int k = 0; k <= 200; k++) {
+        double h = 10.0 - 1e-3 * k * k / 40000.0 * 10; /* 10 down to 9.999 */
+        if (k == 200)
+            h = 10.0; /* exactly tangent */
+        lf_lens_ray g = {{0, h, zfront - 20}, {0, 0, 1}};
+        lf_lens_status st = lf_lens_trace_from_scene(&G, &g, &out, NULL);
+        if (st == LF_LENS_PASSED) {
+            n_pass++;
+            for (int c = 0; c < 3; c++)
+                finite &= isfinite(out.o[c]) && isfinite(out.d[c]);
+        }
+    }
+    CHECK(finite);
+    /* Camera weights for a sweep of directions, including grazing ones. */
+    lf_lens_pupil P;
+    CHECK(lf_lens_pupil_build(&G, 20.0, 0, &P) > 0);
+    int ok = 1;
+    for (int i = 0; i < 2000; i++) {
+        double u = (i % 50 + 0.5) / 50, v = (i / 50 + 0.5) / 40;
+        double w1 = lf_lens_sample_ray(&G, &P, 1, 19.9 * u - 9.95, 0.3, u, v, NULL, &out);
+        double w2 = lf_lens_sample_ray(&G, &P, 0, 19.9 * v - 9.95, 19.9 * u - 9.95, u, v, NULL, &out);
+        ok &= isfinite(w1) && w1 >= 0 && isfinite(w2) && w2 >= 0;
+    }
+    CHECK(ok);
+    /* The stop blocks what falls outside it. */
+    lf_lens S;
+    if (parse("50 5 1.5 30\n0 5 1 10\n-50 40 1 30\n", &S))
+        return;
+    S.film_distance_mm = 40;
+    lf_lens_ray s_in = {{0, 8, -100}, {0, 0, 1}};
+    CHECK(lf_lens_trace_from_scene(&S, &s_in, &out, NULL) == LF_LENS_STOPPED);
+    s_in.o[1] = 2;
+    CHECK(lf_lens_trace_from_scene(&S, &s_in, &out, NULL) == LF_LENS_PASSED);
+    lf_lens_free(&L);
+    lf_lens_free(&G);
+    lf_lens_free(&S);
+}
+
+static void test_parse_errors(void)
+{
+    static const struct {
+        const char *text, *want;
+    } bad[] = {
+        {"# c\n50 5 1.5 20\n-50 40 1\n", "test.dat:3: expected 4 or 5 columns (radius thickness ior aperture [abbe]), got 3"},
+        {"50 5 1.5 20\n-50 40 1 20 0 7\n", "test.dat:2: expected 4 or 5 columns"},
+        {"50 5 1.5x 20\n-50 40 1 20\n", "test.dat:1: ior \"1.5x\" is not a number"},
+        {"50 5 1.5 120\n-50 40 1 20\n", "test.dat:1: aperture diameter 120 exceeds"},
+        {"50 5 1.5 20\n0 1 0 10\n0 1 0 10\n-50 40 1 20\n", "test.dat:3: a second aperture stop"},
+        {"50 -5 1.5 20\n-50 40 1 20\n", "test.dat:1: thickness"},
+        {"50 5 0.5 20\n-50 40 1 20\n", "test.dat:1: ior 0.5"},
+        {"# nothing\n\n", "no lens surfaces"},
+        {"50 5 1.5 20\n-50 40 1.5 20\n", "test.dat:2: the last surface must leave into air"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        lf_lens L;
+        char err[512] = "";
+        CHECK(lf_lens_parse(bad[i].text, "test.dat", &L, err, sizeof err) != 0);
+        CHECK_MSG(strstr(err, bad[i].want) != NULL, "got \"%s\", want \"%s\"", err, bad[i].want);
+    }
+    lf_lens L;
+    char err[512] = "";
+    CHECK(lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/no-such.dat", &L, err, sizeof err) != 0);
+    CHECK(strstr(err, "no-such.dat") != NULL);
+}
+
+static void test_focus(void)
+{
+    lf_lens L;
+    if (load("dgauss.50mm.dat", &L))
+        return;
+    lf_lens_paraxial px;
+    lf_lens_paraxial_analyse(&L, &px);
+    /* Independent: the paraxial image of an axial point at D from the film
+     * (matrix B element of T(v) M T(u) vanishes, u + L + v = D), by bisection. */
+    m2 m = system_matrix(&L, 0, L.n - 1);
+    double len = lf_lens_total_length_mm(&L);
+    const double Ds[3] = {500, 2000, 10000};
+    for (int k = 0; k < 3; k++) {
+        double lo = px.bfl_mm, hi = px.bfl_mm + 60;
+#define B_OF(v) mul((m2){1, (v), 0, 1}, mul(m, (m2){1, Ds[k] - len - (v), 0, 1})).b
+        double b_lo = B_OF(lo);
+        CHECK(b_lo * B_OF(hi) < 0); /* the image lies in the bracket */
+        for (int it = 0; it < 200; it++) {
+            double v = 0.5 * (lo + hi);
+            if ((B_OF(v) > 0) == (b_lo > 0))
+                lo = v;
+            else
+                hi = v;
+        }
+#undef B_OF
+        double v_ref = 0.5 * (lo + hi), v;
+        char err[256];
+        CHECK(lf_lens_focus_thick(&L, Ds[k], &v, err, sizeof err) == 0);
+        CHECK_NEAR(v, v_ref, 1e-6);
+        CHECK_NEAR(lf_lens_paraxial_focus_distance(&L, &px, v_ref), Ds[k], 1e-6 * Ds[k]);
+        /* Stopped down to 2 mm (f/25), real rays focus where paraxial ones do,
+         * to 20 um: a tenth of the depth of focus +-N c (c = 0.03 mm). */
+        lf_lens S = L;
+        lf_lens_surface surf[32];
+        memcpy(surf, L.s, sizeof(lf_lens_surface) * L.n);
+        S.s = surf;
+        lf_lens_set_stop_diameter(&S, 2.0, NULL, 0);
+        double v_search;
+        CHECK(lf_lens_focus_search(&S, Ds[k], &v_search, err, sizeof err) == 0);
+        CHECK_NEAR(v_search, v_ref, 0.02);
+    }
+    /* Closer than possible: a clear error, the film distance untouched. */
+    double v = -1;
+    char err[512] = "";
+    CHECK(lf_lens_focus_thick(&L, 100.0, &v, err, sizeof err) != 0);
+    CHECK(v == -1);
+    CHECK_MSG(strstr(err, "closer than") != NULL, "%s", err);
+    /* ... and the closest possible (unit magnification) is 4f + hiatus. */
+    CHECK(lf_lens_focus_thick(&L, lf_lens_closest_focus_mm(&px) * 1.0001, &v, err, sizeof err) == 0);
+    CHECK_NEAR(v, px.rear_principal_mm + 2 * px.efl_mm, 0.02 * px.efl_mm);
+    /* Aperture larger than the stop: clamped with a warning. */
+    char warn[512] = "";
+    CHECK(lf_lens_set_stop_diameter(&L, 40.0, warn, sizeof warn) == 1);
+    CHECK_NEAR(L.s[L.stop].aperture_radius_mm, 17.1 / 2, 1e-12);
+    CHECK(strstr(warn, "clamping") != NULL);
+    lf_lens_free(&L);
+}
+
+/* Deterministic uniform numbers. */
+static double rnd(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void test_pupil_unbiased(void)
+{
+    static const char *const files[] = {"dgauss.50mm.dat", "wide.22mm.dat", "telephoto.250mm.dat",
+                                        "fisheye.10mm.dat", "dgauss.100mm.dat"};
+    const double film_w = 36, film_h = 24, film_r = 0.5 * hypot(36, 24);
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+        lf_lens L;
+        if (load(files[k], &L))
+            continue;
+        lf_lens_set_stop_diameter(&L, 1e3, NULL, 0); /* wide open: the hardest bounds */
+        char err[256];
+        CHECK(lf_lens_focus_thick(&L, 10000.0, &L.film_distance_mm, err, sizeof err) == 0);
+        lf_lens_pupil P;
+        CHECK(lf_lens_pupil_build(&L, film_r, 0, &P) > 0);
+        uint64_t seed = 1234 + k;
+        /* (1) Useful-ray fraction over the film, among film points that get light. */
+        long traced = 0, passed = 0;
+        for (int i = 0; i < 40000; i++) {
+            double fx = (rnd(&seed) - 0.5) * film_w, fy = (rnd(&seed) - 0.5) * film_h;
+            double u = rnd(&seed), v = rnd(&seed), rx, ry;
+            if (!(lf_lens_pupil_sample(&P, fx, fy, u, v, &rx, &ry) > 0))
+                continue;
+            traced++;
+            lf_lens_ray out;
+            passed += lf_lens_sample_ray(&L, &P, 1, fx, fy, u, v, NULL, &out) > 0;
+        }
+        double frac = traced ? (double)passed / traced : 0;
+        CHECK_MSG(frac >= 0.70, "%s: useful-ray fraction %.3f < 0.70", files[k], frac);
+        /* (2) Conservative bounds: every ray that gets through from the whole
+         * rear disk starts inside the bound (no light is lost). */
+        long outside = 0, through = 0;
+        for (int i = 0; i < 300000; i++) {
+            double fx = (rnd(&seed) - 0.5) * film_w, fy = (rnd(&seed) - 0.5) * film_h;
+            double a = 2 * M_PI * rnd(&seed), r = P.rear_disk_radius_mm * sqrt(rnd(&seed));
+            double rx = r * cos(a), ry = r * sin(a);
+            lf_lens_ray in = {{fx, fy, 0}, {rx - fx, ry - fy, -L.film_distance_mm}};
+            if (lf_lens_trace_from_film(&L, &in, NULL, NULL) != LF_LENS_PASSED)
+                continue;
+            through++;
+            outside += !lf_lens_pupil_contains(&P, fx, fy, rx, ry);
+        }
+        CHECK_MSG(through > 1000, "%s: only %ld rays got through", files[k], through);
+        CHECK_MSG(outside == 0, "%s: %ld of %ld passing rays outside the pupil bound", files[k], outside, through);
+        /* (3) Mean weight at fixed film points: bounds vs rear-disk sampling,
+         * equal within 4 combined standard errors (estimated from the samples). */
+        const double fr[2] = {0.0, 0.8};
+        for (int j = 0; j < 2; j++) {
+            double fx = fr[j] * film_r * 0.8, fy = fr[j] * film_r * 0.6;
+            double m[2], se[2];
+            for (int mode = 0; mode < 2; mode++) {
+                long n = mode ? 1000000 : 50000;
+                double s1 = 0, s2 = 0;
+                for (long i = 0; i < n; i++) {
+                    lf_lens_ray out;
+                    double w = lf_lens_sample_ray(&L, &P, !mode, fx, fy, rnd(&seed), rnd(&seed), NULL, &out);
+                    s1 += w, s2 += w * w;
+                }
+                m[mode] = s1 / n;
+                se[mode] = sqrt(fmax(s2 / n - m[mode] * m[mode], 0) / n);
+            }
+            double tol = 4 * sqrt(se[0] * se[0] + se[1] * se[1]);
+            CHECK_MSG(fabs(m[0] - m[1]) <= tol, "%s film (%g,%g): bounds %.6g vs rear disk %.6g (tol %.3g)", files[k],
+                      fx, fy, m[0], m[1], tol);
+            if (m[1] > 0)
+                CHECK_MSG(tol < 0.08 * m[1], "%s: the comparison is too noisy (tol %.3g of %.3g)", files[k], tol, m[1]);
+        }
+        lf_lens_free(&L);
+    }
+}
+
+static void test_dispersion(void)
+{
+    /* Cauchy fit: n(d) = n_d and (n_d - 1) / (n_F - n_C) = V_d. */
+    lf_lens L;
+    if (parse("60 5 1.6 30 40\n-200 95 1 30\n", &L))
+        return;
+    L.dispersive = 1;
+    CHECK_NEAR(lf_lens_ior(&L, 0, LF_LENS_LAMBDA_D), 1.6, 1e-12);
+    double nF = lf_lens_ior(&L, 0, LF_LENS_LAMBDA_F), nC = lf_lens_ior(&L, 0, LF_LENS_LAMBDA_C);
+    CHECK_NEAR(0.6 / (nF - nC), 40.0, 1e-9);
+    CHECK(lf_lens_ior(&L, 0, 400) > lf_lens_ior(&L, 0, 700)); /* normal dispersion */
+    CHECK(lf_lens_ior(&L, 1, 400) == 1.0);
+    /* Longitudinal colour of the singlet: the paraxial focus at each
+     * wavelength follows the lensmaker's equation with n(lambda). */
+    const double R1 = 60, R2 = -200, d = 5;
+    lf_lens_paraxial px;
+    lf_lens_paraxial_analyse(&L, &px);
+    L.film_distance_mm = px.bfl_mm;
+    const double lams[3] = {LF_LENS_LAMBDA_F, LF_LENS_LAMBDA_D, LF_LENS_LAMBDA_C};
+    for (int k = 0; k < 3; k++) {
+        double n = lf_lens_ior(&L, 0, lams[k]);
+        double f = 1.0 / ((n - 1) * (1 / R1 - 1 / R2 + (n - 1) * d / (n * R1 * R2)));
+        double bfl = f * (1 - (n - 1) * d / (n * R1));
+        lf_lens_trace_opts o = {0};
+        o.lambda_nm = lams[k];
+        lf_lens_ray in = {{0, 1e-3, -200}, {0, 0, 1}}, out;
+        CHECK(lf_lens_trace_from_scene(&L, &in, &out, &o) == LF_LENS_PASSED);
+        double t = -out.o[1] / out.d[1];
+        double z = out.o[2] + t * out.d[2] + L.film_distance_mm; /* from the rear vertex */
+        CHECK_NEAR(z, bfl, 1e-4);
+    }
+    /* Without dispersion every wavelength sees n_d. */
+    L.dispersive = 0;
+    CHECK(lf_lens_ior(&L, 0, 400) == 1.6);
+    lf_lens_free(&L);
+}
+
+/* ---- the camera through the registry ---- */
+typedef struct store {
+    const char *lensfile;
+    double aperture, focus;
+    int dispersion;
+} store;
+static double g_float(void *c, const char *name, double def)
+{
+    store *s = c;
+    if (!strcmp(name, "aperturediameter") && s->aperture > 0)
+        return s->aperture;
+    if (!strcmp(name, "focusdistance") && s->focus > 0)
+        return s->focus;
+    return def;
+}
+static int g_int(void *c, const char *name, int def)
+{
+    (void)c, (void)name;
+    return def;
+}
+static int g_bool(void *c, const char *name, int def)
+{
+    store *s = c;
+    return !strcmp(name, "dispersion") ? s->dispersion : def;
+}
+static const char *g_string(void *c, const char *name, const char *def)
+{
+    store *s = c;
+    return !strcmp(name, "lensfile") && s->lensfile ? s->lensfile : def;
+}
+static int g_floats(void *c, const char *name, double *out, int max)
+{
+    (void)c, (void)name, (void)out, (void)max;
+    return 0;
+}
+static int g_image(void *c, const char *path, int *w, int *h, float **px, char *err, size_t n)
+{
+    (void)c, (void)w, (void)h, (void)px;
+    snprintf(err, n, "no images here (%s)", path);
+    return -1;
+}
+
+static void *make(store *s, int w, int h, char *err, char *warn)
+{
+    lf_camera_params p = {s, g_float, g_int, g_bool, g_string, g_floats, g_image};
+    lf_camera_create_args a = {sizeof a, &p, w, h, 35.0, 0.0, 1.0, LF_SOURCE_DIR "/scenes", err, 512, warn, 512};
+    void *state = NULL;
+    const lf_camera_type *t = lf_camera_find("realistic");
+    if (!t || t->create(&a, &state))
+        return NULL;
+    return state;
+}
+
+static void test_camera(void)
+{
+    const lf_camera_type *t = lf_camera_find("realistic");
+    CHECK(t != NULL);
+    if (!t)
+        return;
+    char err[512] = "", warn[512] = "";
+    store s = {"lenses/dgauss.50mm.dat", 8.0, 3.0, 0};
+    void *c = make(&s, 90, 60, err, warn);
+    CHECK_MSG(c != NULL, "%s", err);
+    if (c) {
+        CHECK(t->needs(c) == LF_CAMERA_NEEDS_LENS);
+        int ok = 1, through = 0;
+        double sum_x_left = 0, sum_y_top = 0;
+        for (int i = 0; i < 20000; i++) {
+            lf_camera_sample cs = {(i % 100 + 0.5) * 0.9, (i / 100 % 200 + 0.5) * 0.3, (i * 0.618034) - floor(i * 0.618034),
+                                   (i * 0.754878) - floor(i * 0.754878), 0, 0.5};
+            lf_camera_ray r = {{0}, {0}, 0, 0};
+            double w = t->generate_ray(c, &cs, &r);
+            ok &= isfinite(w) && w >= 0 && r.wavelength_nm == 0;
+            if (w > 0) {
+                through++;
+                double l = sqrt(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]);
+                ok &= fabs(l - 1) < 1e-9 && r.dir[2] > 0 && r.origin[2] > 0.03 && r.origin[2] < 0.08;
+                if (cs.film_x < 20)
+                    sum_x_left += r.dir[0];
+                if (cs.film_y < 15)
+                    sum_y_top += r.dir[1];
+            }
+        }
+        CHECK(ok);
+        CHECK(through > 10000);
+        /* pbrt's orientation: the left of the image looks left (-x), the top looks up (+y). */
+        CHECK(sum_x_left < 0);
+        CHECK(sum_y_top > 0);
+        char desc[4096];
+        CHECK(t->describe(c, desc, sizeof desc) > 0);
+        CHECK(strstr(desc, "effective focal length: 50.36") != NULL);
+        t->destroy(c);
+    }
+    /* Dispersion: needs wavelength, sets it as the ABI says. */
+    store sd = {"lenses/dgauss.100mm.dat", 30.0, 5.0, 1};
+    c = make(&sd, 30, 20, err, warn);
+    CHECK_MSG(c != NULL, "%s", err);
+    if (c) {
+        CHECK(t->needs(c) == (LF_CAMERA_NEEDS_LENS | LF_CAMERA_NEEDS_WAVELENGTH));
+        lf_camera_sample cs = {15, 10, 0.5, 0.5, 0, 0.25};
+        lf_camera_ray r = {{0}, {0}, 0, 0};
+        t->generate_ray(c, &cs, &r);
+        CHECK_NEAR(r.wavelength_nm, 360.0 + 0.25 * (830.0 - 360.0), 1e-9);
+        t->destroy(c);
+    }
+    /* Hard cases through the camera. */
+    store none = {NULL, 0, 0, 0};
+    CHECK(make(&none, 30, 20, err, warn) == NULL);
+    CHECK(strstr(err, "lensfile") != NULL);
+    store too_close = {"lenses/dgauss.50mm.dat", 8.0, 0.1, 0};
+    CHECK(make(&too_close, 30, 20, err, warn) == NULL);
+    CHECK_MSG(strstr(err, "closer than") != NULL, "%s", err);
+    warn[0] = 0;
+    store big = {"lenses/wide.22mm.dat", 100.0, 3.0, 0};
+    c = make(&big, 30, 20, err, warn);
+    CHECK(c != NULL);
+    CHECK_MSG(strstr(warn, "clamping") != NULL, "warning: %s", warn);
+    if (c)
+        t->destroy(c);
+    /* A lens that admits no light: the rear element sits outside the beam
+     * of the front one (a 1 um stop). */
+    char tmpl[] = "/tmp/lf_lens_XXXXXX";
+    int fd = mkstemp(tmpl);
+    CHECK(fd >= 0);
+    if (fd >= 0) {
+        const char *text = "50 5 1.5 30\n0 5 0 1e-6\n-50 40 1 30\n";
+        CHECK(write(fd, text, strlen(text)) == (ssize_t)strlen(text));
+        close(fd);
+        store dark = {tmpl, 1e-6, 3.0, 0};
+        CHECK(make(&dark, 30, 20, err, warn) == NULL);
+        CHECK_MSG(strstr(err, "admits no light") != NULL, "%s", err);
+        /* A typo in a file: file:line in the camera's message. */
+        FILE *f = fopen(tmpl, "w");
+        fputs("# test\n50 5 1.5 30\n0 5 0 10\n-50 40 1\n", f);
+        fclose(f);
+        store typo = {tmpl, 5, 3.0, 0};
+        CHECK(make(&typo, 30, 20, err, warn) == NULL);
+        char want[128];
+        snprintf(want, sizeof want, "%s:4: expected 4 or 5 columns", tmpl);
+        CHECK_MSG(strstr(err, want) != NULL, "%s", err);
+        unlink(tmpl);
+    }
+}
+
+static void test_sensors(void)
+{
+    double w, h;
+    CHECK(lf_lens_sensor_size("fullframe", &w, &h) == 0 && w == 36 && h == 24);
+    CHECK(lf_lens_sensor_size("1/2.3in", &w, &h) == 0 && w == 6.16 && h == 4.62);
+    CHECK(lf_lens_sensor_size("nope", &w, &h) != 0);
+}
+
+int main(void)
+{
+    test_shipped_efl();
+    test_singlet();
+    test_snell();
+    test_tir_grazing_stop();
+    test_parse_errors();
+    test_focus();
+    test_pupil_unbiased();
+    test_dispersion();
+    test_camera();
+    test_sensors();
+    return lf_test_end();
+}

@@ -109,6 +109,22 @@ lf_vec3 lf_xform_vector(const lf_transform *t, lf_vec3 v);
 /* Normals transform by the inverse transpose. */
 lf_vec3 lf_xform_normal(const lf_transform *t, lf_vec3 n);
 
+/* A transform split into translation, rotation (unit quaternion x y z w) and
+ * a remaining stretch matrix, M = T R S, by polar decomposition (Shoemake &
+ * Duff 1992, as pbrt's AnimatedTransform), so motion between two keyframes
+ * can rotate rigidly instead of shearing through a matrix lerp. */
+typedef struct lf_decomposed {
+    double t[3];
+    double q[4];
+    double s[3][3];
+} lf_decomposed;
+
+/* Returns 0, or -1 if the linear part is singular (a degenerate keyframe). */
+int lf_transform_decompose(const lf_transform *m, lf_decomposed *out);
+/* Interpolates at f in [0,1]: lerp translation, slerp rotation (shortest
+ * arc), lerp stretch. */
+lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f);
+
 #ifdef __cplusplus
 }
 #endif

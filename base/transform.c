@@ -233,3 +233,150 @@ lf_vec3 lf_xform_normal(const lf_transform *t, lf_vec3 n)
                  (float)(mi[0][1] * n.x + mi[1][1] * n.y + mi[2][1] * n.z),
                  (float)(mi[0][2] * n.x + mi[1][2] * n.y + mi[2][2] * n.z));
 }
+
+static double det3(const double m[3][3])
+{
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+static void inv3(const double m[3][3], double out[3][3], double det)
+{
+    out[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
+    out[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
+    out[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
+    out[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
+    out[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
+    out[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
+    out[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
+    out[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
+    out[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
+}
+
+/* Rotation matrix -> unit quaternion (Shepperd's method, stable branch). */
+static void quat_from_matrix(const double r[3][3], double q[4])
+{
+    double tr = r[0][0] + r[1][1] + r[2][2];
+    if (tr > 0) {
+        double s = sqrt(tr + 1.0) * 2;
+        q[3] = 0.25 * s;
+        q[0] = (r[2][1] - r[1][2]) / s;
+        q[1] = (r[0][2] - r[2][0]) / s;
+        q[2] = (r[1][0] - r[0][1]) / s;
+    } else if (r[0][0] > r[1][1] && r[0][0] > r[2][2]) {
+        double s = sqrt(1.0 + r[0][0] - r[1][1] - r[2][2]) * 2;
+        q[3] = (r[2][1] - r[1][2]) / s;
+        q[0] = 0.25 * s;
+        q[1] = (r[0][1] + r[1][0]) / s;
+        q[2] = (r[0][2] + r[2][0]) / s;
+    } else if (r[1][1] > r[2][2]) {
+        double s = sqrt(1.0 + r[1][1] - r[0][0] - r[2][2]) * 2;
+        q[3] = (r[0][2] - r[2][0]) / s;
+        q[0] = (r[0][1] + r[1][0]) / s;
+        q[1] = 0.25 * s;
+        q[2] = (r[1][2] + r[2][1]) / s;
+    } else {
+        double s = sqrt(1.0 + r[2][2] - r[0][0] - r[1][1]) * 2;
+        q[3] = (r[1][0] - r[0][1]) / s;
+        q[0] = (r[0][2] + r[2][0]) / s;
+        q[1] = (r[1][2] + r[2][1]) / s;
+        q[2] = 0.25 * s;
+    }
+    double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; i++)
+        q[i] /= l;
+}
+
+static void matrix_from_quat(const double q[4], double r[3][3])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    r[0][0] = 1 - 2 * (y * y + z * z), r[0][1] = 2 * (x * y - z * w), r[0][2] = 2 * (x * z + y * w);
+    r[1][0] = 2 * (x * y + z * w), r[1][1] = 1 - 2 * (x * x + z * z), r[1][2] = 2 * (y * z - x * w);
+    r[2][0] = 2 * (x * z - y * w), r[2][1] = 2 * (y * z + x * w), r[2][2] = 1 - 2 * (x * x + y * y);
+}
+
+int lf_transform_decompose(const lf_transform *m, lf_decomposed *out)
+{
+    double M[3][3], R[3][3];
+    for (int i = 0; i < 3; i++) {
+        out->t[i] = m->m[i][3];
+        for (int j = 0; j < 3; j++)
+            M[i][j] = R[i][j] = m->m[i][j];
+    }
+    double det = det3(M);
+    if (!(fabs(det) > 1e-300) || !isfinite(det))
+        return -1;
+    /* Polar decomposition: R <- (R + R^-T) / 2 converges to the rotation
+     * (a reflection when det < 0: pbrt handles that the same way). */
+    for (int it = 0; it < 100; it++) {
+        double Ri[3][3], d = det3(R);
+        if (!(fabs(d) > 1e-300))
+            return -1;
+        inv3(R, Ri, d);
+        double norm = 0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double next = 0.5 * (R[i][j] + Ri[j][i]);
+                norm = fmax(norm, fabs(next - R[i][j]));
+                R[i][j] = next;
+            }
+        if (norm < 1e-14)
+            break;
+    }
+    int reflect = det3(R) < 0;
+    double Rr[3][3];
+    memcpy(Rr, R, sizeof Rr);
+    if (reflect) /* keep a proper rotation for the quaternion; the reflection goes into S */
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                Rr[i][j] = -R[i][j];
+    quat_from_matrix(Rr, out->q);
+    /* S = R^-1 M = R^T M (with the reflection folded in) */
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double s = 0;
+            for (int k = 0; k < 3; k++)
+                s += Rr[k][i] * M[k][j];
+            out->s[i][j] = s;
+        }
+    return 0;
+}
+
+lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f)
+{
+    double q[4], qb[4] = {b->q[0], b->q[1], b->q[2], b->q[3]};
+    double dot = a->q[0] * qb[0] + a->q[1] * qb[1] + a->q[2] * qb[2] + a->q[3] * qb[3];
+    if (dot < 0) { /* shortest arc */
+        for (int i = 0; i < 4; i++)
+            qb[i] = -qb[i];
+        dot = -dot;
+    }
+    if (dot > 0.9995) {
+        for (int i = 0; i < 4; i++)
+            q[i] = (1 - f) * a->q[i] + f * qb[i];
+    } else {
+        double th = acos(dot < 1 ? dot : 1), s = sin(th);
+        double wa = sin((1 - f) * th) / s, wb = sin(f * th) / s;
+        for (int i = 0; i < 4; i++)
+            q[i] = wa * a->q[i] + wb * qb[i];
+    }
+    double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; i++)
+        q[i] /= l;
+    double R[3][3], m[4][4] = {{0}};
+    matrix_from_quat(q, R);
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            double s = 0;
+            for (int k = 0; k < 3; k++)
+                s += R[i][k] * ((1 - f) * a->s[k][j] + f * b->s[k][j]);
+            m[i][j] = s;
+        }
+        m[i][3] = (1 - f) * a->t[i] + f * b->t[i];
+    }
+    m[3][3] = 1;
+    lf_transform t;
+    if (lf_transform_from_matrix(m, &t))
+        t = lf_transform_identity();
+    return t;
+}

@@ -38,7 +38,7 @@ static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *
         return lf_v3(0, 0, 0);
     const lf_light *l = &s->lights[li];
     lf_light_sample ls;
-    if (!lf_light_sample_li(s, l, h->sc.p, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
+    if (!lf_light_sample_li(s, l, h->sc.p, h->tau, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
         return lf_v3(0, 0, 0);
     lf_vec3 f = lf_bsdf_f(bsdf, wo, ls.wi);
     float cosi = lf_absdot(ls.wi, h->sc.ns);
@@ -47,7 +47,7 @@ static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *
     lf_vec3 o = lf_offset_origin(h->sc.p, h->sc.ng, ls.wi);
     float tmax = isinf(ls.dist) ? INFINITY : ls.dist * (1.f - 1e-4f);
     (*rays)++;
-    if (lf_scene_occluded(s, o, ls.wi, tmax))
+    if (lf_scene_occluded(s, o, ls.wi, tmax, h->tau))
         return lf_v3(0, 0, 0);
     float p_l = (float)pmf * ls.pdf;
     float w = 1.f;
@@ -56,7 +56,7 @@ static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *
     return lf_scale(lf_mul(f, ls.Li), cosi * w / p_l);
 }
 
-lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, lf_sample_stream *st,
+lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
                    long long *rays)
 {
     lf_vec3 L = lf_v3(0, 0, 0), beta = lf_v3(1, 1, 1);
@@ -67,7 +67,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
     for (;;) {
         lf_hit h;
         (*rays)++;
-        if (!lf_scene_intersect(s, o, d, INFINITY, &h)) {
+        if (!lf_scene_intersect(s, o, d, INFINITY, tau, &h)) {
             for (int k = 0; k < s->n_infinite; k++) {
                 const lf_light *l = &s->lights[s->infinite_lights[k]];
                 lf_vec3 Le = lf_light_infinite_le(l, d);

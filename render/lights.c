@@ -145,7 +145,8 @@ static float smoothstep(float x, float a, float b)
     return t * t * (3 - 2 * t);
 }
 
-int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0, float u1, lf_light_sample *ls)
+int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float tau, float u0, float u1,
+                       lf_light_sample *ls)
 {
     ls->delta = 0;
     switch (l->kind) {
@@ -197,7 +198,8 @@ int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0
     case LF_LIGHT_TRIANGLE: {
         const lf_mesh *m = &s->meshes[l->mesh];
         int t = l->prim;
-        const float *a = m->P + 3 * m->idx[3 * t], *b = m->P + 3 * m->idx[3 * t + 1], *c = m->P + 3 * m->idx[3 * t + 2];
+        lf_vec3 pa = lf_mesh_vertex_at(m, m->idx[3 * t], tau), pb = lf_mesh_vertex_at(m, m->idx[3 * t + 1], tau),
+                pc = lf_mesh_vertex_at(m, m->idx[3 * t + 2], tau);
         /* uniform barycentrics (Heitz's low-distortion square-to-triangle) */
         float b0, b1;
         if (u0 < u1) {
@@ -208,14 +210,12 @@ int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0
             b0 = u0 - b1;
         }
         float b2 = 1 - b0 - b1;
-        lf_vec3 pa = lf_v3(a[0], a[1], a[2]), pb = lf_v3(b[0], b[1], b[2]), pc = lf_v3(c[0], c[1], c[2]);
         lf_vec3 q = lf_add(lf_add(lf_scale(pa, b0), lf_scale(pb, b1)), lf_scale(pc, b2));
         lf_vec3 n = lf_normalize(lf_cross(lf_sub(pa, pc), lf_sub(pb, pc)));
         if (m->N) {
-            const float *na = m->N + 3 * m->idx[3 * t], *nb = m->N + 3 * m->idx[3 * t + 1],
-                        *nc = m->N + 3 * m->idx[3 * t + 2];
-            lf_vec3 ns = lf_v3(b0 * na[0] + b1 * nb[0] + b2 * nc[0], b0 * na[1] + b1 * nb[1] + b2 * nc[1],
-                               b0 * na[2] + b1 * nb[2] + b2 * nc[2]);
+            lf_vec3 na = lf_mesh_normal_at(m, m->idx[3 * t], tau), nb = lf_mesh_normal_at(m, m->idx[3 * t + 1], tau),
+                    nc = lf_mesh_normal_at(m, m->idx[3 * t + 2], tau);
+            lf_vec3 ns = lf_add(lf_add(lf_scale(na, b0), lf_scale(nb, b1)), lf_scale(nc, b2));
             if (lf_dot(n, ns) < 0)
                 n = lf_neg(n);
         } else if (m->flip_normal) {
@@ -239,7 +239,7 @@ int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0
     }
     case LF_LIGHT_SPHERE: {
         const lf_sphere *sp = &s->spheres[l->sphere];
-        lf_vec3 dc = lf_sub(sp->center, p);
+        lf_vec3 dc = lf_sub(lf_sphere_center_at(sp, tau), p);
         float dc2 = lf_dot(dc, dc), r = sp->radius;
         if (dc2 <= r * r * 1.0001f)
             return 0; /* inside or on the sphere: light sampling skipped, BSDF sampling still finds it */
@@ -290,7 +290,7 @@ float lf_light_pdf_li(const lf_scene *s, const lf_light *l, lf_vec3 p, lf_vec3 w
     }
     case LF_LIGHT_SPHERE: {
         const lf_sphere *sp = &s->spheres[l->sphere];
-        lf_vec3 dc = lf_sub(sp->center, p);
+        lf_vec3 dc = lf_sub(lf_sphere_center_at(sp, hit->tau), p);
         float dc2 = lf_dot(dc, dc), r = sp->radius;
         if (dc2 <= r * r * 1.0001f)
             return 0;

@@ -17,9 +17,10 @@
  * and spheres that Embree's sphere primitive cannot represent). */
 typedef struct lf_mesh {
     int n_tris, n_verts;
+    int n_keys;    /* keyframes of its motion (1: static), evenly spaced in Embree time 0..1 */
     int *idx;      /* 3 per triangle */
-    float *P;      /* world space, 3 per vertex */
-    float *N;      /* world space shading normals, or NULL */
+    float *P;      /* world space, 3 per vertex, n_keys blocks of 3 * n_verts */
+    float *N;      /* world space shading normals (same layout), or NULL */
     float *uv;     /* 2 per vertex, or NULL (pbrt defaults per triangle) */
     int material;
     int light_first;   /* index of the first triangle's light, -1 if not emissive */
@@ -27,13 +28,60 @@ typedef struct lf_mesh {
 } lf_mesh;
 
 typedef struct lf_sphere {
-    lf_vec3 center;
+    lf_vec3 center;     /* at the first keyframe */
     float radius;
+    int n_keys;         /* 1: static */
+    lf_vec3 *centers;   /* n_keys centres when moving, else NULL */
     lf_transform object_to_world; /* for pbrt's (u,v) parameterisation */
     int material;
     int light;         /* -1 if not emissive */
     int flip_normal;
 } lf_sphere;
+
+/* Keyframe segment and blend for Embree time tau in [0,1] over n keys. */
+static inline int lf_key_segment(int n_keys, float tau, float *frac)
+{
+    float x = tau * (float)(n_keys - 1);
+    int k = (int)x;
+    if (k >= n_keys - 1)
+        k = n_keys - 2;
+    if (k < 0)
+        k = 0;
+    *frac = x - (float)k;
+    return k;
+}
+
+static inline lf_vec3 lf_sphere_center_at(const lf_sphere *sp, float tau)
+{
+    if (sp->n_keys <= 1)
+        return sp->center;
+    float f;
+    int k = lf_key_segment(sp->n_keys, tau, &f);
+    return lf_add(lf_scale(sp->centers[k], 1.f - f), lf_scale(sp->centers[k + 1], f));
+}
+
+/* Vertex i of a mesh at Embree time tau (linear between keyframes, as Embree). */
+static inline lf_vec3 lf_mesh_vertex_at(const lf_mesh *m, int i, float tau)
+{
+    const float *p = m->P + 3 * (size_t)i;
+    if (m->n_keys <= 1)
+        return lf_v3(p[0], p[1], p[2]);
+    float f;
+    int k = lf_key_segment(m->n_keys, tau, &f);
+    const float *a = p + (size_t)k * 3 * m->n_verts, *b = a + (size_t)3 * m->n_verts;
+    return lf_v3(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]));
+}
+
+static inline lf_vec3 lf_mesh_normal_at(const lf_mesh *m, int i, float tau)
+{
+    const float *p = m->N + 3 * (size_t)i;
+    if (m->n_keys <= 1)
+        return lf_v3(p[0], p[1], p[2]);
+    float f;
+    int k = lf_key_segment(m->n_keys, tau, &f);
+    const float *a = p + (size_t)k * 3 * m->n_verts, *b = a + (size_t)3 * m->n_verts;
+    return lf_v3(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]));
+}
 
 typedef enum lf_light_kind {
     LF_LIGHT_POINT,
@@ -73,9 +121,12 @@ typedef struct lf_scene {
     int n_meshes;
     lf_sphere *spheres;
     int n_spheres;
-    unsigned sphere_geom_id; /* RTC_INVALID_GEOMETRY_ID if none */
-    unsigned *geom_mesh;     /* geomID -> mesh index (or -1) */
+    unsigned sphere_geom_id; /* the static spheres' geometry; RTC_INVALID_GEOMETRY_ID if none */
+    int *geom_index;         /* geomID -> mesh index (>= 0) or -1 - sphere index (moving sphere) */
     int n_geom;
+    int moving_shapes;       /* meshes or spheres with more than one keyframe */
+    int max_keys;
+    double time0, time1;     /* TransformTimes: scene time of Embree time 0 and 1 */
     lf_light *lights;
     int n_lights;
     int *infinite_lights;    /* indices of infinite lights */
@@ -107,6 +158,7 @@ typedef struct lf_hit {
     int material;
     int light;         /* -1 if not emissive */
     int sphere;        /* analytic sphere index, or -1; its uv is filled by lf_scene_sphere_uv */
+    float tau;         /* Embree time of the ray that found it */
 } lf_hit;
 
 /* ---- lights (render/lights.c) ---- */
@@ -118,7 +170,9 @@ typedef struct lf_light_sample {
     int delta;
 } lf_light_sample;
 
-int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float u0, float u1, lf_light_sample *ls);
+/* tau: the path's Embree time (moving area lights are sampled where they are then). */
+int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float tau, float u0, float u1,
+                       lf_light_sample *ls);
 /* Solid-angle pdf of sampling direction wi from p that hits the light at hit
  * (area lights) or escapes (infinite). */
 float lf_light_pdf_li(const lf_scene *s, const lf_light *l, lf_vec3 p, lf_vec3 wi, const lf_hit *hit);
@@ -133,8 +187,9 @@ lf_vec3 lf_equal_area_square_to_sphere(float u, float v);
 void lf_equal_area_sphere_to_square(lf_vec3 d, float *u, float *v);
 
 /* ---- intersection (render/scene.c) ---- */
-int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_hit *hit);
-int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax);
+/* tau: Embree ray time in [0,1] (scene time mapped over TransformTimes). */
+int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit);
+int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau);
 /* Fills hit->sc.uv for sphere hits (deferred: only textured materials read it). */
 void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit);
 /* Origin offset off a surface to avoid self-intersection, on the side of w. */
@@ -147,7 +202,7 @@ typedef struct lf_integrator {
 } lf_integrator;
 
 /* Radiance along a world-space camera ray. rays counts traced rays. */
-lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, lf_sample_stream *st,
+lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
                    long long *rays);
 
 #endif

@@ -48,6 +48,17 @@ struct lf_renderer {
     lf_render_stats stats;
     lf_transform world_to_camera;
     int white;
+    /* motion and shutters */
+    int time_needed;          /* something moves: draw a time sample per camera ray */
+    int camera_moving;
+    lf_decomposed camera_keys[2];
+    double time0, time1;      /* TransformTimes */
+    int rolling;              /* rolling shutter */
+    double readout;           /* seconds from the first to the last row (column) starting */
+    int readout_dir;          /* 0 top->bottom, 1 bottom->top, 2 left->right, 3 right->left */
+    int has_curve;
+    lf_distrib1d curve;       /* shutter efficiency over the exposure, importance sampled */
+    double curve_mean;        /* mean efficiency: the effective fraction of the exposure */
 };
 
 lf_render_opts lf_render_opts_default(void)
@@ -347,7 +358,71 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         r->shutter_open = r->shutter_close;
         r->shutter_close = t;
     }
-    r->imaging_ratio *= r->shutter_close - r->shutter_open;
+    /* Shutter extensions (docs/motion.md), read by the host for every camera. */
+    const char *shutter = lf_params_string(ps, "shutter", "global");
+    if (!strcmp(shutter, "rolling"))
+        r->rolling = 1;
+    else if (strcmp(shutter, "global"))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: \"shutter\" must be \"global\" or \"rolling\", got \"%s\"", where,
+                            shutter);
+    r->readout = lf_params_float(ps, "readouttime", 0.0);
+    const char *dir = lf_params_string(ps, "readoutdirection", "toptobottom");
+    static const char *dirs[] = {"toptobottom", "bottomtotop", "lefttoright", "righttoleft"};
+    r->readout_dir = -1;
+    for (int i = 0; i < 4; i++)
+        if (!strcmp(dir, dirs[i]))
+            r->readout_dir = i;
+    if (r->readout_dir < 0)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: \"readoutdirection\" must be toptobottom, bottomtotop, lefttoright or righttoleft, got "
+                            "\"%s\"",
+                            where, dir);
+    if (!(r->readout >= 0) || !isfinite(r->readout))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: \"readouttime\" must be >= 0", where);
+    if (r->readout > 0 && !r->rolling)
+        lf_warn_append(&r->warnings, "%s: warning: \"readouttime\" only matters with \"shutter\" \"rolling\"", where);
+    size_t ncurve = 0;
+    const double *curve = lf_params_nums(ps, "shuttercurve", LF_PT_FLOAT, &ncurve);
+    r->curve_mean = 1.0;
+    if (curve) {
+        /* (time fraction, efficiency) pairs over the exposure, piecewise linear,
+         * tabulated finely for importance sampling. */
+        if (ncurve < 4 || ncurve % 2)
+            return lf_error_set(err, LF_ERR_PARAM,
+                                "%s: \"shuttercurve\" needs (time efficiency) pairs, at least 2, got %zu numbers", where,
+                                ncurve);
+        int np = (int)(ncurve / 2);
+        for (int i = 0; i < np; i++)
+            if (curve[2 * i] < 0 || curve[2 * i] > 1 || curve[2 * i + 1] < 0 || (i && curve[2 * i] < curve[2 * i - 2]))
+                return lf_error_set(err, LF_ERR_PARAM,
+                                    "%s: \"shuttercurve\" times must rise within [0,1] and efficiencies be >= 0", where);
+        enum { NB = 1024 };
+        double tab[NB], sum = 0;
+        for (int i = 0; i < NB; i++) {
+            double x = (i + 0.5) / NB, v = 0;
+            if (x <= curve[0])
+                v = curve[1];
+            else if (x >= curve[2 * np - 2])
+                v = curve[2 * np - 1];
+            else
+                for (int k = 0; k + 1 < np; k++)
+                    if (x >= curve[2 * k] && x <= curve[2 * k + 2]) {
+                        double w = curve[2 * k + 2] - curve[2 * k];
+                        double f = w > 0 ? (x - curve[2 * k]) / w : 0;
+                        v = curve[2 * k + 1] + f * (curve[2 * k + 3] - curve[2 * k + 1]);
+                        break;
+                    }
+            tab[i] = v;
+            sum += v;
+        }
+        if (!(sum > 0))
+            return lf_error_set(err, LF_ERR_PARAM, "%s: \"shuttercurve\" never opens (all efficiencies 0)", where);
+        if (lf_distrib1d_init(&r->curve, tab, NB, err))
+            return err->code;
+        r->has_curve = 1;
+        r->curve_mean = sum / NB;
+    }
+    r->imaging_ratio *= (r->shutter_close - r->shutter_open) * r->curve_mean;
     char cerr[1024] = "", cwarn[1024] = "";
     char scene_dir[4096] = ".";
     const char *scene_file = cd->e.loc.file ? cd->e.loc.file : r->scene_path;
@@ -368,11 +443,21 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         lf_warn_append(&r->warnings, "%s: warning: Camera \"%s\": %s", where, type, cwarn);
     r->camera_needs = r->camera_type->needs(r->camera);
     r->camera_name = dupstr(type);
-    if (cd->world_to_camera.animated)
-        lf_warn_append(&r->warnings, "%s: warning: camera motion is not supported yet; using the start transform",
-                       where);
     r->world_to_camera = cd->world_to_camera.xf[0];
     r->camera_to_world = lf_transform_inverse(&cd->world_to_camera.xf[0]);
+    r->time0 = d->transform_start_time;
+    r->time1 = d->transform_end_time;
+    if (cd->world_to_camera.animated) {
+        /* Camera motion: camera-to-world interpolated rigidly (pbrt's
+         * AnimatedTransform) at each ray's time. */
+        for (int k = 0; k < 2; k++) {
+            lf_transform c2w = lf_transform_inverse(&cd->world_to_camera.xf[k]);
+            if (lf_transform_decompose(&c2w, &r->camera_keys[k]))
+                return lf_error_set(err, LF_ERR_NUMERIC, "%s: the camera's %s motion keyframe is degenerate (singular)",
+                                    where, k ? "end" : "start");
+        }
+        r->camera_moving = 1;
+    }
     char ctx[128];
     snprintf(ctx, sizeof ctx, "Camera \"%s\"", type);
     return lf_params_finish(ps, ctx, err);
@@ -415,6 +500,9 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
             d->accelerator.params.items[i].used = 1; /* Embree builds its own BVH */
+    /* Time is sampled only when something moves: a static scene renders the
+     * same bits whatever the shutter says, and pays nothing for it. */
+    r->time_needed = (r->scene.moving_shapes > 0 || r->camera_moving) && r->shutter_close >= r->shutter_open;
     long nproc = sysconf(_SC_NPROCESSORS_ONLN);
     r->threads = opts->threads > 0 ? opts->threads : (nproc > 0 ? (int)nproc : 1);
     *out = r;
@@ -452,6 +540,8 @@ void lf_renderer_free(lf_renderer *r)
         r->camera_type->destroy(r->camera);
     if (r->scene.device || r->scene.meshes || r->scene.materials)
         lf_scene_free(&r->scene);
+    if (r->has_curve)
+        lf_distrib1d_free(&r->curve);
     lf_filter_free(&r->filter);
     free(r->film_filename);
     free(r->camera_name);
@@ -514,9 +604,24 @@ char *lf_renderer_explain(const lf_renderer *r)
     appendf(&b, &len, &cap, "  defocus: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_LENS ? "on (the camera samples its lens)"
                                                    : "off (pinhole: no lens samples drawn)");
-    appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
-            r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");
-    appendf(&b, &len, &cap, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
+    if (r->time_needed) {
+        appendf(&b, &len, &cap,
+                "  motion blur: on (%d moving shapes, up to %d keyframes = %d segments, on Embree motion-BVH nodes; "
+                "camera %s); one time sample per camera ray in [%g, %g]\n",
+                s->moving_shapes, s->max_keys, s->max_keys - 1, r->camera_moving ? "moving" : "static",
+                r->shutter_open, r->shutter_close + (r->rolling ? r->readout : 0));
+    } else {
+        appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
+                r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");
+    }
+    if (r->rolling)
+        appendf(&b, &len, &cap, "  rolling shutter: on, readout %g s %s, exposure %g s per row%s\n", r->readout,
+                (const char *[]){"top to bottom", "bottom to top", "left to right", "right to left"}[r->readout_dir],
+                r->shutter_close - r->shutter_open, r->time_needed ? "" : " (nothing moves: no visible effect)");
+    else
+        appendf(&b, &len, &cap, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
+    if (r->has_curve)
+        appendf(&b, &len, &cap, "  shutter curve: mean efficiency %.4g, times importance-sampled\n", r->curve_mean);
     appendf(&b, &len, &cap, "  dispersion: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH ? "on (the camera samples wavelength)"
                                                          : "off (no wavelength samples)");
@@ -531,7 +636,8 @@ char *lf_renderer_explain(const lf_renderer *r)
     appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette\n",
             r->integrator_name, r->integrator.max_depth);
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
-            s->n_triangles, s->n_meshes, s->n_spheres, "static BVH");
+            s->n_triangles, s->n_meshes, s->n_spheres,
+            s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
     int counts[7] = {0};
     for (int i = 0; i < s->n_lights; i++)
         counts[s->lights[i].kind]++;
@@ -556,6 +662,28 @@ typedef struct job {
     atomic_llong rays, paths, nonfinite, zero_weight;
     pthread_mutex_t progress_lock;
 } job;
+
+/* Scene time of a camera ray: within the exposure [open, close] (shifted
+ * per row or column by a rolling shutter's readout), distributed by the
+ * shutter efficiency curve when there is one. */
+static double shutter_time(const lf_renderer *r, double u, double film_x, double film_y)
+{
+    double x = u;
+    if (r->has_curve)
+        x = lf_distrib1d_sample(&r->curve, u, NULL, NULL);
+    double start = r->shutter_open;
+    if (r->rolling) {
+        double f;
+        switch (r->readout_dir) {
+        case 1: f = 1 - film_y / r->yres; break;
+        case 2: f = film_x / r->xres; break;
+        case 3: f = 1 - film_x / r->xres; break;
+        default: f = film_y / r->yres; break;
+        }
+        start += lf_clampd(f, 0, 1) * r->readout;
+    }
+    return start + x * (r->shutter_close - r->shutter_open);
+}
 
 static void render_tile(job *jb, int tile, long long *rays, long long *paths, long long *nonfinite,
                         long long *zero_weight)
@@ -583,7 +711,15 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                 cs.lens_u = cs.lens_v = 0.5;
                 if (need_lens)
                     lf_sample_2d_d(&st, &cs.lens_u, &cs.lens_v);
+                double tau = 0;
                 cs.time = r->shutter_open;
+                if (r->time_needed) {
+                    double ut, unused;
+                    lf_sample_2d_d(&st, &ut, &unused);
+                    cs.time = shutter_time(r, ut, cs.film_x, cs.film_y);
+                    tau = r->time1 > r->time0 ? (cs.time - r->time0) / (r->time1 - r->time0) : 0;
+                    tau = tau < 0 ? 0 : (tau > 1 ? 1 : tau); /* Embree asserts 0 <= time <= 1 */
+                }
                 cs.wavelength_u = 0.5;
                 if (need_wl) {
                     double unused;
@@ -599,12 +735,18 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                     (*zero_weight)++;
                     continue;
                 }
-                lf_dvec3 o = lf_xform_point_d(&r->camera_to_world, (lf_dvec3){cr.origin[0], cr.origin[1], cr.origin[2]});
-                lf_dvec3 d = lf_xform_vector_d(&r->camera_to_world, (lf_dvec3){cr.dir[0], cr.dir[1], cr.dir[2]});
+                lf_transform moving;
+                const lf_transform *c2w = &r->camera_to_world;
+                if (r->camera_moving) {
+                    moving = lf_decomposed_interpolate(&r->camera_keys[0], &r->camera_keys[1], tau);
+                    c2w = &moving;
+                }
+                lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr.origin[0], cr.origin[1], cr.origin[2]});
+                lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr.dir[0], cr.dir[1], cr.dir[2]});
                 double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
                 lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
                 lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
-                lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, &st, rays);
+                lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, (float)tau, &st, rays);
                 L = lf_scale(L, (float)w * scale);
                 if (need_wl && cr.wavelength_nm > 0)
                     L = lf_mul(L, lf_wavelength_rgb_weight(cr.wavelength_nm));

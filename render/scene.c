@@ -30,6 +30,13 @@ void lf_warn_append(char **buf, const char *fmt, ...)
     *buf = n;
 }
 
+/* The keyframes of a shape's motion over the TransformTimes interval (Embree
+ * time 0..1), evenly spaced; n == 1 for a static shape. */
+typedef struct motion {
+    const lf_transform *keys;
+    int n;
+} motion;
+
 typedef struct builder {
     lf_scene *s;
     lf_scene_desc *d;
@@ -150,7 +157,7 @@ static int add_mesh_lights(builder *b, lf_mesh *m, int area_light)
 }
 
 /* Transforms a mesh given in object space into world space and pushes it. */
-static int finish_mesh(builder *b, const lf_shape_desc *sh, const lf_transform *xf, float *P, int nv, float *N,
+static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, float *P, int nv, float *N,
                        float *uv, int *idx, int nt)
 {
     for (int i = 0; i < 3 * nt; i++)
@@ -162,24 +169,43 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const lf_transform *
             return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"%s\": vertex index %d out of range (%d vertices)",
                                 where, sh->e.type, bad, nv);
         }
-    for (int i = 0; i < nv; i++) {
-        lf_vec3 p = lf_xform_point(xf, lf_v3(P[3 * i], P[3 * i + 1], P[3 * i + 2]));
-        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) {
-            char where[512];
-            loc_prefix(where, sizeof where, &sh->e.loc);
-            free(P), free(N), free(uv), free(idx);
-            return lf_error_set(b->err, LF_ERR_NUMERIC, "%s: Shape \"%s\": vertex %d is not finite", where,
-                                sh->e.type, i);
-        }
-        P[3 * i] = p.x, P[3 * i + 1] = p.y, P[3 * i + 2] = p.z;
-        if (N) {
-            lf_vec3 n = lf_normalize(lf_xform_normal(xf, lf_v3(N[3 * i], N[3 * i + 1], N[3 * i + 2])));
-            N[3 * i] = n.x, N[3 * i + 1] = n.y, N[3 * i + 2] = n.z;
-        }
+    /* World-space vertices (and normals) per keyframe, one block per key,
+     * plus one float of padding: Embree reads vertices with 16-byte loads. */
+    size_t block = (size_t)3 * nv;
+    float *PW = malloc(sizeof(float) * (block * mo->n + 1));
+    float *NW = N ? malloc(sizeof(float) * (block * mo->n + 1)) : NULL;
+    if (!PW || (N && !NW)) {
+        free(PW), free(NW), free(P), free(N), free(uv), free(idx);
+        return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
     }
+    PW[block * mo->n] = 0;
+    for (int k = 0; k < mo->n; k++)
+        for (int i = 0; i < nv; i++) {
+            lf_vec3 p = lf_xform_point(&mo->keys[k], lf_v3(P[3 * i], P[3 * i + 1], P[3 * i + 2]));
+            if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) {
+                char where[512];
+                loc_prefix(where, sizeof where, &sh->e.loc);
+                free(PW), free(NW), free(P), free(N), free(uv), free(idx);
+                return lf_error_set(b->err, LF_ERR_NUMERIC, "%s: Shape \"%s\": vertex %d is not finite", where,
+                                    sh->e.type, i);
+            }
+            float *pw = PW + k * block + 3 * i;
+            pw[0] = p.x, pw[1] = p.y, pw[2] = p.z;
+            if (N) {
+                lf_vec3 n = lf_normalize(lf_xform_normal(&mo->keys[k], lf_v3(N[3 * i], N[3 * i + 1], N[3 * i + 2])));
+                float *nw = NW + k * block + 3 * i;
+                nw[0] = n.x, nw[1] = n.y, nw[2] = n.z;
+            }
+        }
+    free(P);
+    free(N);
+    P = PW;
+    N = NW;
+    const lf_transform *xf = &mo->keys[0];
     lf_mesh m = {0};
     m.n_tris = nt;
     m.n_verts = nv;
+    m.n_keys = mo->n;
     m.idx = idx;
     m.P = P;
     m.N = N;
@@ -203,7 +229,7 @@ static float *dup_floats(const double *v, size_t n)
     return f;
 }
 
-static int shape_trianglemesh(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int shape_trianglemesh(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     lf_paramset *ps = &sh->e.params;
     size_t np = 0, ni = 0, nn = 0, nuv = 0;
@@ -243,10 +269,10 @@ static int shape_trianglemesh(builder *b, lf_shape_desc *sh, const lf_transform 
     }
     for (int i = 0; i < 3 * nt; i++)
         idx[i] = I ? (int)I[i] : i;
-    return finish_mesh(b, sh, xf, fp, nv, fn, fuv, idx, nt);
+    return finish_mesh(b, sh, mo, fp, nv, fn, fuv, idx, nt);
 }
 
-static int shape_plymesh(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int shape_plymesh(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     lf_paramset *ps = &sh->e.params;
     const char *fn = lf_params_string(ps, "filename", NULL);
@@ -268,13 +294,13 @@ static int shape_plymesh(builder *b, lf_shape_desc *sh, const lf_transform *xf)
     if (lf_ply_read(path, &pm, &perr))
         return lf_error_set(b->err, perr.code, "%s: Shape \"plymesh\": %s", where, perr.msg);
     lf_ply_mesh copy = pm;
-    return finish_mesh(b, sh, xf, copy.P, (int)copy.n_vertices, copy.N, copy.uv, copy.indices, (int)copy.n_triangles);
+    return finish_mesh(b, sh, mo, copy.P, (int)copy.n_vertices, copy.N, copy.uv, copy.indices, (int)copy.n_triangles);
 }
 
 /* Tessellated parametric surface: f(u, v) -> object-space point, on a grid. */
 typedef void (*surface_fn)(const double *prm, double u, double v, double out[3], double nrm[3]);
 
-static int tessellate(builder *b, lf_shape_desc *sh, const lf_transform *xf, surface_fn f, const double *prm, int nu,
+static int tessellate(builder *b, lf_shape_desc *sh, const motion *mo, surface_fn f, const double *prm, int nu,
                       int nv_, int with_normals)
 {
     int nv = (nu + 1) * (nv_ + 1), nt = 2 * nu * nv_;
@@ -314,7 +340,7 @@ static int tessellate(builder *b, lf_shape_desc *sh, const lf_transform *xf, sur
             w++;
         }
     }
-    return finish_mesh(b, sh, xf, P, nv, N, UV, idx, w);
+    return finish_mesh(b, sh, mo, P, nv, N, UV, idx, w);
 }
 
 /* pbrt's sphere: (u,v) -> phi = u phimax, theta from zmin to zmax. */
@@ -353,8 +379,9 @@ static double similarity_scale(const lf_transform *xf)
     return c[0];
 }
 
-static int shape_sphere(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
 {
+    const lf_transform *xf = &mo->keys[0];
     lf_paramset *ps = &sh->e.params;
     double r = lf_params_float(ps, "radius", 1.0);
     double zmin = lf_params_float(ps, "zmin", -r), zmax = lf_params_float(ps, "zmax", r);
@@ -369,6 +396,9 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const lf_transform *xf)
     phimax = lf_clampd(phimax, 0, 360);
     double scale = similarity_scale(xf);
     int full = zmin <= -r && zmax >= r && phimax >= 360.0;
+    for (int k = 1; k < mo->n && scale > 0; k++)
+        if (similarity_scale(&mo->keys[k]) <= 0)
+            scale = 0; /* sheared somewhere along the motion: tessellate */
     if (full && scale > 0) {
         if (b->s->n_spheres == b->cap_spheres) {
             int nc = b->cap_spheres ? 2 * b->cap_spheres : 8;
@@ -381,6 +411,24 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const lf_transform *xf)
         lf_sphere sp = {0};
         sp.center = lf_xform_point(xf, lf_v3(0, 0, 0));
         sp.radius = (float)(r * scale);
+        sp.n_keys = 1;
+        if (mo->n > 1) {
+            /* A moving sphere: its centre per keyframe (radius from the first;
+             * a changing scale would need an ellipsoid). */
+            sp.centers = malloc(sizeof(lf_vec3) * (size_t)mo->n);
+            if (!sp.centers)
+                return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+            for (int k = 0; k < mo->n; k++)
+                sp.centers[k] = lf_xform_point(&mo->keys[k], lf_v3(0, 0, 0));
+            sp.n_keys = mo->n;
+            double s1 = similarity_scale(&mo->keys[mo->n - 1]);
+            if (fabs(s1 - scale) > 1e-6 * scale) {
+                char where[512];
+                loc_prefix(where, sizeof where, &sh->e.loc);
+                lf_warn_append(&b->s->warnings, "%s: warning: a sphere whose scale changes during the shutter keeps its "
+                               "starting radius", where);
+            }
+        }
         sp.object_to_world = *xf;
         sp.material = sh->material;
         sp.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
@@ -408,10 +456,10 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const lf_transform *xf)
      * the area error below 1e-5 relative). */
     double prm[4] = {r, acos(lf_clampd(zmax / r, -1, 1)), acos(lf_clampd(zmin / r, -1, 1)), phimax * LF_PI / 180};
     int nu = (int)ceil(256 * phimax / 360.0);
-    return tessellate(b, sh, xf, sphere_surface, prm, nu < 4 ? 4 : nu, 128, 1);
+    return tessellate(b, sh, mo, sphere_surface, prm, nu < 4 ? 4 : nu, 128, 1);
 }
 
-static int shape_disk(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int shape_disk(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     lf_paramset *ps = &sh->e.params;
     double prm[4] = {lf_params_float(ps, "height", 0.0), lf_params_float(ps, "radius", 1.0),
@@ -423,7 +471,7 @@ static int shape_disk(builder *b, lf_shape_desc *sh, const lf_transform *xf)
     prm[3] = lf_clampd(prm[3], 0, 360) * LF_PI / 180;
     /* 512 segments: polygon area / circle area = sinc-like 1 - 2.5e-5. */
     int nu = (int)ceil(512 * prm[3] / (2 * LF_PI));
-    return tessellate(b, sh, xf, disk_surface, prm, nu < 4 ? 4 : nu, 1, 1);
+    return tessellate(b, sh, mo, disk_surface, prm, nu < 4 ? 4 : nu, 1, 1);
 }
 
 static void bilinear_surface(const double *prm, double u, double v, double out[3], double nrm[3])
@@ -443,7 +491,7 @@ static void bilinear_surface(const double *prm, double u, double v, double out[3
         nrm[0] /= l, nrm[1] /= l, nrm[2] /= l;
 }
 
-static int shape_bilinearmesh(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int shape_bilinearmesh(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     lf_paramset *ps = &sh->e.params;
     size_t np = 0, ni = 0;
@@ -479,13 +527,13 @@ static int shape_bilinearmesh(builder *b, lf_shape_desc *sh, const lf_transform 
         for (int c = 0; c < 3; c++)
             skew = fmax(skew, fabs(prm[c] + prm[9 + c] - prm[3 + c] - prm[6 + c]));
         int n = skew == 0 ? 1 : 16;
-        if (tessellate(b, sh, xf, bilinear_surface, prm, n, n, 0))
+        if (tessellate(b, sh, mo, bilinear_surface, prm, n, n, 0))
             return b->err->code;
     }
     return 0;
 }
 
-typedef int (*shape_fn)(builder *b, lf_shape_desc *sh, const lf_transform *xf);
+typedef int (*shape_fn)(builder *b, lf_shape_desc *sh, const motion *mo);
 static const struct {
     const char *name;
     shape_fn fn;
@@ -494,7 +542,7 @@ static const struct {
     {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh},
 };
 
-static int build_shape(builder *b, lf_shape_desc *sh, const lf_transform *xf)
+static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     char where[512];
     loc_prefix(where, sizeof where, &sh->e.loc);
@@ -504,7 +552,7 @@ static int build_shape(builder *b, lf_shape_desc *sh, const lf_transform *xf)
     }
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {
-            if (shape_table[i].fn(b, sh, xf))
+            if (shape_table[i].fn(b, sh, mo))
                 return b->err->code;
             char ctx[256];
             snprintf(ctx, sizeof ctx, "Shape \"%s\"", sh->e.type);
@@ -528,19 +576,34 @@ int lf_scene_build_lights(lf_scene_desc *d, lf_scene *s, lf_error *err); /* ligh
 static void sphere_bounds_fn(const struct RTCBoundsFunctionArguments *a)
 {
     const lf_sphere *sp = (const lf_sphere *)a->geometryUserPtr + a->primID;
-    a->bounds_o->lower_x = sp->center.x - sp->radius;
-    a->bounds_o->lower_y = sp->center.y - sp->radius;
-    a->bounds_o->lower_z = sp->center.z - sp->radius;
-    a->bounds_o->upper_x = sp->center.x + sp->radius;
-    a->bounds_o->upper_y = sp->center.y + sp->radius;
-    a->bounds_o->upper_z = sp->center.z + sp->radius;
+    lf_vec3 c = sp->n_keys > 1 ? sp->centers[a->timeStep] : sp->center;
+    a->bounds_o->lower_x = c.x - sp->radius;
+    a->bounds_o->lower_y = c.y - sp->radius;
+    a->bounds_o->lower_z = c.z - sp->radius;
+    a->bounds_o->upper_x = c.x + sp->radius;
+    a->bounds_o->upper_y = c.y + sp->radius;
+    a->bounds_o->upper_z = c.z + sp->radius;
+}
+
+/* Static-sphere geometry: moving spheres live in their own geometries and
+ * get empty bounds here, which Embree skips. */
+static void static_sphere_bounds_fn(const struct RTCBoundsFunctionArguments *a)
+{
+    const lf_sphere *sp = (const lf_sphere *)a->geometryUserPtr + a->primID;
+    if (sp->n_keys > 1) {
+        a->bounds_o->lower_x = a->bounds_o->lower_y = a->bounds_o->lower_z = 1.f;
+        a->bounds_o->upper_x = a->bounds_o->upper_y = a->bounds_o->upper_z = -1.f;
+        return;
+    }
+    sphere_bounds_fn(a);
 }
 
 /* Nearest root in (tnear, tfar), or -1. d need not be unit length. */
-static float sphere_hit_t(const lf_sphere *sp, const float o[3], const float dir[3], float tnear, float tfar)
+static float sphere_hit_t(const lf_sphere *sp, lf_vec3 center, const float o[3], const float dir[3], float tnear,
+                          float tfar)
 {
     lf_vec3 d = lf_v3(dir[0], dir[1], dir[2]);
-    lf_vec3 f = lf_v3(o[0] - sp->center.x, o[1] - sp->center.y, o[2] - sp->center.z);
+    lf_vec3 f = lf_v3(o[0] - center.x, o[1] - center.y, o[2] - center.z);
     float a = lf_dot(d, d);
     float b = -lf_dot(f, d) / a;          /* t of the closest point */
     lf_vec3 l = lf_madd(f, d, b);         /* closest point - centre */
@@ -570,14 +633,15 @@ static void sphere_intersect_fn(const struct RTCIntersectFunctionNArguments *a)
     const lf_sphere *sp = (const lf_sphere *)a->geometryUserPtr + a->primID;
     struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit; /* N == 1: rtcIntersect1 */
     float o[3] = {rh->ray.org_x, rh->ray.org_y, rh->ray.org_z}, d[3] = {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z};
-    float t = sphere_hit_t(sp, o, d, rh->ray.tnear, rh->ray.tfar);
+    lf_vec3 c = lf_sphere_center_at(sp, rh->ray.time);
+    float t = sphere_hit_t(sp, c, o, d, rh->ray.tnear, rh->ray.tfar);
     if (t < 0)
         return;
     rh->ray.tfar = t;
     rh->hit.u = rh->hit.v = 0;
-    rh->hit.Ng_x = o[0] + t * d[0] - sp->center.x;
-    rh->hit.Ng_y = o[1] + t * d[1] - sp->center.y;
-    rh->hit.Ng_z = o[2] + t * d[2] - sp->center.z;
+    rh->hit.Ng_x = o[0] + t * d[0] - c.x;
+    rh->hit.Ng_y = o[1] + t * d[1] - c.y;
+    rh->hit.Ng_z = o[2] + t * d[2] - c.z;
     rh->hit.primID = a->primID;
     rh->hit.geomID = a->geomID;
     rh->hit.instID[0] = a->context->instID[0];
@@ -590,7 +654,7 @@ static void sphere_occluded_fn(const struct RTCOccludedFunctionNArguments *a)
     const lf_sphere *sp = (const lf_sphere *)a->geometryUserPtr + a->primID;
     struct RTCRay *r = (struct RTCRay *)a->ray;
     float o[3] = {r->org_x, r->org_y, r->org_z}, d[3] = {r->dir_x, r->dir_y, r->dir_z};
-    if (sphere_hit_t(sp, o, d, r->tnear, r->tfar) >= 0)
+    if (sphere_hit_t(sp, lf_sphere_center_at(sp, r->time), o, d, r->tnear, r->tfar) >= 0)
         r->tfar = -INFINITY;
 }
 
@@ -601,10 +665,92 @@ static void rtc_error_cb(void *user, enum RTCError code, const char *str)
     (void)str;
 }
 
+/* Keyframes for a (possibly animated) object-to-world transform, optionally
+ * composed with an animated instance transform.  pbrt interpolates the
+ * decomposed transform (rigid rotation); Embree interpolates vertices
+ * linearly between time steps, so a rotation is followed by N segments:
+ * "integer motionsegments" (a lensfield extension) or, by default, one
+ * segment per 5 degrees of rotation (a pure translation needs one). */
+static int motion_keys(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst, lf_transform **keys, int *n)
+{
+    const lf_anim_xform *ax = &sh->object_to_world;
+    int animated = ax->animated || (inst && inst->animated);
+    int requested = lf_params_int(&sh->e.params, "motionsegments", 0);
+    char where[512];
+    loc_prefix(where, sizeof where, &sh->e.loc);
+    if (requested < 0 || requested > 1024)
+        return lf_error_set(b->err, LF_ERR_PARAM, "%s: \"motionsegments\" must be in 1..1024, got %d", where, requested);
+    if (!animated) {
+        *keys = malloc(sizeof(lf_transform));
+        if (!*keys)
+            return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+        (*keys)[0] = inst ? lf_transform_compose(&inst->xf[0], &ax->xf[0]) : ax->xf[0];
+        *n = 1;
+        return 0;
+    }
+    lf_decomposed da[2], di[2];
+    for (int k = 0; k < 2; k++) {
+        if (lf_transform_decompose(&ax->xf[k], &da[k]) ||
+            (inst && lf_transform_decompose(&inst->xf[k], &di[k])))
+            return lf_error_set(b->err, LF_ERR_NUMERIC,
+                                "%s: Shape \"%s\": its %s motion keyframe transform is degenerate (singular)", where,
+                                sh->e.type, k ? "end" : "start");
+    }
+    double dot_a = fabs(da[0].q[0] * da[1].q[0] + da[0].q[1] * da[1].q[1] + da[0].q[2] * da[1].q[2] +
+                        da[0].q[3] * da[1].q[3]);
+    double angle = 2 * acos(dot_a < 1 ? dot_a : 1) * 180 / LF_PI;
+    if (inst) {
+        double dot_i = fabs(di[0].q[0] * di[1].q[0] + di[0].q[1] * di[1].q[1] + di[0].q[2] * di[1].q[2] +
+                            di[0].q[3] * di[1].q[3]);
+        angle += 2 * acos(dot_i < 1 ? dot_i : 1) * 180 / LF_PI;
+    }
+    int segs = requested > 0 ? requested : (int)ceil(angle / 5.0);
+    if (segs < 1)
+        segs = 1;
+    if (segs > 1024)
+        segs = 1024;
+    *keys = malloc(sizeof(lf_transform) * (size_t)(segs + 1));
+    if (!*keys)
+        return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+    for (int k = 0; k <= segs; k++) {
+        double f = (double)k / segs;
+        lf_transform t = ax->animated ? lf_decomposed_interpolate(&da[0], &da[1], f) : ax->xf[0];
+        if (k == 0)
+            t = ax->xf[0];
+        else if (k == segs)
+            t = ax->xf[1];
+        if (inst) {
+            lf_transform ti = inst->animated ? lf_decomposed_interpolate(&di[0], &di[1], f) : inst->xf[0];
+            if (k == 0)
+                ti = inst->xf[0];
+            else if (k == segs)
+                ti = inst->xf[1];
+            t = lf_transform_compose(&ti, &t);
+        }
+        (*keys)[k] = t;
+    }
+    *n = segs + 1;
+    return 0;
+}
+
+static int build_shape_moving(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst)
+{
+    lf_transform *keys = NULL;
+    int n = 0;
+    if (motion_keys(b, sh, inst, &keys, &n))
+        return b->err->code;
+    motion mo = {keys, n};
+    int rc = build_shape(b, sh, &mo);
+    free(keys);
+    return rc;
+}
+
 int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
 {
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
+    s->time0 = d->transform_start_time;
+    s->time1 = d->transform_end_time;
     builder b = {s, d, 0, 0, 0, err};
     if (lf_materials_build(d, &s->materials, err))
         goto fail;
@@ -614,14 +760,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         lf_shape_desc *sh = &d->shapes[i];
         if (sh->object >= 0)
             continue; /* instantiated below */
-        if (sh->object_to_world.animated) {
-            char where[512];
-            loc_prefix(where, sizeof where, &sh->e.loc);
-            lf_warn_append(&s->warnings,
-                           "%s: warning: animated shape transforms are not supported yet; using the start transform",
-                           where);
-        }
-        if (build_shape(&b, sh, &sh->object_to_world.xf[0]))
+        if (build_shape_moving(&b, sh, NULL))
             goto fail;
     }
     for (size_t k = 0; k < d->n_instances; k++) {
@@ -630,8 +769,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
             lf_shape_desc *sh = &d->shapes[i];
             if (sh->object != in->object)
                 continue;
-            lf_transform xf = lf_transform_compose(&in->instance_to_world.xf[0], &sh->object_to_world.xf[0]);
-            if (build_shape(&b, sh, &xf))
+            if (build_shape_moving(&b, sh, &in->instance_to_world))
                 goto fail;
         }
     }
@@ -647,46 +785,80 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     rtcSetDeviceErrorFunction(s->device, rtc_error_cb, NULL);
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
-    s->n_geom = s->n_meshes + 1;
-    s->geom_mesh = malloc(sizeof(unsigned) * (size_t)s->n_geom);
-    if (!s->geom_mesh) {
+    int n_moving_spheres = 0;
+    for (int i = 0; i < s->n_spheres; i++)
+        n_moving_spheres += s->spheres[i].n_keys > 1;
+    s->n_geom = s->n_meshes + 1 + n_moving_spheres;
+    s->geom_index = malloc(sizeof(int) * (size_t)s->n_geom);
+    if (!s->geom_index) {
         lf_error_set(err, LF_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    s->max_keys = 1;
     lf_vec3 bmin = lf_v3(INFINITY, INFINITY, INFINITY), bmax = lf_v3(-INFINITY, -INFINITY, -INFINITY);
     for (int m = 0; m < s->n_meshes; m++) {
         lf_mesh *me = &s->meshes[m];
         RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, me->P, 0, 3 * sizeof(float),
-                                   (size_t)me->n_verts);
+        if (me->n_keys > 1) {
+            /* Motion: one vertex buffer per keyframe over Embree time 0..1. */
+            rtcSetGeometryTimeStepCount(g, (unsigned)me->n_keys);
+            s->moving_shapes++;
+        }
+        for (int k = 0; k < me->n_keys; k++)
+            rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, (unsigned)k, RTC_FORMAT_FLOAT3,
+                                       me->P + (size_t)k * 3 * me->n_verts, 0, 3 * sizeof(float), (size_t)me->n_verts);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, me->idx, 0, 3 * sizeof(int),
                                    (size_t)me->n_tris);
         rtcCommitGeometry(g);
         unsigned id = rtcAttachGeometry(s->rtc, g);
         rtcReleaseGeometry(g);
-        s->geom_mesh[id] = (unsigned)m;
-        for (int v = 0; v < me->n_verts; v++) {
-            bmin = lf_v3(fminf(bmin.x, me->P[3 * v]), fminf(bmin.y, me->P[3 * v + 1]), fminf(bmin.z, me->P[3 * v + 2]));
-            bmax = lf_v3(fmaxf(bmax.x, me->P[3 * v]), fmaxf(bmax.y, me->P[3 * v + 1]), fmaxf(bmax.z, me->P[3 * v + 2]));
+        s->geom_index[id] = m;
+        if (me->n_keys > s->max_keys)
+            s->max_keys = me->n_keys;
+        for (size_t v = 0; v < (size_t)me->n_verts * me->n_keys; v++) {
+            const float *p = me->P + 3 * v;
+            bmin = lf_v3(fminf(bmin.x, p[0]), fminf(bmin.y, p[1]), fminf(bmin.z, p[2]));
+            bmax = lf_v3(fmaxf(bmax.x, p[0]), fmaxf(bmax.y, p[1]), fmaxf(bmax.z, p[2]));
         }
     }
     if (s->n_spheres) {
         RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_USER);
         rtcSetGeometryUserPrimitiveCount(g, (unsigned)s->n_spheres);
         rtcSetGeometryUserData(g, s->spheres);
-        rtcSetGeometryBoundsFunction(g, sphere_bounds_fn, NULL);
+        rtcSetGeometryBoundsFunction(g, static_sphere_bounds_fn, NULL);
         rtcSetGeometryIntersectFunction(g, sphere_intersect_fn);
         rtcSetGeometryOccludedFunction(g, sphere_occluded_fn);
-        for (int i = 0; i < s->n_spheres; i++) {
-            lf_sphere *sp = &s->spheres[i];
-            bmin = lf_v3(fminf(bmin.x, sp->center.x - sp->radius), fminf(bmin.y, sp->center.y - sp->radius),
-                         fminf(bmin.z, sp->center.z - sp->radius));
-            bmax = lf_v3(fmaxf(bmax.x, sp->center.x + sp->radius), fmaxf(bmax.y, sp->center.y + sp->radius),
-                         fmaxf(bmax.z, sp->center.z + sp->radius));
-        }
         rtcCommitGeometry(g);
         s->sphere_geom_id = rtcAttachGeometry(s->rtc, g);
         rtcReleaseGeometry(g);
+        s->geom_index[s->sphere_geom_id] = INT32_MIN;
+        for (int i = 0; i < s->n_spheres; i++) {
+            lf_sphere *sp = &s->spheres[i];
+            for (int k = 0; k < sp->n_keys; k++) {
+                lf_vec3 c = sp->n_keys > 1 ? sp->centers[k] : sp->center;
+                bmin = lf_v3(fminf(bmin.x, c.x - sp->radius), fminf(bmin.y, c.y - sp->radius),
+                             fminf(bmin.z, c.z - sp->radius));
+                bmax = lf_v3(fmaxf(bmax.x, c.x + sp->radius), fmaxf(bmax.y, c.y + sp->radius),
+                             fmaxf(bmax.z, c.z + sp->radius));
+            }
+            if (sp->n_keys > 1) {
+                /* A moving sphere: its own geometry with one time step per keyframe. */
+                RTCGeometry gm = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_USER);
+                rtcSetGeometryUserPrimitiveCount(gm, 1);
+                rtcSetGeometryTimeStepCount(gm, (unsigned)sp->n_keys);
+                rtcSetGeometryUserData(gm, sp);
+                rtcSetGeometryBoundsFunction(gm, sphere_bounds_fn, NULL);
+                rtcSetGeometryIntersectFunction(gm, sphere_intersect_fn);
+                rtcSetGeometryOccludedFunction(gm, sphere_occluded_fn);
+                rtcCommitGeometry(gm);
+                unsigned id = rtcAttachGeometry(s->rtc, gm);
+                rtcReleaseGeometry(gm);
+                s->geom_index[id] = -1 - i;
+                s->moving_shapes++;
+                if (sp->n_keys > s->max_keys)
+                    s->max_keys = sp->n_keys;
+            }
+        }
     }
     rtcCommitScene(s->rtc);
     if (bmin.x > bmax.x)
@@ -752,8 +924,10 @@ void lf_scene_free(lf_scene *s)
         free(s->meshes[i].uv);
     }
     free(s->meshes);
+    for (int i = 0; i < s->n_spheres; i++)
+        free(s->spheres[i].centers);
     free(s->spheres);
-    free(s->geom_mesh);
+    free(s->geom_index);
     for (int i = 0; i < s->n_lights; i++)
         if (s->lights[i].env) {
             lf_envmap_free(s->lights[i].env);
@@ -780,13 +954,13 @@ lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w)
     return lf_madd(p, ng, lf_dot(ng, w) >= 0 ? eps : -eps);
 }
 
-static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax)
+static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax, float tau)
 {
     rh->ray.org_x = o.x, rh->ray.org_y = o.y, rh->ray.org_z = o.z;
     rh->ray.dir_x = d.x, rh->ray.dir_y = d.y, rh->ray.dir_z = d.z;
     rh->ray.tnear = 0.f;
     rh->ray.tfar = tmax;
-    rh->ray.time = 0.f;
+    rh->ray.time = tau;
     rh->ray.mask = 0xffffffffu;
     rh->ray.id = 0;
     rh->ray.flags = 0;
@@ -794,10 +968,10 @@ static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax)
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
-int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_hit *hit)
+int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit)
 {
     struct RTCRayHit rh;
-    init_ray(&rh, o, d, tmax);
+    init_ray(&rh, o, d, tmax, tau);
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcIntersect1(s->rtc, &ctx, &rh);
@@ -805,20 +979,24 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_h
         return 0;
     hit->t = rh.ray.tfar;
     lf_shading_ctx *sc = &hit->sc;
-    if (rh.hit.geomID == s->sphere_geom_id) {
-        const lf_sphere *sp = &s->spheres[rh.hit.primID];
+    int gi = s->geom_index[rh.hit.geomID];
+    if (gi < 0) {
+        int si = gi == INT32_MIN ? (int)rh.hit.primID : -1 - gi;
+        const lf_sphere *sp = &s->spheres[si];
+        lf_vec3 c = lf_sphere_center_at(sp, tau);
         lf_vec3 p = lf_madd(o, d, rh.ray.tfar);
-        lf_vec3 n = lf_normalize(lf_sub(p, sp->center));
-        p = lf_madd(sp->center, n, sp->radius); /* re-project onto the surface */
+        lf_vec3 n = lf_normalize(lf_sub(p, c));
+        p = lf_madd(c, n, sp->radius); /* re-project onto the surface */
         /* Object-space direction of the hit: the tangent dp/du and, when a
          * texture needs it, pbrt's (u,v) (lf_scene_sphere_uv) derive from it. */
         const double(*wo)[4] = sp->object_to_world.inv; /* world -> object, linear part */
-        lf_vec3 dw = lf_sub(p, sp->center);
+        lf_vec3 dw = lf_sub(p, c);
         lf_vec3 q = lf_v3((float)(wo[0][0] * dw.x + wo[0][1] * dw.y + wo[0][2] * dw.z),
                           (float)(wo[1][0] * dw.x + wo[1][1] * dw.y + wo[1][2] * dw.z),
                           (float)(wo[2][0] * dw.x + wo[2][1] * dw.y + wo[2][2] * dw.z));
         sc->uv = (lf_vec2){0, 0};
-        hit->sphere = (int)rh.hit.primID;
+        hit->sphere = si;
+        hit->tau = tau;
         lf_vec3 dpdu_o = lf_v3(-q.y, q.x, 0);
         if (dpdu_o.x == 0 && dpdu_o.y == 0)
             dpdu_o = lf_v3(1, 0, 0);
@@ -832,12 +1010,11 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_h
         return 1;
     }
     hit->sphere = -1;
-    const lf_mesh *m = &s->meshes[s->geom_mesh[rh.hit.geomID]];
+    hit->tau = tau;
+    const lf_mesh *m = &s->meshes[gi];
     int t = (int)rh.hit.primID;
     int i0 = m->idx[3 * t], i1 = m->idx[3 * t + 1], i2 = m->idx[3 * t + 2];
-    lf_vec3 p0 = lf_v3(m->P[3 * i0], m->P[3 * i0 + 1], m->P[3 * i0 + 2]);
-    lf_vec3 p1 = lf_v3(m->P[3 * i1], m->P[3 * i1 + 1], m->P[3 * i1 + 2]);
-    lf_vec3 p2 = lf_v3(m->P[3 * i2], m->P[3 * i2 + 1], m->P[3 * i2 + 2]);
+    lf_vec3 p0 = lf_mesh_vertex_at(m, i0, tau), p1 = lf_mesh_vertex_at(m, i1, tau), p2 = lf_mesh_vertex_at(m, i2, tau);
     float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.f - b1 - b2;
     sc->p = lf_add(lf_add(lf_scale(p0, b0), lf_scale(p1, b1)), lf_scale(p2, b2));
     /* pbrt-v4 Triangle: n = normalize(cross(p0 - p2, p1 - p2)). */
@@ -867,9 +1044,7 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, lf_h
     }
     sc->dpdu = lf_normalize(dpdu);
     if (m->N) {
-        lf_vec3 n0 = lf_v3(m->N[3 * i0], m->N[3 * i0 + 1], m->N[3 * i0 + 2]);
-        lf_vec3 n1 = lf_v3(m->N[3 * i1], m->N[3 * i1 + 1], m->N[3 * i1 + 2]);
-        lf_vec3 n2 = lf_v3(m->N[3 * i2], m->N[3 * i2 + 1], m->N[3 * i2 + 2]);
+        lf_vec3 n0 = lf_mesh_normal_at(m, i0, tau), n1 = lf_mesh_normal_at(m, i1, tau), n2 = lf_mesh_normal_at(m, i2, tau);
         lf_vec3 ns = lf_normalize(lf_add(lf_add(lf_scale(n0, b0), lf_scale(n1, b1)), lf_scale(n2, b2)));
         if (!(lf_dot(ns, ns) > 0))
             ns = n;
@@ -894,7 +1069,7 @@ void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit)
         return;
     const lf_sphere *sp = &s->spheres[hit->sphere];
     const double(*wo)[4] = sp->object_to_world.inv;
-    lf_vec3 dw = lf_sub(hit->sc.p, sp->center);
+    lf_vec3 dw = lf_sub(hit->sc.p, lf_sphere_center_at(sp, hit->tau));
     lf_vec3 q = lf_normalize(lf_v3((float)(wo[0][0] * dw.x + wo[0][1] * dw.y + wo[0][2] * dw.z),
                                    (float)(wo[1][0] * dw.x + wo[1][1] * dw.y + wo[1][2] * dw.z),
                                    (float)(wo[2][0] * dw.x + wo[2][1] * dw.y + wo[2][2] * dw.z)));
@@ -906,14 +1081,14 @@ void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit)
     hit->sc.uv = (lf_vec2){phi * (float)LF_INV_2PI, (theta - (float)LF_PI) / (float)-LF_PI};
 }
 
-int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax)
+int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau)
 {
     struct RTCRay r;
     r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
     r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;
     r.tnear = 0.f;
     r.tfar = tmax;
-    r.time = 0.f;
+    r.time = tau;
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;

@@ -889,6 +889,15 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
         lf_attrs_set_m44d(meta, "lensfield:world_to_camera", m);
         if (r->white)
             lf_attrs_set_int(meta, "lensfield:white", 1);
+        lf_attrs_set_string(meta, "lensfield:shutter", r->rolling ? "rolling" : "global");
+        if (r->rolling) {
+            lf_attrs_set_double(meta, "lensfield:readout_time", r->readout);
+            lf_attrs_set_string(meta, "lensfield:readout_direction",
+                                (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir]);
+        }
+        if (r->has_curve)
+            lf_attrs_set_double(meta, "lensfield:shutter_efficiency", r->curve_mean);
+        lf_attrs_set_int(meta, "lensfield:motion_blur", r->time_needed);
         if (r->camera_type->metadata) {
             lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
             r->camera_type->metadata(r->camera, &sink);

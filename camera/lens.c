@@ -562,9 +562,8 @@ static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray
             if (p[0] * p[0] + p[1] * p[1] > ap * ap)
                 return LF_LENS_CLIPPED;
             /* Snell's law: n_i sin(theta_i) = n_t sin(theta_t). */
-            double nrm[3] = {(p[0]) / R, (p[1]) / R, (p[2] - zc) / R};
-            double nl = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-            nrm[0] /= nl, nrm[1] /= nl, nrm[2] /= nl;
+            double inv_r = 1.0 / R; /* p lies on the sphere: (p - c) / R is the unit normal */
+            double nrm[3] = {p[0] * inv_r, p[1] * inv_r, (p[2] - zc) * inv_r};
             double cos_i = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
             if (cos_i < 0.0) {
                 nrm[0] = -nrm[0], nrm[1] = -nrm[1], nrm[2] = -nrm[2];
@@ -579,10 +578,8 @@ static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray
             if (sin2_t >= 1.0)
                 return LF_LENS_TIR;
             double cos_t = sqrt(1.0 - sin2_t);
-            for (int j = 0; j < 3; j++)
+            for (int j = 0; j < 3; j++) /* unit length by construction; renormalised at the end */
                 d[j] = eta * d[j] + (eta * cos_i - cos_t) * nrm[j];
-            dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            d[0] /= dl, d[1] /= dl, d[2] /= dl;
             if (!(d[2] * dir > 0.0))
                 return LF_LENS_BACKWARDS;
         }
@@ -593,6 +590,8 @@ static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray
         }
     }
     if (out) {
+        dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        d[0] /= dl, d[1] /= dl, d[2] /= dl;
         memcpy(out->o, o, sizeof o);
         memcpy(out->d, d, sizeof d);
     }

@@ -1,0 +1,213 @@
+/* bench_lens_rays - cost of camera rays through real lenses.
+ *
+ * For each shipped lens (wide open, focused at 3 m, full-frame film, 36 x 24
+ * raster of 1 mm pixels ... camera-space rays): ns per camera ray with the
+ * exit-pupil bounds and with plain rear-disk sampling (camera/lens.c), the
+ * useful-ray fraction of each, the exit-pupil precomputation time, and the
+ * whole "realistic" camera through the registry against a pinhole
+ * ("perspective") and, if registered, "thinlens".  Medians of 5 repeats.
+ *
+ * usage: bench_lens_rays [rays-per-repeat (default 400000)]
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "camera/lens.h"
+#include "camera/lf_camera.h"
+
+enum { REPEATS = 5 };
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, n, sizeof *v, cmp);
+    return v[n / 2];
+}
+
+static double halton_slow(long i, int base)
+{
+    double f = 1, r = 0;
+    for (; i > 0; i /= base) {
+        f /= base;
+        r += f * (i % base);
+    }
+    return r;
+}
+
+/* Sample points are precomputed so the timings hold only the camera's work. */
+static double *samples;
+static long n_samples;
+static double halton(long i, int base)
+{
+    int d = base == 2 ? 0 : base == 3 ? 1 : base == 5 ? 2 : 3;
+    return samples[4 * i + d];
+}
+
+/* registry camera parameters */
+typedef struct store {
+    const char *lensfile;
+} store;
+static double g_float(void *c, const char *name, double def)
+{
+    (void)c;
+    if (!strcmp(name, "aperturediameter"))
+        return 1000.0; /* wide open (clamped to the stop) */
+    if (!strcmp(name, "focusdistance"))
+        return 3.0;
+    if (!strcmp(name, "fov"))
+        return 40.0;
+    return def;
+}
+static int g_int(void *c, const char *n, int def)
+{
+    (void)c, (void)n;
+    return def;
+}
+static const char *g_string(void *c, const char *name, const char *def)
+{
+    store *s = c;
+    return !strcmp(name, "lensfile") && s->lensfile ? s->lensfile : def;
+}
+static int g_floats(void *c, const char *n, double *o, int m)
+{
+    (void)c, (void)n, (void)o, (void)m;
+    return 0;
+}
+static int g_image(void *c, const char *p, int *w, int *h, float **px, char *e, size_t n)
+{
+    (void)c, (void)w, (void)h, (void)px;
+    snprintf(e, n, "no images (%s)", p);
+    return -1;
+}
+
+/* ns per generate_ray for a registered camera; also its setup time. */
+static double camera_ns(const char *type, const char *lensfile, long n, double *setup_s, double *through)
+{
+    store s = {lensfile};
+    lf_camera_params p = {&s, g_float, g_int, g_int, g_string, g_floats, g_image};
+    char err[1024] = "", warn[1024] = "";
+    lf_camera_create_args a = {sizeof a, &p, 1440, 960, 43.27, 0, 1, LF_SOURCE_DIR "/scenes", err, sizeof err,
+                               warn, sizeof warn};
+    const lf_camera_type *t = lf_camera_find(type);
+    if (!t)
+        return -1;
+    void *st;
+    double t0 = now();
+    if (t->create(&a, &st)) {
+        fprintf(stderr, "%s: %s\n", type, err);
+        return -1;
+    }
+    *setup_s = now() - t0;
+    double ns[REPEATS];
+    long ok = 0;
+    for (int r = 0; r < REPEATS; r++) {
+        double sink = 0;
+        ok = 0;
+        t0 = now();
+        for (long i = 0; i < n; i++) {
+            lf_camera_sample cs = {halton(i, 2) * 1440, halton(i, 3) * 960, halton(i, 5), halton(i, 7), 0, 0.5};
+            lf_camera_ray ray;
+            ray.time = 0, ray.wavelength_nm = 0;
+            double w = t->generate_ray(st, &cs, &ray);
+            sink += w;
+            ok += w > 0;
+        }
+        ns[r] = (now() - t0) / n * 1e9;
+        if (sink < 0)
+            printf("?");
+    }
+    *through = (double)ok / n;
+    t->destroy(st);
+    return median(ns, REPEATS);
+}
+
+int main(int argc, char **argv)
+{
+    long n = argc > 1 ? atol(argv[1]) : 400000;
+    if (n <= 0)
+        n = 400000;
+    samples = malloc(sizeof(double) * 4 * (size_t)n);
+    if (!samples)
+        return 1;
+    n_samples = n;
+    for (long i = 0; i < n; i++)
+        for (int d = 0; d < 4; d++)
+            samples[4 * i + d] = halton_slow(i + 1, (int[]){2, 3, 5, 7}[d]);
+    static const char *const lenses[] = {"dgauss.50mm.dat", "dgauss.100mm.dat", "wide.22mm.dat",
+                                         "telephoto.250mm.dat", "fisheye.10mm.dat"};
+    const double film_w = 36, film_h = 24, film_r = 0.5 * 43.2666;
+    double setup, thr;
+    double pin = camera_ns("perspective", NULL, n, &setup, &thr);
+    double thin = lf_camera_find("thinlens") ? camera_ns("thinlens", NULL, n, &setup, &thr) : -1;
+    printf("bench_lens_rays: %ld rays per repeat, median of %d; full-frame film, wide open, focus 3 m\n", n, REPEATS);
+    printf("pinhole (perspective) camera: %.1f ns/ray\n", pin);
+    if (thin > 0)
+        printf("thinlens camera:              %.1f ns/ray\n", thin);
+    printf("\n%-20s %9s %9s %9s %9s %9s %10s %10s %8s\n", "lens", "pupil s", "ns bound", "useful", "ns disk",
+           "useful", "camera ns", "x pinhole", "setup s");
+    for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
+        char path[1024], err[1024];
+        snprintf(path, sizeof path, LF_SOURCE_DIR "/scenes/lenses/%s", lenses[k]);
+        lf_lens L;
+        if (lf_lens_load(path, &L, err, sizeof err)) {
+            fprintf(stderr, "%s\n", err);
+            return 1;
+        }
+        lf_lens_set_stop_diameter(&L, 1e3, NULL, 0);
+        if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, err, sizeof err)) {
+            fprintf(stderr, "%s\n", err);
+            return 1;
+        }
+        lf_lens_pupil P;
+        double build[REPEATS];
+        for (int r = 0; r < REPEATS; r++) {
+            double t0 = now();
+            lf_lens_pupil_build(&L, film_r, 0, &P);
+            build[r] = now() - t0;
+        }
+        double ns[2], useful[2];
+        for (int mode = 0; mode < 2; mode++) {
+            double t[REPEATS];
+            long traced = 0, passed = 0;
+            for (int r = 0; r < REPEATS; r++) {
+                traced = passed = 0;
+                double t0 = now();
+                for (long i = 0; i < n; i++) {
+                    double fx = (halton(i, 2) - 0.5) * film_w, fy = (halton(i, 3) - 0.5) * film_h;
+                    double u = halton(i, 5), v = halton(i, 7), rx, ry;
+                    if (mode == 0 && !(lf_lens_pupil_sample(&P, fx, fy, u, v, &rx, &ry) > 0))
+                        continue; /* no light at this film point: nothing traced */
+                    traced++;
+                    lf_lens_ray out;
+                    passed += lf_lens_sample_ray(&L, &P, mode == 0, fx, fy, u, v, NULL, &out) > 0;
+                }
+                t[r] = (now() - t0) / n * 1e9;
+            }
+            ns[mode] = median(t, REPEATS);
+            useful[mode] = traced ? (double)passed / traced : 0;
+        }
+        double cam = camera_ns("realistic", path, n, &setup, &thr);
+        printf("%-20s %9.3f %9.1f %8.1f%% %9.1f %8.1f%% %10.1f %10.1f %8.3f\n", lenses[k], median(build, REPEATS),
+               ns[0], 100 * useful[0], ns[1], 100 * useful[1], cam, cam / pin, setup);
+        lf_lens_free(&L);
+    }
+    printf("\npupil s: exit-pupil bound precomputation (64 bins x 16 strips); ns bound / ns disk: lens.c sampling\n"
+           "+ tracing per film sample with the bounds / over the whole rear disk; useful: rays that get through\n"
+           "among those traced; camera ns: the registered \"realistic\" camera's generate_ray (raster -> camera\n"
+           "space); setup s: its create() (parse, focus, bounds, useful-fraction estimate)\n");
+    return 0;
+}

@@ -25,7 +25,8 @@ enum {
     LF_ERR_UNSUPPORTED = 4,
     LF_ERR_NOMEM = 5,
     LF_ERR_NUMERIC = 6,   /* NaN/Inf or out-of-range numbers */
-    LF_ERR_INTERNAL = 7
+    LF_ERR_INTERNAL = 7,
+    LF_ERR_INTERRUPTED = 8 /* stopped on request (SIGINT/SIGTERM); state was saved */
 };
 
 typedef struct lf_error {

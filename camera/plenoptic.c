@@ -277,7 +277,7 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     c->pixel = c->sensor_w / c->width;
     if (fabs(c->sensor_h * 1e3 - c->nominal_h_mm) > 0.01 * c->nominal_h_mm)
         warn(a,
-             "plenoptic: the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to "
+             "the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to "
              "the image width, pixels are square)",
              c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm, c->sensor_h * 1e3);
 
@@ -342,12 +342,12 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     c->overlap_ratio = (D + c->pitch) * c->mla_focal / (c->pitch * (zi + c->mla_focal));
     if (c->overlap_ratio > 1.01)
         warn(a,
-             "plenoptic: f-number mismatch: the main lens (image side f/%.3g) is faster than the microlenses (f/%.3g): "
+             "f-number mismatch: the main lens (image side f/%.3g) is faster than the microlenses (f/%.3g): "
              "microlens images overlap (each is %.1f%% of their spacing; neighbours cross-talk)",
              Nimg, Nmla, 100.0 * c->overlap_ratio);
     else if (c->overlap_ratio < 0.99)
         warn(a,
-             "plenoptic: f-number mismatch: the main lens (image side f/%.3g) is slower than the microlenses (f/%.3g): "
+             "f-number mismatch: the main lens (image side f/%.3g) is slower than the microlenses (f/%.3g): "
              "microlens images leave gaps (each is %.1f%% of their spacing; pixels between them stay dark)",
              Nimg, Nmla, 100.0 * c->overlap_ratio);
     *state = c;

@@ -37,6 +37,15 @@ typedef struct lf_render_opts {
     lf_progress_fn progress;
     void *progress_ctx;
     const char *scene_path; /* for metadata and the camera's scene_dir */
+    /* Splitting and fault tolerance (docs/distributed.md) */
+    int spp_begin, spp_end; /* render only sample indices [begin, end); end 0: all */
+    int tile_index, tile_count; /* render only row band tile_index of tile_count; count 0: all */
+    int part;             /* output a mergeable part: RGB preview + exact accumulator channels */
+    const char *checkpoint_path; /* write the film here atomically every checkpoint_every s */
+    double checkpoint_every;
+    int resume;           /* continue from checkpoint_path (same scene and settings) */
+    volatile int *stop;   /* set non-zero (e.g. from a signal handler) to stop after the tiles
+                           * in flight, write a final checkpoint and return LF_ERR_INTERRUPTED */
     int white;            /* render the white image: the camera and film of the scene looking at
                            * a uniform environment of radiance 1 and nothing else (flat field for
                            * devignetting and light-field calibration) */
@@ -50,6 +59,10 @@ typedef struct lf_renderer lf_renderer;
  * Every parameter the scene wrote must be read by someone, or this fails
  * with the file:line:col of the first unused one. */
 int lf_renderer_create(lf_scene_desc *desc, const lf_render_opts *opts, lf_renderer **out, lf_error *err);
+/* Replaces the run-time options (checkpointing, stop flag, progress) before
+ * rendering; scene-shaping options (crop, tiles, sample range, spp, seed,
+ * white) keep the values given at create. */
+void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts);
 /* Non-fatal notes gathered while building ("file:line:col: warning: ..."), or NULL. */
 const char *lf_renderer_warnings(const lf_renderer *r);
 /* The effect plan: camera model, which effects are simulated and why. malloc'ed. */
@@ -58,6 +71,12 @@ char *lf_renderer_explain(const lf_renderer *r);
  * with lensfield:* attributes.  Samples whose radiance is NaN/Inf are
  * dropped and counted (lensfield:nonfinite_samples, lf_renderer_stats). */
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err);
+/* Merges part files written with opts.part (sample ranges and/or row bands
+ * of the same scene and settings) into the image an unsplit render gives,
+ * bit for bit: parts carry exact fixed-point sums.  Checks that the parts
+ * agree and that every pixel gets every sample exactly once. */
+int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *meta, lf_error *err);
+
 /* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
 const char *lf_renderer_film_filename(const lf_renderer *r);
 /* Film "savefp16" (pbrt default true): store EXR channels as half floats. */

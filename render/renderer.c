@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #if defined(__SSE__) || defined(__x86_64__)
 #include <pmmintrin.h>
@@ -16,6 +17,7 @@
 #endif
 
 #include "../base/lf_color.h"
+#include "film.h"
 #include "render_internal.h"
 
 #define LF_VERSION_STRING "lensfield 0.1"
@@ -59,6 +61,10 @@ struct lf_renderer {
     int has_curve;
     lf_distrib1d curve;       /* shutter efficiency over the exposure, importance sampled */
     double curve_mean;        /* mean efficiency: the effective fraction of the exposure */
+    /* splitting and checkpoints */
+    int spp_begin, spp_end;   /* sample index range rendered */
+    char settings[1024];      /* what must agree between parts of one render */
+    char scene_hash[32];
 };
 
 lf_render_opts lf_render_opts_default(void)
@@ -479,6 +485,45 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     if (opts->crop[1] > opts->crop[0]) {
         r->px0 = opts->crop[0], r->px1 = opts->crop[1], r->py0 = opts->crop[2], r->py1 = opts->crop[3];
     }
+    if (opts->tile_count > 0) {
+        /* row band tile_index of tile_count within the crop window */
+        if (opts->tile_index < 0 || opts->tile_index >= opts->tile_count) {
+            lf_error_set(err, LF_ERR_PARAM, "tile %d/%d: the index must be in 0..%d", opts->tile_index,
+                         opts->tile_count, opts->tile_count - 1);
+            goto fail;
+        }
+        int rows = r->py1 - r->py0;
+        int y0 = r->py0 + (int)((long long)rows * opts->tile_index / opts->tile_count);
+        int y1 = r->py0 + (int)((long long)rows * (opts->tile_index + 1) / opts->tile_count);
+        r->py0 = y0, r->py1 = y1;
+    }
+    r->spp_begin = 0;
+    r->spp_end = r->sampler.spp;
+    if (opts->spp_end > 0) {
+        if (opts->spp_begin < 0 || opts->spp_begin >= opts->spp_end || opts->spp_end > r->sampler.spp) {
+            lf_error_set(err, LF_ERR_PARAM, "sample range [%d, %d) is not within the %d samples per pixel",
+                         opts->spp_begin, opts->spp_end, r->sampler.spp);
+            goto fail;
+        }
+        r->spp_begin = opts->spp_begin;
+        r->spp_end = opts->spp_end;
+    }
+    /* What parts of one render must share (checked by merge and resume). */
+    {
+        uint64_t hsh = 1469598103934665603ull;
+        FILE *f = opts->scene_path ? fopen(opts->scene_path, "rb") : NULL;
+        if (f) {
+            int ch;
+            while ((ch = fgetc(f)) != EOF)
+                hsh = (hsh ^ (uint64_t)(unsigned char)ch) * 1099511628211ull;
+            fclose(f);
+        }
+        snprintf(r->scene_hash, sizeof r->scene_hash, "%016llx", (unsigned long long)hsh);
+        snprintf(r->settings, sizeof r->settings,
+                 "scene %s; film %dx%d; camera %s; spp %d; seed %u; sampler %s; filter %s; maxdepth %d; white %d",
+                 r->scene_hash, r->xres, r->yres, r->camera_name, r->sampler.spp, r->sampler.seed, r->sampler_name,
+                 r->filter_name, r->integrator.max_depth, opts->white);
+    }
     if (r->px0 < 0 || r->py0 < 0 || r->px1 > r->xres || r->py1 > r->yres || r->px1 <= r->px0 || r->py1 <= r->py0) {
         lf_error_set(err, LF_ERR_PARAM, "crop window [%d,%d) x [%d,%d) is empty or outside the %dx%d film", r->px0,
                      r->px1, r->py0, r->py1, r->xres, r->yres);
@@ -510,6 +555,16 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
 fail:
     lf_renderer_free(r);
     return err && err->code ? err->code : LF_ERR_INTERNAL;
+}
+
+void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts)
+{
+    r->opts.checkpoint_path = opts->checkpoint_path;
+    r->opts.checkpoint_every = opts->checkpoint_every;
+    r->opts.resume = opts->resume;
+    r->opts.stop = opts->stop;
+    r->opts.progress = opts->progress;
+    r->opts.progress_ctx = opts->progress_ctx;
 }
 
 const char *lf_renderer_warnings(const lf_renderer *r)
@@ -656,9 +711,13 @@ enum { TILE = 16 };
 typedef struct job {
     lf_renderer *r;
     lf_image *img;
+    lf_pixel_acc *acc;        /* per-pixel sums when writing parts or checkpoints, else NULL */
     int tiles_x, tiles_y;
     atomic_int next_tile;
     atomic_long done_tiles;
+    atomic_uchar *tile_done;  /* 1 once a tile's pixels are final */
+    int *order;               /* tiles still to render, in order */
+    int n_order;
     atomic_llong rays, paths, nonfinite, zero_weight;
     pthread_mutex_t progress_lock;
 } job;
@@ -698,8 +757,8 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
     float scale = (float)r->imaging_ratio;
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
-            double sum[3] = {0, 0, 0}, wsum = 0;
-            for (int i = 0; i < r->sampler.spp; i++) {
+            lf_pixel_acc acc = {{0, 0, 0, 0}};
+            for (int i = r->spp_begin; i < r->spp_end; i++) {
                 lf_sample_stream st;
                 lf_sample_start(&st, &r->sampler, x, y, (uint32_t)i);
                 double fu, fv, dx, dy;
@@ -730,7 +789,7 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                 cr.wavelength_nm = 0;
                 double w = ct->generate_ray(r->camera, &cs, &cr);
                 (*paths)++;
-                wsum += fw;
+                acc.v[3] += lf_acc_quantize(fw);
                 if (!(w > 0) || !isfinite(w)) {
                     (*zero_weight)++;
                     continue;
@@ -759,11 +818,16 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                     if (m > r->max_component)
                         L = lf_scale(L, (float)(r->max_component / m));
                 }
-                sum[0] += fw * L.x, sum[1] += fw * L.y, sum[2] += fw * L.z;
+                /* exact fixed-point sums: split renders merge bit-identically */
+                acc.v[0] += lf_acc_quantize(fw * L.x);
+                acc.v[1] += lf_acc_quantize(fw * L.y);
+                acc.v[2] += lf_acc_quantize(fw * L.z);
             }
             float *px = lf_image_px(jb->img, x - r->px0, y - r->py0);
             for (int c = 0; c < 3; c++)
-                px[c] = wsum != 0 ? (float)(sum[c] / wsum) : 0.f;
+                px[c] = lf_acc_value(&acc, c);
+            if (jb->acc)
+                jb->acc[(size_t)(y - r->py0) * jb->img->width + (x - r->px0)] = acc;
         }
 }
 
@@ -777,11 +841,16 @@ static void *worker(void *arg)
 #endif
     long long rays = 0, paths = 0, nonfinite = 0, zero_weight = 0;
     int total = jb->tiles_x * jb->tiles_y;
+    volatile int *stop = jb->r->opts.stop;
     for (;;) {
-        int t = atomic_fetch_add(&jb->next_tile, 1);
-        if (t >= total)
+        if (stop && *stop)
             break;
+        int k = atomic_fetch_add(&jb->next_tile, 1);
+        if (k >= jb->n_order)
+            break;
+        int t = jb->order[k];
         render_tile(jb, t, &rays, &paths, &nonfinite, &zero_weight);
+        atomic_store_explicit(&jb->tile_done[t], 1, memory_order_release);
         long done = atomic_fetch_add(&jb->done_tiles, 1) + 1;
         if (jb->r->opts.progress) {
             pthread_mutex_lock(&jb->progress_lock);
@@ -825,6 +894,149 @@ static double now_seconds(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+/* ---- parts and checkpoints ---- */
+
+/* The image written for parts and checkpoints: RGB preview, then the four
+ * accumulators as 24-bit limbs (film.h). */
+static int acc_image(const job *jb, const unsigned char *done, lf_image *out, lf_error *err)
+{
+    const lf_image *img = jb->img;
+    if (lf_image_alloc(out, img->width, img->height, 3 + LF_ACC_CHANNELS, err))
+        return err->code;
+    for (int ty = 0; ty < jb->tiles_y; ty++)
+        for (int tx = 0; tx < jb->tiles_x; tx++) {
+            int t = ty * jb->tiles_x + tx;
+            if (done && !done[t])
+                continue;
+            for (int y = ty * TILE; y < (ty + 1) * TILE && y < img->height; y++)
+                for (int x = tx * TILE; x < (tx + 1) * TILE && x < img->width; x++) {
+                    float *o = lf_image_px(out, x, y);
+                    const lf_pixel_acc *a = &jb->acc[(size_t)y * img->width + x];
+                    for (int c = 0; c < 3; c++)
+                        o[c] = lf_acc_value(a, c);
+                    for (int k = 0; k < 4; k++)
+                        lf_acc_to_limbs(a->v[k], o + 3 + LF_ACC_LIMBS * k);
+                }
+        }
+    return 0;
+}
+
+static void done_tiles_hex(const job *jb, const unsigned char *done, char *buf, size_t n)
+{
+    int total = jb->tiles_x * jb->tiles_y;
+    size_t k = 0;
+    for (int t = 0; t < total && k + 1 < n; t += 4) {
+        int v = 0;
+        for (int b = 0; b < 4 && t + b < total; b++)
+            if (done[t + b])
+                v |= 1 << b;
+        buf[k++] = "0123456789abcdef"[v];
+    }
+    buf[k] = '\0';
+}
+
+static void part_attrs(const lf_renderer *r, lf_attrs *meta)
+{
+    lf_attrs_set_string(meta, "lensfield:settings", r->settings);
+    lf_attrs_set_int(meta, "lensfield:spp_begin", r->spp_begin);
+    lf_attrs_set_int(meta, "lensfield:spp_end", r->spp_end);
+    lf_attrs_set_int(meta, "lensfield:spp_total", r->sampler.spp);
+    float res[2] = {(float)r->xres, (float)r->yres};
+    lf_attrs_set_floats(meta, "lensfield:full_resolution", res, 2);
+    float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
+    lf_attrs_set_floats(meta, "lensfield:pixel_bounds", crop, 4);
+}
+
+static int write_checkpoint(const lf_renderer *r, const job *jb, lf_error *err)
+{
+    /* One snapshot of which tiles are final, used for both the pixels and
+     * the list, so a tile finishing meanwhile cannot be listed without its
+     * pixels. */
+    int ntiles = jb->tiles_x * jb->tiles_y;
+    unsigned char *done = malloc((size_t)ntiles);
+    if (!done)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    for (int t = 0; t < ntiles; t++)
+        done[t] = atomic_load_explicit(&jb->tile_done[t], memory_order_acquire);
+    lf_image ck;
+    if (acc_image(jb, done, &ck, err)) {
+        free(done);
+        return err->code;
+    }
+    lf_attrs a = {0};
+    part_attrs(r, &a);
+    int total = jb->tiles_x * jb->tiles_y;
+    char *hex = malloc((size_t)total / 4 + 2);
+    if (!hex) {
+        free(done);
+        lf_image_free(&ck);
+        lf_attrs_free(&a);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    done_tiles_hex(jb, done, hex, (size_t)total / 4 + 2);
+    free(done);
+    lf_attrs_set_string(&a, "lensfield:done_tiles", hex);
+    lf_attrs_set_int(&a, "lensfield:checkpoint", 1);
+    free(hex);
+    lf_write_opts wo = {0};
+    int rc = lf_image_write(r->opts.checkpoint_path, &ck, &a, &wo, err);
+    lf_image_free(&ck);
+    lf_attrs_free(&a);
+    return rc;
+}
+
+/* Loads a checkpoint written by the same scene and settings: its finished
+ * tiles are copied and skipped. */
+static int load_checkpoint(lf_renderer *r, job *jb, lf_error *err)
+{
+    lf_image ck;
+    lf_attrs a = {0};
+    lf_error e = {0};
+    if (lf_image_read(r->opts.checkpoint_path, &ck, &a, &e))
+        return lf_error_set(err, e.code, "cannot resume: %s", e.msg);
+    const lf_attr *st = lf_attrs_get(&a, "lensfield:settings"), *hex = lf_attrs_get(&a, "lensfield:done_tiles");
+    const lf_attr *b0 = lf_attrs_get(&a, "lensfield:spp_begin"), *b1 = lf_attrs_get(&a, "lensfield:spp_end");
+    const lf_attr *pb = lf_attrs_get(&a, "lensfield:pixel_bounds");
+    int ok = st && st->type == LF_ATTR_STRING && !strcmp(st->s, r->settings) && hex && hex->type == LF_ATTR_STRING &&
+             b0 && b1 && b0->i == r->spp_begin && b1->i == r->spp_end && pb && pb->n == 4 && pb->v[0] == r->px0 &&
+             pb->v[1] == r->px1 && pb->v[2] == r->py0 && pb->v[3] == r->py1 && ck.width == jb->img->width &&
+             ck.height == jb->img->height && ck.channels == 3 + LF_ACC_CHANNELS;
+    if (!ok) {
+        lf_image_free(&ck);
+        lf_attrs_free(&a);
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "cannot resume from %s: it was written by a different scene, settings, sample range or "
+                            "crop",
+                            r->opts.checkpoint_path);
+    }
+    int total = jb->tiles_x * jb->tiles_y;
+    size_t nhex = strlen(hex->s);
+    for (int t = 0; t < total; t++) {
+        size_t k = (size_t)t / 4;
+        if (k >= nhex)
+            break;
+        char ch = hex->s[k];
+        int v = ch >= '0' && ch <= '9' ? ch - '0' : (ch >= 'a' && ch <= 'f' ? ch - 'a' + 10 : 0);
+        if (!(v & (1 << (t % 4))))
+            continue;
+        int tx = t % jb->tiles_x, ty = t / jb->tiles_x;
+        for (int y = ty * TILE; y < (ty + 1) * TILE && y < ck.height; y++)
+            for (int x = tx * TILE; x < (tx + 1) * TILE && x < ck.width; x++) {
+                const float *in = lf_image_px(&ck, x, y);
+                lf_pixel_acc *acc = &jb->acc[(size_t)y * ck.width + x];
+                for (int c = 0; c < 4; c++)
+                    acc->v[c] = lf_acc_from_limbs(in + 3 + LF_ACC_LIMBS * c);
+                float *px = lf_image_px(jb->img, x, y);
+                for (int c = 0; c < 3; c++)
+                    px[c] = lf_acc_value(acc, c);
+            }
+        atomic_store(&jb->tile_done[t], 1);
+    }
+    lf_image_free(&ck);
+    lf_attrs_free(&a);
+    return 0;
+}
+
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err)
 {
     int w = r->px1 - r->px0, h = r->py1 - r->py0;
@@ -836,27 +1048,105 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     jb.img = img;
     jb.tiles_x = (w + TILE - 1) / TILE;
     jb.tiles_y = (h + TILE - 1) / TILE;
+    int total = jb.tiles_x * jb.tiles_y;
+    jb.tile_done = calloc((size_t)total, sizeof *jb.tile_done);
+    jb.order = malloc(sizeof(int) * (size_t)total);
+    int need_acc = r->opts.part || r->opts.checkpoint_path;
+    if (need_acc)
+        jb.acc = calloc((size_t)w * h, sizeof *jb.acc);
+    if (!jb.tile_done || !jb.order || (need_acc && !jb.acc)) {
+        free(jb.tile_done), free(jb.order), free(jb.acc);
+        lf_image_free(img);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %dx%d film", w, h);
+    }
+    struct stat ck_stat;
+    int have_checkpoint = r->opts.checkpoint_path && stat(r->opts.checkpoint_path, &ck_stat) == 0;
+    /* --resume without a checkpoint yet (killed before the first one) starts over */
+    if (r->opts.resume && have_checkpoint && load_checkpoint(r, &jb, err)) {
+        free(jb.tile_done), free(jb.order), free(jb.acc);
+        lf_image_free(img);
+        return err->code;
+    }
+    for (int t = 0; t < total; t++)
+        if (!atomic_load(&jb.tile_done[t]))
+            jb.order[jb.n_order++] = t;
+    atomic_store(&jb.done_tiles, total - jb.n_order);
     pthread_mutex_init(&jb.progress_lock, NULL);
     double t0 = now_seconds();
     int nt = r->threads;
     pthread_t *th = calloc((size_t)nt, sizeof *th);
     if (!th) {
+        free(jb.tile_done), free(jb.order), free(jb.acc);
         lf_image_free(img);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
-    int started = 0;
-    for (int i = 1; i < nt; i++)
-        if (pthread_create(&th[i], NULL, worker, &jb) == 0)
-            started++;
-        else
-            th[i] = 0;
-    worker(&jb);
-    for (int i = 1; i < nt; i++)
-        if (th[i])
-            pthread_join(th[i], NULL);
+    int rc = 0;
+    if (!r->opts.checkpoint_path) {
+        /* the calling thread renders too */
+        for (int i = 1; i < nt; i++)
+            if (pthread_create(&th[i], NULL, worker, &jb) != 0)
+                th[i] = 0;
+        worker(&jb);
+        for (int i = 1; i < nt; i++)
+            if (th[i])
+                pthread_join(th[i], NULL);
+    } else {
+        /* the calling thread watches: periodic checkpoints and stop requests */
+        int started = 0;
+        for (int i = 0; i < nt; i++)
+            if (pthread_create(&th[i], NULL, worker, &jb) == 0)
+                started++;
+            else
+                th[i] = 0;
+        if (!started)
+            worker(&jb);
+        double last = now_seconds();
+        for (;;) {
+            long done = atomic_load(&jb.done_tiles);
+            if (done >= total || (r->opts.stop && *r->opts.stop) || !started)
+                break;
+            struct timespec ts = {0, 20 * 1000 * 1000};
+            nanosleep(&ts, NULL);
+            if (r->opts.checkpoint_every > 0 && now_seconds() - last >= r->opts.checkpoint_every) {
+                lf_error cerr = {0};
+                if (write_checkpoint(r, &jb, &cerr) && !rc)
+                    rc = lf_error_set(err, cerr.code, "checkpoint: %s", cerr.msg);
+                last = now_seconds();
+            }
+        }
+        for (int i = 0; i < nt; i++)
+            if (th[i])
+                pthread_join(th[i], NULL);
+        if (atomic_load(&jb.done_tiles) < total) {
+            /* stopped: the final checkpoint holds every finished tile */
+            lf_error cerr = {0};
+            if (write_checkpoint(r, &jb, &cerr))
+                rc = lf_error_set(err, cerr.code, "final checkpoint: %s", cerr.msg);
+            else
+                rc = lf_error_set(err, LF_ERR_INTERRUPTED,
+                                  "interrupted with %ld of %d tiles done; checkpoint written to %s (continue with "
+                                  "--resume)",
+                                  atomic_load(&jb.done_tiles), total, r->opts.checkpoint_path);
+        }
+    }
     free(th);
-    (void)started;
     pthread_mutex_destroy(&jb.progress_lock);
+    if (!rc && r->opts.part) {
+        lf_image part;
+        if (acc_image(&jb, NULL, &part, err))
+            rc = err->code;
+        else {
+            lf_image_free(img);
+            *img = part;
+        }
+    }
+    free(jb.tile_done);
+    free(jb.order);
+    free(jb.acc);
+    if (rc) {
+        lf_image_free(img);
+        return rc;
+    }
     r->stats.seconds = now_seconds() - t0;
     r->stats.rays = jb.rays;
     r->stats.camera_paths = jb.paths;
@@ -867,7 +1157,13 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
         lf_attrs_set_string(meta, "lensfield:camera", r->camera_name);
         if (r->scene_path)
             lf_attrs_set_string(meta, "lensfield:scene", r->scene_path);
-        lf_attrs_set_int(meta, "lensfield:spp", r->sampler.spp);
+        lf_attrs_set_int(meta, "lensfield:spp", r->spp_end - r->spp_begin);
+        lf_attrs_set_string(meta, "lensfield:scene_hash", r->scene_hash);
+        lf_attrs_set_int(meta, "lensfield:savefp16", r->save_half);
+        if (r->opts.part) {
+            lf_attrs_set_int(meta, "lensfield:part", 1);
+            part_attrs(r, meta);
+        }
         lf_attrs_set_int(meta, "lensfield:seed", (int)r->sampler.seed);
         lf_attrs_set_string(meta, "lensfield:sampler", r->sampler_name);
         lf_attrs_set_string(meta, "lensfield:filter", r->filter_name);

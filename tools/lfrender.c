@@ -2,17 +2,23 @@
  *
  * usage: lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [--spp N] [--threads N]
  *                 [--seed S] [--crop x0 x1 y0 y1] [--quiet] [--explain] [--white]
+ *                 [--spp-range A B] [--tile I/N] [--part]
+ *                 [--checkpoint-every SECONDS] [--checkpoint PATH] [--resume]
  *                 [--camera-plugin LIB.so]...
+ *        lfrender merge PART.exr... -o OUT.exr
  *
  * Exit codes: 0 success; 1 the scene or the render failed (message names
- * file:line:column); 2 bad command line.  No output file is written on
+ * file:line:column); 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
+ * after writing a checkpoint that --resume continues from.  No output file is written on
  * failure, and outputs are replaced atomically.
  */
 #include <errno.h>
+#include <signal.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -37,7 +43,16 @@ static void usage(FILE *f)
                "  --explain         print the effect plan and exit without rendering\n"
                "  --white           render the white image: same camera and film, a uniform\n"
                "                    environment of radiance 1 and nothing else (flat field)\n"
-               "  --camera-plugin L load camera types from the shared object L\n");
+               "  --spp-range A B   render only sample indices [A, B) of every pixel (a mergeable part)\n"
+               "  --tile I/N        render only row band I of N (0-based; a mergeable part)\n"
+               "  --part            write a mergeable part even without a split\n"
+               "  --checkpoint-every S  save the film every S seconds (default path OUT.checkpoint.exr);\n"
+               "                    SIGINT/SIGTERM save a final checkpoint and exit 130\n"
+               "  --checkpoint PATH where checkpoints go\n"
+               "  --resume          continue from the checkpoint (same scene and settings)\n"
+               "  --camera-plugin L load camera types from the shared object L\n"
+               "\n"
+               "       lfrender merge PART.exr... -o OUT.exr   sum parts into the unsplit image, bit for bit\n");
 }
 
 static int parse_int(const char *s, long lo, long hi, long *out)
@@ -127,9 +142,66 @@ static int check_writable(const char *path, char *msg, size_t n)
     return 0;
 }
 
+static volatile int stop_requested;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
+
+static int merge_main(int argc, char **argv)
+{
+    const char *out = NULL;
+    const char **parts = calloc((size_t)argc, sizeof *parts);
+    int n = 0;
+    if (!parts)
+        return 1;
+    for (int i = 2; i < argc; i++) {
+        if (!strcmp(argv[i], "-o") && i + 1 < argc)
+            out = argv[++i];
+        else if (argv[i][0] == '-') {
+            fprintf(stderr, "lfrender merge: unknown option \"%s\"\nusage: lfrender merge PART.exr... -o OUT.exr\n",
+                    argv[i]);
+            free(parts);
+            return 2;
+        } else
+            parts[n++] = argv[i];
+    }
+    if (!out || !n) {
+        fprintf(stderr, "usage: lfrender merge PART.exr... -o OUT.exr\n");
+        free(parts);
+        return 2;
+    }
+    lf_error err = {0};
+    lf_image img;
+    lf_attrs meta = {0};
+    int rc = lf_render_merge(parts, n, &img, &meta, &err);
+    if (!rc) {
+        /* write as the unsplit render would: Film "savefp16" travels in the parts */
+        lf_write_opts wo = {0};
+        const lf_attr *h = lf_attrs_get(&meta, "lensfield:savefp16");
+        wo.half = h && h->type == LF_ATTR_INT && h->i;
+        for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
+            if (img.data[k] > 65504.f)
+                wo.half = 0;
+        rc = lf_image_write(out, &img, &meta, &wo, &err);
+        lf_image_free(&img);
+    }
+    lf_attrs_free(&meta);
+    free(parts);
+    if (rc) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
+        return 1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    const char *scene = NULL, *out = NULL;
+    if (argc > 1 && !strcmp(argv[1], "merge"))
+        return merge_main(argc, argv);
+    const char *scene = NULL, *out = NULL, *checkpoint = NULL;
     lf_render_opts o = lf_render_opts_default();
     int quiet = 0, explain = 0;
     for (int i = 1; i < argc; i++) {
@@ -179,6 +251,36 @@ int main(int argc, char **argv)
             explain = 1;
         } else if (!strcmp(a, "--white")) {
             o.white = 1;
+        } else if (!strcmp(a, "--part")) {
+            o.part = 1;
+        } else if (!strcmp(a, "--resume")) {
+            o.resume = 1;
+        } else if (!strcmp(a, "--checkpoint") && i + 1 < argc) {
+            checkpoint = argv[++i];
+        } else if (!strcmp(a, "--checkpoint-every") && i + 1 < argc) {
+            char *end;
+            double v = strtod(argv[++i], &end);
+            if (*end || !(v > 0)) {
+                fprintf(stderr, "lfrender: --checkpoint-every expects seconds > 0, got \"%s\"\n", argv[i]);
+                return 2;
+            }
+            o.checkpoint_every = v;
+        } else if (!strcmp(a, "--spp-range") && i + 2 < argc) {
+            long b0, b1;
+            if (parse_int(argv[i + 1], 0, 1 << 24, &b0) || parse_int(argv[i + 2], 1, 1 << 24, &b1) || b1 <= b0) {
+                fprintf(stderr, "lfrender: --spp-range expects A B with 0 <= A < B\n");
+                return 2;
+            }
+            o.spp_begin = (int)b0, o.spp_end = (int)b1, o.part = 1;
+            i += 2;
+        } else if (!strcmp(a, "--tile") && i + 1 < argc) {
+            int ti, tn;
+            char extra;
+            if (sscanf(argv[++i], "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn) {
+                fprintf(stderr, "lfrender: --tile expects I/N with 0 <= I < N, got \"%s\"\n", argv[i]);
+                return 2;
+            }
+            o.tile_index = ti, o.tile_count = tn, o.part = 1;
         } else if (!strcmp(a, "--camera-plugin") && i + 1 < argc) {
             char msg[1024];
             if (lf_camera_load_plugin(argv[++i], msg, sizeof msg)) {
@@ -199,6 +301,14 @@ int main(int argc, char **argv)
     if (!scene) {
         usage(stderr);
         return 2;
+    }
+    if (o.checkpoint_every > 0 || o.resume || checkpoint) {
+        /* from here on, SIGINT/SIGTERM stop the render and save a checkpoint */
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigaction(SIGINT, &sa, NULL);
+        sigaction(SIGTERM, &sa, NULL);
     }
     lf_error err = {0};
     lf_scene_desc desc;
@@ -228,6 +338,23 @@ int main(int argc, char **argv)
     }
     if (!out)
         out = lf_renderer_film_filename(r);
+    if (o.part && (strlen(out) < 4 || strcasecmp(out + strlen(out) - 4, ".exr"))) {
+        fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
+        lf_renderer_free(r);
+        lf_scene_desc_free(&desc);
+        return 2;
+    }
+    char ckpath[4200];
+    if (o.checkpoint_every > 0 || o.resume || checkpoint) {
+        if (!checkpoint) {
+            snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
+            checkpoint = ckpath;
+        }
+        o.checkpoint_path = checkpoint;
+        o.stop = &stop_requested;
+        /* the renderer copied the options at create: hand it the new ones */
+        lf_renderer_set_opts(r, &o);
+    }
     char msg[1200];
     if (check_writable(out, msg, sizeof msg)) {
         fprintf(stderr, "lfrender: %s\n", msg);
@@ -245,7 +372,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
         lf_write_opts wo = {0};
-        wo.half = lf_renderer_film_half(r);
+        wo.half = o.part ? 0 : lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
         if (wo.half) {
             /* Half floats top out at 65504: keep bright renders exact in float. */
             size_t n = (size_t)img.width * img.height * img.channels;
@@ -267,8 +394,10 @@ int main(int argc, char **argv)
     }
     if (rc)
         fprintf(stderr, "lfrender: %s\n", err.msg);
+    else if (o.checkpoint_path)
+        remove(o.checkpoint_path); /* finished: the checkpoint is no longer needed */
     lf_attrs_free(&meta);
     lf_renderer_free(r);
     lf_scene_desc_free(&desc);
-    return rc ? 1 : 0;
+    return rc == LF_ERR_INTERRUPTED ? 130 : (rc ? 1 : 0);
 }

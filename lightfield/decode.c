@@ -26,6 +26,7 @@ void lf_lf_free(lf_lightfield *lf)
         return;
     free(lf->data);
     free(lf->valid);
+    free(lf->half);
     memset(lf, 0, sizeof *lf);
 }
 
@@ -135,14 +136,16 @@ static int decode_lenses(const lf_image *raw, const lf_lf_layout *l, lf_lightfie
     for (int j = 0; j < l->lens_y; j++)
         for (int i = 0; i < l->lens_x; i++) {
             double lx = i * l->pitch_px + (hex && (j & 1) ? l->pitch_px / 2 : 0), ly = j * row;
-            /* counter-clockwise as seen on screen (y down) */
-            double cx = l->offset_px[0] + c * lx + s * ly, cy = l->offset_px[1] - s * lx + c * ly;
+            /* the ordinary rotation matrix applied to pixel coordinates */
+            double cx = l->offset_px[0] + c * lx - s * ly, cy = l->offset_px[1] + s * lx + c * ly;
             for (int iv = 0; iv < n; iv++)
                 for (int iu = 0; iu < n; iu++) {
-                    /* the microlens inverts: view +u (camera right) is pixel offset -u */
+                    /* pixel offset (du, dv) sees the aperture at (du, -dv) (camera space, y
+                     * up; docs/lightfield-format.md): view +u (right) is du > 0, view +v
+                     * (down, camera -y) is dv > 0 */
                     float rgb[3];
                     size_t idx = ((size_t)(iv * n + iu) * lf->nt + j) * lf->ns + i;
-                    if (raw_bilinear(raw, cx - (iu - half), cy - (iv - half), rgb)) {
+                    if (raw_bilinear(raw, cx + (iu - half), cy + (iv - half), rgb)) {
                         memcpy(lf->data + idx * 3, rgb, sizeof rgb);
                     } else {
                         lf->valid[idx] = 0.f;

@@ -18,18 +18,22 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fft_internal.h"
 #include "lf_lightfield.h"
+
+/* Kaiser-Bessel kernel width (taps) and table size */
+enum { KB_WIDTH = 4, KB_TABLE = 4096 };
 
 struct lf_lf_fourier {
     int ns, nt, Ps, Pt, Pu, Pv, nu, nv;
     double cu, cv;     /* half-integer part of the centred view coordinates */
     double wsum;       /* sum of aperture weights */
     double beta;
+    float kb_tab[KB_TABLE + 1];
     double disp_v_per_u;
     float *S;          /* [kt][ks <= Ps/2][mv][mu][ch] complex (re, im) */
 };
 
-enum { KB_WIDTH = 4 };
 
 static double bessel_i0(double x)
 {
@@ -43,12 +47,23 @@ static double bessel_i0(double x)
     return s;
 }
 
-static double kb(double x, double beta)
+static double kb_exact(double x, double beta)
 {
     double r = 2 * x / KB_WIDTH;
     if (fabs(r) >= 1)
         return 0;
     return bessel_i0(beta * sqrt(1 - r * r)) / bessel_i0(beta);
+}
+
+/* Tabulated kernel for the per-frame slice (linear interpolation of 4096
+ * samples over [0, 2]: relative error ~1e-7). */
+static double kb_from(const float *tab, double x)
+{
+    double a = fabs(x) * (KB_TABLE / (KB_WIDTH / 2.0));
+    int i = (int)a;
+    if (i >= KB_TABLE)
+        return 0;
+    return tab[i] + (a - i) * (tab[i + 1] - tab[i]);
 }
 
 /* Continuous transform of the kernel at frequency f (Simpson's rule). */
@@ -59,7 +74,7 @@ static double kb_hat(double f, double beta)
     for (int i = 0; i <= n; i++) {
         double x = -KB_WIDTH / 2.0 + i * h;
         double w = (i == 0 || i == n) ? 1 : (i & 1 ? 4 : 2);
-        s += w * kb(x, beta) * cos(2 * M_PI * x * f);
+        s += w * kb_exact(x, beta) * cos(2 * M_PI * x * f);
     }
     return s * h / 3;
 }
@@ -74,7 +89,7 @@ static int next_pow2(int n)
 
 /* In-place radix-2 FFT of n complex floats with stride (in complex units).
  * sign -1 forward, +1 inverse (unnormalised). */
-static void fft1d(float *a, int n, int stride, int sign)
+void lf_lf_fft1d(float *a, int n, int stride, int sign)
 {
     for (int i = 1, j = 0; i < n; i++) {
         int bit = n >> 1;
@@ -89,8 +104,12 @@ static void fft1d(float *a, int n, int stride, int sign)
     }
     for (int len = 2; len <= n; len <<= 1) {
         double ang = sign * 2 * M_PI / len;
+        /* twiddles by recurrence in double (no trig per butterfly group) */
+        double cr = 1, ci = 0, dr = cos(ang), di = sin(ang);
         for (int k = 0; k < len / 2; k++) {
-            float wr = (float)cos(ang * k), wi = (float)sin(ang * k);
+            float wr = (float)cr, wi = (float)ci;
+            double t = cr * dr - ci * di;
+            ci = cr * di + ci * dr, cr = t;
             for (int i = 0; i < n; i += len) {
                 float *p = a + 2 * (size_t)(i + k) * stride, *q = a + 2 * (size_t)(i + k + len / 2) * stride;
                 float xr = q[0] * wr - q[1] * wi, xi = q[0] * wi + q[1] * wr;
@@ -101,12 +120,12 @@ static void fft1d(float *a, int n, int stride, int sign)
     }
 }
 
-static void fft2d(float *a, int w, int h, int sign)
+void lf_lf_fft2d(float *a, int w, int h, int sign)
 {
     for (int y = 0; y < h; y++)
-        fft1d(a + 2 * (size_t)y * w, w, 1, sign);
+        lf_lf_fft1d(a + 2 * (size_t)y * w, w, 1, sign);
     for (int x = 0; x < w; x++)
-        fft1d(a + 2 * (size_t)x, h, w, sign);
+        lf_lf_fft1d(a + 2 * (size_t)x, h, w, sign);
 }
 
 int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, double oversample, lf_lf_fourier **out,
@@ -132,6 +151,8 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
     double sigma = oversample;
     double b2 = (KB_WIDTH / sigma) * (KB_WIDTH / sigma) * (sigma - 0.5) * (sigma - 0.5) - 0.8;
     f->beta = M_PI * sqrt(b2 > 0.1 ? b2 : 0.1);
+    for (int i = 0; i <= KB_TABLE; i++)
+        f->kb_tab[i] = (float)kb_exact(i * (KB_WIDTH / 2.0) / KB_TABLE, f->beta);
     int hs = f->Ps / 2 + 1;
     size_t nfreq = (size_t)hs * f->Pt, cell = (size_t)f->Pu * f->Pv * 3;
     int nviews = lf->nu * lf->nv;
@@ -180,7 +201,7 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
             for (int t = 0; t < lf->nt; t++)
                 for (int s = 0; s < lf->ns; s++)
                     buf[2 * ((size_t)t * f->Ps + s)] = view[((size_t)t * lf->ns + s) * 3 + ch];
-            fft2d(buf, f->Ps, f->Pt, -1);
+            lf_lf_fft2d(buf, f->Ps, f->Pt, -1);
             float *dst = Lhat + 2 * nfreq * ((size_t)vi * 3 + ch);
             for (int kt = 0; kt < f->Pt; kt++)
                 memcpy(dst + 2 * (size_t)kt * hs, buf + 2 * (size_t)kt * f->Ps, sizeof(float) * 2 * hs);
@@ -258,13 +279,13 @@ int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disp, lf_image *out, lf
         int jv = (int)floor(mv) - 1;
         double kv[KB_WIDTH];
         for (int b = 0; b < KB_WIDTH; b++)
-            kv[b] = kb(mv - (jv + b), f->beta);
+            kv[b] = kb_from(f->kb_tab, mv - (jv + b));
         for (int ks = 0; ks < hs; ks++) {
             double mu = ks * dx * f->Pu / f->Ps;
             int ju = (int)floor(mu) - 1;
             double ku[KB_WIDTH];
             for (int a = 0; a < KB_WIDTH; a++)
-                ku[a] = kb(mu - (ju + a), f->beta);
+                ku[a] = kb_from(f->kb_tab, mu - (ju + a));
             const float *S = f->S + 2 * ((size_t)kt * hs + ks) * cell;
             double acc[3][2] = {{0, 0}, {0, 0}, {0, 0}};
             for (int b = 0; b < KB_WIDTH; b++) {
@@ -295,7 +316,7 @@ int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disp, lf_image *out, lf
                 float *d = p + 2 * ((size_t)kt * f->Ps + ks);
                 d[0] = q[0], d[1] = -q[1];
             }
-        fft2d(p, f->Ps, f->Pt, +1);
+        lf_lf_fft2d(p, f->Ps, f->Pt, +1);
     }
     if (lf_image_alloc(out, f->ns, f->nt, 3, err)) {
         free(spec);

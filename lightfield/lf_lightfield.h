@@ -105,6 +105,7 @@ typedef struct lf_lightfield {
     double disp_at_inf;
     double disp_per_alpha;  /* d = disp_per_alpha * (1 - 1/alpha); 0: alpha unavailable */
     lf_lf_layout layout;
+    uint16_t *half; /* optional IEEE half copy of data (lf_lf_make_half), same layout */
 } lf_lightfield;
 
 static inline float *lf_lf_view(const lf_lightfield *lf, int iu, int iv)
@@ -124,6 +125,11 @@ int lf_lf_plenoptic_views(const lf_lf_layout *lay);
 int lf_lf_decode(const lf_image *raw, const lf_lf_layout *lay, const lf_image *white, lf_lightfield *lf,
                  lf_error *err);
 
+/* Adds (or refreshes) the half-float copy lf->half of lf->data, for
+ * refocusing at half the memory traffic (values round to nearest even;
+ * magnitudes above 65504 become infinite, so refocus refuses such fields). */
+int lf_lf_make_half(lf_lightfield *lf, lf_error *err);
+
 /* Conversions; fail with LF_ERR_PARAM when the layout lacks what they need. */
 int lf_lf_alpha_to_disparity(const lf_lightfield *lf, double alpha, double *disp, lf_error *err);
 int lf_lf_depth_to_disparity(const lf_lightfield *lf, double depth_m, double *disp, lf_error *err);
@@ -137,6 +143,7 @@ typedef struct lf_lf_refocus_opts {
     double aperture_radius;
     int u0, u1, v0, v1;
     int threads; /* <= 0: 2 */
+    int use_half; /* read the half-float copy (lf_lf_make_half): half the memory traffic */
 } lf_lf_refocus_opts;
 lf_lf_refocus_opts lf_lf_refocus_defaults(void);
 int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image *out, lf_error *err);

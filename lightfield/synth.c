@@ -22,8 +22,10 @@ typedef struct synth_ctx {
     const lf_lf_synth_opts *o;
     double R[9];                   /* virtual camera to grid space */
     double in_tan, in_half;        /* data cameras: tan(fov/2), half shorter side (px) */
+    double in_scale;               /* in_half / in_tan */
     double out_tan, out_half;      /* virtual camera */
     double minx, maxy, bx, by;     /* camera grid */
+    double inv_bx, inv_by;
     lf_image *out, *cov;
     int y0, y1;
     size_t uncovered;
@@ -38,6 +40,14 @@ static uint64_t splitmix(uint64_t *s)
 }
 static double rnd(uint64_t *s) { return (splitmix(s) >> 11) * (1.0 / 9007199254740992.0); }
 
+/* sin and cos on [-pi/4, pi/4] by Taylor polynomials (errors < 3e-7). */
+static inline void sincos_quarter(double x, double *sn, double *cs)
+{
+    double x2 = x * x;
+    *sn = x * (1 - x2 / 6 * (1 - x2 / 20 * (1 - x2 / 42 * (1 - x2 / 72))));
+    *cs = 1 - x2 / 2 * (1 - x2 / 12 * (1 - x2 / 30 * (1 - x2 / 56 * (1 - x2 / 90))));
+}
+
 /* Shirley's concentric square-to-disk map. */
 static void concentric(double a, double b, double *x, double *y)
 {
@@ -46,23 +56,25 @@ static void concentric(double a, double b, double *x, double *y)
         *x = *y = 0;
         return;
     }
-    double r, phi;
-    if (fabs(a) > fabs(b))
-        r = a, phi = M_PI / 4 * (b / a);
-    else
-        r = b, phi = M_PI / 2 - M_PI / 4 * (a / b);
-    *x = r * cos(phi), *y = r * sin(phi);
+    double sn, cs;
+    if (fabs(a) > fabs(b)) {
+        sincos_quarter(M_PI / 4 * (b / a), &sn, &cs);
+        *x = a * cs, *y = a * sn;
+    } else {
+        /* phi = pi/2 - theta: cos phi = sin theta, sin phi = cos theta */
+        sincos_quarter(M_PI / 4 * (a / b), &sn, &cs);
+        *x = b * sn, *y = b * cs;
+    }
 }
 
-/* Looks up data camera (i, j) where it sees direction rel (grid space):
- * bilinear inside its own tile only.  Returns 0 when outside its view. */
-static int lookup(const synth_ctx *c, int i, int j, const double rel[3], float rgb[3])
+/* Looks up data camera (i, j) where it sees the point at relative position
+ * (qx, qy) * z (tangents qx = rel.x / rel.z, qy = rel.y / rel.z): bilinear
+ * inside its own tile only.  Returns 0 when outside its view. */
+static inline int lookup(const synth_ctx *c, int i, int j, double qx, double qy, float rgb[3])
 {
     const lf_lightfield *lf = c->lf;
-    if (!(rel[2] > 1e-12))
-        return 0;
-    double px = lf->ns * 0.5 + rel[0] / rel[2] / c->in_tan * c->in_half;
-    double py = lf->nt * 0.5 - rel[1] / rel[2] / c->in_tan * c->in_half;
+    double px = lf->ns * 0.5 + qx * c->in_scale;
+    double py = lf->nt * 0.5 - qy * c->in_scale;
     if (!(px >= 0 && px <= lf->ns && py >= 0 && py <= lf->nt))
         return 0;
     double xi = px - 0.5, yi = py - 0.5;
@@ -97,14 +109,14 @@ static int lookup(const synth_ctx *c, int i, int j, const double rel[3], float r
 
 /* Radiance along one ray (origin o, direction d, focal point f or NULL for
  * infinity), grid space.  Returns 0 when the ray is not covered. */
-static int radiance(const synth_ctx *c, const double o[3], const double d[3], const double *f, float rgb[3])
+static inline int radiance(const synth_ctx *c, const double o[3], const double d[3], const double *f, float rgb[3])
 {
     const lf_lightfield *lf = c->lf;
     if (d[2] == 0)
         return 0;
     double t = -o[2] / d[2];
     double cx = o[0] + t * d[0], cy = o[1] + t * d[1];
-    double fi = lf->nu > 1 ? (cx - c->minx) / c->bx : 0, fj = lf->nv > 1 ? (c->maxy - cy) / c->by : 0;
+    double fi = lf->nu > 1 ? (cx - c->minx) * c->inv_bx : 0, fj = lf->nv > 1 ? (c->maxy - cy) * c->inv_by : 0;
     const double eps = 1e-9;
     if (fi < -eps || fi > lf->nu - 1 + eps || fj < -eps || fj > lf->nv - 1 + eps)
         return 0;
@@ -119,19 +131,31 @@ static int radiance(const synth_ctx *c, const double o[3], const double d[3], co
         j0 = 0;
     double ax = lf->nu > 1 ? fi - i0 : 0, ay = lf->nv > 1 ? fj - j0 : 0;
     double acc[3] = {0, 0, 0}, wsum = 0;
+    /* the focal point is at the same depth for every data camera: one division */
+    double inv_z;
+    if (f) {
+        if (!(f[2] > 1e-12))
+            return 0;
+        inv_z = 1.0 / f[2];
+    } else {
+        if (!(d[2] > 1e-12))
+            return 0;
+        inv_z = 1.0 / d[2];
+    }
     for (int k = 0; k < 4; k++) {
         int i = i0 + (k & 1), j = j0 + (k >> 1);
         double w = (k & 1 ? ax : 1 - ax) * (k & 2 ? ay : 1 - ay);
         if (w <= 0 || i >= lf->nu || j >= lf->nv)
             continue;
-        double C[2] = {lf->nu > 1 ? c->minx + i * c->bx : cx, lf->nv > 1 ? c->maxy - j * c->by : cy};
-        double rel[3];
-        if (f)
-            rel[0] = f[0] - C[0], rel[1] = f[1] - C[1], rel[2] = f[2];
-        else
-            rel[0] = d[0], rel[1] = d[1], rel[2] = d[2];
+        double qx, qy;
+        if (f) {
+            double C0 = lf->nu > 1 ? c->minx + i * c->bx : cx, C1 = lf->nv > 1 ? c->maxy - j * c->by : cy;
+            qx = (f[0] - C0) * inv_z, qy = (f[1] - C1) * inv_z;
+        } else {
+            qx = d[0] * inv_z, qy = d[1] * inv_z;
+        }
         float s[3];
-        if (!lookup(c, i, j, rel, s))
+        if (!lookup(c, i, j, qx, qy, s))
             continue;
         acc[0] += w * s[0], acc[1] += w * s[1], acc[2] += w * s[2];
         wsum += w;
@@ -150,25 +174,35 @@ static void *synth_worker(void *arg)
     int spp = o->spp > 0 ? o->spp : 1;
     int m = (int)ceil(sqrt((double)spp));
     int finite_focus = o->focal_distance > 0;
+    const double out_k = c->out_tan / c->out_half;
+    /* lens strata are a random permutation of the film strata per pixel, so
+     * film and lens positions are uncorrelated */
+    int *perm = malloc(sizeof(int) * (size_t)spp);
+    if (!perm)
+        return NULL;
     for (int y = c->y0; y < c->y1; y++)
         for (int x = 0; x < o->width; x++) {
             uint64_t st = ((uint64_t)o->seed << 40) ^ ((uint64_t)y << 20) ^ (uint64_t)x;
             splitmix(&st);
-            int off = (int)(splitmix(&st) % (uint64_t)spp);
+            for (int k = 0; k < spp; k++)
+                perm[k] = k;
+            for (int k = spp - 1; k > 0; k--) {
+                int r = (int)(((splitmix(&st) >> 32) * (uint64_t)(k + 1)) >> 32), tmp = perm[k];
+                perm[k] = perm[r], perm[r] = tmp;
+            }
             double acc[3] = {0, 0, 0};
             int covered = 0;
             for (int k = 0; k < spp; k++) {
                 double jx = 0.5, jy = 0.5, lu = 0.5, lv = 0.5;
                 if (spp > 1) {
                     jx = (k % m + rnd(&st)) / m, jy = (k / m + rnd(&st)) / m;
-                    int l = (k + off) % spp;
+                    int l = perm[k];
                     lu = (l % m + rnd(&st)) / m, lv = (l / m + rnd(&st)) / m;
                     if (lv >= 1)
                         lv = rnd(&st);
                 }
                 /* camera space: pbrt perspective, fov across the shorter side */
-                double dc[3] = {(x + jx - o->width * 0.5) / c->out_half * c->out_tan,
-                                -(y + jy - o->height * 0.5) / c->out_half * c->out_tan, 1.0};
+                double dc[3] = {(x + jx - o->width * 0.5) * out_k, -(y + jy - o->height * 0.5) * out_k, 1.0};
                 double pl[3] = {0, 0, 0};
                 if (o->lens_radius > 0) {
                     concentric(lu, lv, &pl[0], &pl[1]);
@@ -205,6 +239,7 @@ static void *synth_worker(void *arg)
             if (!covered)
                 c->uncovered++;
         }
+    free(perm);
     return NULL;
 }
 
@@ -244,10 +279,12 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
                 c.R[i * 3 + j] += Rz[i * 3 + k] * T[k * 3 + j];
         }
     c.in_tan = tan(l->fov_deg * M_PI / 360), c.in_half = 0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt);
+    c.in_scale = c.in_half / c.in_tan;
     c.out_tan = tan(o->fov_deg * M_PI / 360), c.out_half = 0.5 * (o->width < o->height ? o->width : o->height);
     c.minx = l->grid_bounds[0], c.maxy = l->grid_bounds[3];
     c.bx = lf->nu > 1 ? (l->grid_bounds[1] - l->grid_bounds[0]) / (lf->nu - 1) : 1;
     c.by = lf->nv > 1 ? (l->grid_bounds[3] - l->grid_bounds[2]) / (lf->nv - 1) : 1;
+    c.inv_bx = 1 / c.bx, c.inv_by = 1 / c.by;
     if (lf->nu == 1)
         c.minx = 0.5 * (l->grid_bounds[0] + l->grid_bounds[1]);
     if (lf->nv == 1)

@@ -21,13 +21,6 @@ static double lum(const lf_image *im, int x, int y)
     return isfinite(v) ? v : 0.0;
 }
 
-/* lattice coordinates (lx, ly) of lens (i, j), in pitches */
-static void lattice(int hex, int i, int j, double *lx, double *ly)
-{
-    *lx = i + (hex && (j & 1) ? 0.5 : 0.0);
-    *ly = j * (hex ? sqrt(3.0) / 2 : 1.0);
-}
-
 /* Solve the 3x3 system M x = r (Cramer); returns 0 when singular. */
 static int solve3(const double M[9], const double r[3], double x[3])
 {

@@ -13,12 +13,11 @@ cmake --build build --target lfrender > /dev/null
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 scene=scenes/bench/plane-spheres.pbrt
-t() { # wall-clock seconds of one run
-  local s e
-  s=$(date +%s.%N)
-  build/bin/lfrender "$scene" --spp "$spp" --threads 2 -o "$tmp/o.exr" --quiet "$@"
-  e=$(date +%s.%N)
-  awk -v a="$s" -v b="$e" 'BEGIN {printf "%.3f\n", b - a}'
+t() { # CPU seconds (user + system) of one run: stable on a shared machine,
+       # and what checkpointing adds is CPU work (copying tiles, encoding EXR)
+  local TIMEFORMAT='%U %S'
+  { time build/bin/lfrender "$scene" --spp "$spp" --threads 2 -o "$tmp/o.exr" --quiet "$@" ; } 2>&1 | tail -1 |
+    awk '{printf "%.3f\n", $1 + $2}'
 }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
 plain=(); c60=(); c1=()
@@ -30,5 +29,5 @@ done
 p=$(printf '%s\n' "${plain[@]}" | median)
 a=$(printf '%s\n' "${c60[@]}" | median)
 b=$(printf '%s\n' "${c1[@]}" | median)
-echo "plain: $p s; checkpoint every 60 s: $a s ($(awk -v x="$a" -v y="$p" 'BEGIN{printf "%+.1f%%", (x/y-1)*100}')); every 1 s: $b s ($(awk -v x="$b" -v y="$p" 'BEGIN{printf "%+.1f%%", (x/y-1)*100}'))"
+echo "CPU time: plain: $p s; checkpoint every 60 s: $a s ($(awk -v x="$a" -v y="$p" 'BEGIN{printf "%+.1f%%", (x/y-1)*100}')); every 1 s: $b s ($(awk -v x="$b" -v y="$p" 'BEGIN{printf "%+.1f%%", (x/y-1)*100}'))"
 echo "($runs runs each, $spp spp, 2 threads, $(nproc) cores, $(date -u +%F))"

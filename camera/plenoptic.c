@@ -63,6 +63,7 @@
 #include <string.h>
 
 #include "camera_internal.h"
+#include "lens.h"
 
 typedef struct sensor_size {
     const char *name;
@@ -83,10 +84,21 @@ static const sensor_size sensors[] = {
 enum { MAX_CANDIDATES = 256 };
 
 typedef struct plenoptic {
-    /* main lens */
+    /* main lens (a compound lens: its equivalent thin lens, see below) */
     double focal_length, fstop, aperture_radius; /* f, N, R = f/2N (metres) */
     double focus_distance;                        /* z_o; INFINITY allowed */
     double mla_distance;                          /* z_i */
+    /* where the lattice geometry sees the aperture: the main lens itself
+     * (thin), or the exit pupil (compound); pupil_radius is the paraxial
+     * radius, search_radius bounds every ray that gets through */
+    double pupil_distance, pupil_radius, search_radius;
+    /* compound main lens ("lensfile") */
+    int compound;
+    lf_lens lens;
+    lf_lens_paraxial px;
+    double working_fnumber;
+    double principal_to_mla_mm;  /* front principal point H (camera origin) to the MLA */
+    double focus_from_mla_m;     /* "focusdistance" as given: MLA to the plane in focus */
     /* sensor */
     int width, height;
     double sensor_w, sensor_h, pixel;            /* metres; pixel pitch */
@@ -122,6 +134,8 @@ static int fail(const lf_camera_create_args *a, plenoptic *c, const char *fmt, .
     va_start(ap, fmt);
     vsnprintf(a->error, a->error_size, fmt, ap);
     va_end(ap);
+    if (c)
+        lf_lens_free(&c->lens);
     free(c);
     return -1;
 }
@@ -192,6 +206,110 @@ static void place_lattice(plenoptic *c)
     c->ny = jmax - jmin + 1;
 }
 
+/* A compound main lens (docs/lightfield.md, "Compound main lens"):
+ * "lensfile" with "aperturediameter" as the realistic camera reads them;
+ * "focusdistance" (metres, 0 = infinity) is measured from the MLA, the
+ * lens's film plane, as realistic and pbrt-v4 measure it, and the MLA sits
+ * where lf_lens_focus_thick puts the film.  Camera space has its origin at
+ * the lens's front principal point H, so that with z from H and z_i from H'
+ * the thin-lens relations the light-field library uses (1/z + 1/z_i = 1/f,
+ * PHYSICS.md) hold for the paraxial lens.  The lattice geometry sees the
+ * aperture as the paraxial exit pupil; candidates are searched within a
+ * radius there that bounds every ray that gets through (traced at create). */
+static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, const char *lensfile, double zo)
+{
+    const lf_camera_params *p = a->params;
+    double aperture_mm = p->get_float(p->ctx, "aperturediameter", 1.0); /* pbrt-v4's default, as realistic */
+    if (!lensfile[0]) {
+        snprintf(a->error, a->error_size, "\"lensfile\" is empty (give a .dat prescription; see scenes/lenses/)");
+        return -1;
+    }
+    if (!(aperture_mm > 0.0) || !isfinite(aperture_mm)) {
+        snprintf(a->error, a->error_size, "\"aperturediameter\" must be > 0 mm, got %g", aperture_mm);
+        return -1;
+    }
+    if (!(zo >= 0.0)) {
+        snprintf(a->error, a->error_size, "\"focusdistance\" must be > 0 m (0 = infinity), got %g", zo);
+        return -1;
+    }
+    char path[4096];
+    if (lensfile[0] == '/' || !a->scene_dir || !a->scene_dir[0])
+        snprintf(path, sizeof path, "%s", lensfile);
+    else
+        snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
+    if (lf_lens_load(path, &c->lens, a->error, a->error_size))
+        return -1;
+    lf_lens *L = &c->lens;
+    if (L->stop < 0) {
+        warn(a, "%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
+    } else {
+        char msg[600] = "";
+        if (lf_lens_set_stop_diameter(L, aperture_mm, msg, sizeof msg))
+            warn(a, "%s", msg);
+    }
+    if (lf_lens_paraxial_analyse(L, &c->px) || !(c->px.efl_mm > 0.0)) {
+        snprintf(a->error, a->error_size, "%s: the lens forms no real image (afocal or negative focal length)", path);
+        return -1;
+    }
+    double focus_mm = zo == 0.0 || isinf(zo) ? INFINITY : zo * 1e3;
+    if (lf_lens_focus_thick(L, focus_mm, &L->film_distance_mm, a->error, a->error_size))
+        return -1;
+    c->compound = 1;
+    c->focus_from_mla_m = isinf(focus_mm) ? INFINITY : zo;
+    c->working_fnumber = lf_lens_working_fnumber(L, &c->px, focus_mm, L->film_distance_mm);
+    double f = c->px.efl_mm, zi = L->film_distance_mm - c->px.rear_principal_mm; /* H' -> MLA */
+    c->principal_to_mla_mm = L->film_distance_mm + c->px.total_length_mm - c->px.front_principal_mm;
+    if (!(zi > 0.0) || !isfinite(c->working_fnumber) || !(c->working_fnumber > 0.0)) {
+        snprintf(a->error, a->error_size, "%s: no usable image at %g mm behind the rear vertex", path,
+                 L->film_distance_mm);
+        return -1;
+    }
+    /* the equivalent thin lens at H': same f, same z_i, same image-side cone */
+    c->focal_length = f * 1e-3;
+    c->mla_distance = zi * 1e-3;
+    c->focus_distance = zi > f * (1.0 + 1e-12) ? f * zi / (zi - f) * 1e-3 : INFINITY;
+    c->aperture_radius = 0.5 * c->mla_distance / c->working_fnumber;
+    c->fstop = c->focal_length / (2.0 * c->aperture_radius);
+    /* paraxial exit pupil, seen from the MLA */
+    c->pupil_distance = (L->film_distance_mm - c->px.exit_pupil_mm) * 1e-3;
+    c->pupil_radius = 0.5 * c->px.exit_pupil_diameter_mm * 1e-3;
+    if (!(c->pupil_distance > 0.0) || !(c->pupil_radius > 0.0)) {
+        snprintf(a->error, a->error_size, "%s: the exit pupil (%g mm from the MLA) is not in front of the MLA", path,
+                 c->pupil_distance * 1e3);
+        return -1;
+    }
+    /* search radius on the exit-pupil plane: every ray from an MLA point
+     * within the sensor's half diagonal that gets through crosses the
+     * rear-vertex plane inside lf_lens_rear_disk_radius; trace a grid of
+     * them and keep the largest crossing of the pupil plane, plus the grid
+     * step (scaled to that plane) as margin */
+    double w_mm = c->nominal_w_mm, h_mm = w_mm * a->image_height / a->image_width;
+    double r_max = 0.5 * hypot(w_mm, h_mm), Zr = L->film_distance_mm, Zp = c->pupil_distance * 1e3;
+    double R_rear = lf_lens_rear_disk_radius(L, r_max), hmax = 0.0;
+    enum { NR = 17, NG = 48 };
+    double step = 2.0 * R_rear / NG;
+    for (int k = 0; k < NR; k++) {
+        double r = r_max * k / (NR - 1);
+        for (int j = 0; j <= NG; j++)
+            for (int i = 0; i <= NG; i++) {
+                double x = -R_rear + i * step, y = -R_rear + j * step;
+                if (x * x + y * y > R_rear * R_rear)
+                    continue;
+                lf_lens_ray in = {{r, 0, 0}, {x - r, y, -Zr}};
+                if (lf_lens_trace_from_film(L, &in, NULL, NULL) != LF_LENS_PASSED)
+                    continue;
+                double hx = r + (x - r) * Zp / Zr, hy = y * Zp / Zr;
+                hmax = fmax(hmax, hypot(hx, hy));
+            }
+    }
+    if (!(hmax > 0.0)) {
+        snprintf(a->error, a->error_size, "%s admits no light at stop diameter %g mm", path, aperture_mm);
+        return -1;
+    }
+    c->search_radius = (hmax + 1.5 * step * Zp / Zr) * 1e-3;
+    return 0;
+}
+
 static int plenoptic_create(const lf_camera_create_args *a, void **state)
 {
     const lf_camera_params *p = a->params;
@@ -202,8 +320,7 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     }
     c->width = a->image_width;
     c->height = a->image_height;
-    double f_mm = p->get_float(p->ctx, "focallength", 50.0);
-    c->fstop = p->get_float(p->ctx, "fstop", 2.8);
+    const char *lensfile = p->get_string(p->ctx, "lensfile", NULL);
     double zo = p->get_float(p->ctx, "focusdistance", 1.0);
     const char *grid = p->get_string(p->ctx, "grid", "square");
     double pitch_um = p->get_float(p->ctx, "pitch", 0.0);
@@ -212,24 +329,30 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     double rot_deg = p->get_float(p->ctx, "rotation", 0.0);
     double offset_mm = p->get_float(p->ctx, "sensoroffset", 0.0);
 
-    if (!(f_mm > 0.0) || !isfinite(f_mm))
-        return fail(a, c, "\"focallength\" must be > 0 mm, got %g", f_mm);
-    if (!(c->fstop > 0.0) || !isfinite(c->fstop))
-        return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
-    c->focal_length = f_mm * 1e-3;
-    c->aperture_radius = c->focal_length / (2.0 * c->fstop);
-    /* 0 (or inf) means infinity: the MLA then sits in the focal plane */
-    if (zo == 0.0 || zo == INFINITY) {
-        c->focus_distance = INFINITY;
-        c->mla_distance = c->focal_length;
-    } else if (!(zo > c->focal_length) || !isfinite(zo)) {
-        return fail(a, c,
-                    "\"focusdistance\" %g m must exceed the focal length (%g mm) for a real image (or be 0 for "
-                    "infinity)",
-                    zo, f_mm);
-    } else {
-        c->focus_distance = zo;
-        c->mla_distance = c->focal_length / (1.0 - c->focal_length / zo);
+    if (!lensfile) {
+        double f_mm = p->get_float(p->ctx, "focallength", 50.0);
+        c->fstop = p->get_float(p->ctx, "fstop", 2.8);
+        if (!(f_mm > 0.0) || !isfinite(f_mm))
+            return fail(a, c, "\"focallength\" must be > 0 mm, got %g", f_mm);
+        if (!(c->fstop > 0.0) || !isfinite(c->fstop))
+            return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
+        c->focal_length = f_mm * 1e-3;
+        c->aperture_radius = c->focal_length / (2.0 * c->fstop);
+        /* 0 (or inf) means infinity: the MLA then sits in the focal plane */
+        if (zo == 0.0 || zo == INFINITY) {
+            c->focus_distance = INFINITY;
+            c->mla_distance = c->focal_length;
+        } else if (!(zo > c->focal_length) || !isfinite(zo)) {
+            return fail(a, c,
+                        "\"focusdistance\" %g m must exceed the focal length (%g mm) for a real image (or be 0 for "
+                        "infinity)",
+                        zo, f_mm);
+        } else {
+            c->focus_distance = zo;
+            c->mla_distance = c->focal_length / (1.0 - c->focal_length / zo);
+        }
+        c->pupil_distance = c->mla_distance;
+        c->pupil_radius = c->search_radius = c->aperture_radius;
     }
     if (!strcmp(grid, "square"))
         c->hex = 0;
@@ -281,6 +404,13 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
              "the image width, pixels are square)",
              c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm, c->sensor_h * 1e3);
 
+    /* a compound main lens needs the sensor size for its pupil search */
+    if (lensfile && main_lens_compound(a, c, lensfile, zo)) {
+        lf_lens_free(&c->lens);
+        free(c);
+        return -1;
+    }
+
     /* microlens pitch and focal length */
     if (pitch_um != 0.0 && count != 0)
         return fail(a, c, "give either \"pitch\" (um) or \"microlenses\" (count across the width), not both");
@@ -294,7 +424,8 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
         return fail(a, c, "\"microlensfocallength\" must be > 0 mm, got %g", fmla_mm);
     if (!isfinite(offset_mm))
         return fail(a, c, "\"sensoroffset\" must be finite, got %g", offset_mm);
-    double zi = c->mla_distance, D = 2.0 * c->aperture_radius, off = offset_mm * 1e-3;
+    /* the lattice sees the aperture at the (exit) pupil: Z and D below are z_i and f/N for a thin lens */
+    double zi = c->pupil_distance, D = 2.0 * c->pupil_radius, off = offset_mm * 1e-3;
     c->sensor_offset = off;
     if (count > 0) {
         /* the images tile the width: spacing P = W / count pixels = p (z_i + d) / z_i */
@@ -325,7 +456,7 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     c->cell_area = c->hex ? sqrt(3.0) / 2.0 * c->pitch * c->pitch : c->pitch * c->pitch;
     c->cell_radius = c->hex ? c->pitch / sqrt(3.0) : c->pitch / sqrt(2.0);
     double alpha = 1.0 + zi / d - zi / c->mla_focal;
-    c->search_px = (c->aperture_radius + fabs(alpha) * c->cell_radius) * d / zi / c->pixel;
+    c->search_px = (c->search_radius + fabs(alpha) * c->cell_radius) * d / zi / c->pixel;
     double cell_px = c->hex ? sqrt(3.0) / 2.0 * c->image_pitch_px * c->image_pitch_px
                             : c->image_pitch_px * c->image_pitch_px;
     double max_cand = M_PI * pow(c->search_px + c->image_pitch_px, 2.0) / cell_px;
@@ -432,19 +563,33 @@ static double plenoptic_generate_ray(const void *state, const lf_camera_sample *
     double mx = (mx_px - 0.5 * c->width) * c->phys_per_px, my = (0.5 * c->height - my_px) * c->phys_per_px;
     double psx = (s->film_x - 0.5 * c->width) * c->pixel, psy = (0.5 * c->height - s->film_y) * c->pixel;
 
-    double d = c->mla_sensor, zi = c->mla_distance;
+    double d = c->mla_sensor, zi = c->pupil_distance;
     double dx = mx - psx, dy = my - psy;
     double cos2 = d * d / (d * d + dx * dx + dy * dy);
-    /* ideal thin microlens, then on to the main lens */
+    /* ideal thin microlens, then on to the main lens (thin) or its exit pupil (compound) */
     double sx = dx / d - (mx - cx) / c->mla_focal, sy = dy / d - (my - cy) / c->mla_focal;
     double hx = mx + sx * zi, hy = my + sy * zi;
-    if (hx * hx + hy * hy > c->aperture_radius * c->aperture_radius)
-        return 0.0; /* vignetted by the main aperture */
+    if (hx * hx + hy * hy > c->search_radius * c->search_radius)
+        return 0.0; /* vignetted by the main aperture (thin), or surely by the lens (compound) */
+    double w = K * c->weight_scale * cos2 * cos2;
+    if (c->compound) {
+        /* lens space (mm; film = MLA at z = 0, light towards +z) is camera
+         * space mirrored in z, laterally the camera's: upright -> negate */
+        lf_lens_ray in = {{-mx * 1e3, -my * 1e3, 0.0}, {-sx, -sy, -1.0}}, out;
+        if (lf_lens_trace_from_film(&c->lens, &in, &out, NULL) != LF_LENS_PASSED || !isfinite(w))
+            return 0.0;
+        double len = sqrt(out.d[0] * out.d[0] + out.d[1] * out.d[1] + out.d[2] * out.d[2]);
+        if (!(len > 0.0) || !isfinite(len))
+            return 0.0;
+        r->origin[0] = out.o[0] * 1e-3, r->origin[1] = out.o[1] * 1e-3;
+        r->origin[2] = -(out.o[2] + c->principal_to_mla_mm) * 1e-3; /* camera origin at H */
+        r->dir[0] = out.d[0] / len, r->dir[1] = out.d[1] / len, r->dir[2] = -out.d[2] / len;
+        return w;
+    }
     sx -= hx / c->focal_length, sy -= hy / c->focal_length;
     /* upright -> camera space: point reflection of the lateral coordinates */
     double dir[3] = {-sx, -sy, 1.0};
     double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + 1.0);
-    double w = K * c->weight_scale * cos2 * cos2;
     if (!isfinite(len) || !isfinite(w))
         return 0.0;
     r->origin[0] = -hx, r->origin[1] = -hy, r->origin[2] = 0.0;
@@ -454,7 +599,10 @@ static double plenoptic_generate_ray(const void *state, const lf_camera_sample *
 
 static void plenoptic_destroy(void *state)
 {
-    free(state);
+    plenoptic *c = state;
+    if (c)
+        lf_lens_free(&c->lens);
+    free(c);
 }
 
 #define APPEND(...)                                                \
@@ -473,10 +621,26 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
     if (size == 0)
         buf = scratch, size = 1;
     double D = 2.0 * c->aperture_radius, zi = c->mla_distance;
-    APPEND("model: plenoptic camera (Ng 2005): thin main lens, microlens array at its image plane, sensor behind\n");
-    APPEND("main lens: f %g mm, f/%g (aperture %.6g mm), focused at %.6g m\n", c->focal_length * 1e3, c->fstop,
-           D * 1e3, c->focus_distance);
-    APPEND("main lens to microlens array z_i: %.6g mm (image-side f-number z_i/D = %.4g)\n", zi * 1e3, zi / D);
+    if (c->compound) {
+        const lf_lens *L = &c->lens;
+        APPEND("model: plenoptic camera (Ng 2005): compound main lens %s (%d surfaces, traced exactly), microlens "
+               "array at its image plane, sensor behind\n",
+               L->path, L->n);
+        APPEND("main lens: EFL %.6g mm (paraxial), stop %.4g mm, working f/%.4g; focused at %.6g m from the microlens "
+               "array (%.6g m from the front principal point, the camera origin)\n",
+               c->px.efl_mm, L->stop >= 0 ? 2.0 * L->s[L->stop].aperture_radius_mm : 0.0, c->working_fnumber,
+               c->focus_from_mla_m, c->focus_distance);
+        APPEND("rear vertex to microlens array: %.6g mm; exit pupil %.6g mm wide, %.6g mm in front of the array "
+               "(candidate search radius there %.6g mm)\n",
+               L->film_distance_mm, 2e3 * c->pupil_radius, c->pupil_distance * 1e3, c->search_radius * 1e3);
+        APPEND("equivalent thin lens (metadata): f %.6g mm, f/%.6g, H' to microlens array z_i %.6g mm\n",
+               c->focal_length * 1e3, c->fstop, zi * 1e3);
+    } else {
+        APPEND("model: plenoptic camera (Ng 2005): thin main lens, microlens array at its image plane, sensor behind\n");
+        APPEND("main lens: f %g mm, f/%g (aperture %.6g mm), focused at %.6g m\n", c->focal_length * 1e3, c->fstop,
+               D * 1e3, c->focus_distance);
+        APPEND("main lens to microlens array z_i: %.6g mm (image-side f-number z_i/D = %.4g)\n", zi * 1e3, zi / D);
+    }
     APPEND("microlenses: %s grid, pitch %.6g um, focal length %.6g mm (f/%.4g), rotation %g deg\n",
            c->hex ? "hex" : "square", c->pitch * 1e6, c->mla_focal * 1e3, c->mla_focal / c->pitch,
            c->rotation_rad * 180.0 / M_PI);
@@ -516,6 +680,12 @@ static void plenoptic_metadata(const void *state, const lf_camera_attr_sink *sin
     double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
     sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
     sink->set_double(sink->ctx, "lensfield:sensor_offset_mm", c->sensor_offset * 1e3);
+    if (c->compound) {
+        sink->set_string(sink->ctx, "lensfield:lens_file", c->lens.path);
+        sink->set_double(sink->ctx, "lensfield:lens_efl_mm", c->px.efl_mm);
+        sink->set_double(sink->ctx, "lensfield:lens_working_fnumber", c->working_fnumber);
+        sink->set_double(sink->ctx, "lensfield:lens_film_distance_mm", c->lens.film_distance_mm);
+    }
 }
 
 const lf_camera_type lf_camera_plenoptic = {

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "camera/lens.h"
 #include "camera/lf_camera.h"
 #include "lf_test.h"
 
@@ -745,6 +746,147 @@ static void test_plenoptic_focused(void)
     t->destroy(c);
 }
 
+/* A compound main lens (scenes/lenses/dgauss.50mm.dat).  The expected
+ * numbers come from the lens library's paraxial analysis (camera/lens.h),
+ * not from the camera: the working f-number at the focus distance sets the
+ * matched microlens focal length f_mla = p N_w, the paraxial exit pupil at Z
+ * in front of the MLA sets the image spacing p (Z + f_mla)/Z.  Light that
+ * reaches the sensor is traced back through the prescription (from the
+ * scene side) to the MLA to see which microlens it came through. */
+static void test_plenoptic_compound(double mla_scale, double *outside_fraction)
+{
+    const lf_camera_type *t = lf_camera_find("plenoptic");
+    const double stop_mm = 8, focus_m = 2, p_um = 100;
+    lf_lens lens;
+    char err[512] = "";
+    if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+        return;
+    }
+    char warn[600];
+    lf_lens_set_stop_diameter(&lens, stop_mm, warn, sizeof warn);
+    lf_lens_paraxial px;
+    CHECK(lf_lens_paraxial_analyse(&lens, &px) == 0);
+    CHECK(lf_lens_focus_thick(&lens, focus_m * 1e3, &lens.film_distance_mm, err, sizeof err) == 0);
+    double Nw = lf_lens_working_fnumber(&lens, &px, focus_m * 1e3, lens.film_distance_mm);
+    double Z = lens.film_distance_mm - px.exit_pupil_mm; /* mm, MLA -> exit pupil */
+    double p = p_um * 1e-3, fm = p * Nw * mla_scale, Pimg = p * (Z + fm) / Z;
+    const int nl = 7, W = 77, H = 77, mid = nl / 2;
+    double pix = Pimg / 11.02; /* mm; 6.99 images across: 7 lenses, the middle one on the axis */
+    store s = {{{"lensfile", {0}, 0, "lenses/dgauss.50mm.dat"},
+                {"aperturediameter", {stop_mm}, 1, NULL},
+                {"focusdistance", {focus_m}, 1, NULL},
+                {"pitch", {p_um}, 1, NULL},
+                {"microlensfocallength", {fm}, 1, NULL},
+                {"sensorsize", {W * pix, H * pix}, 2, NULL}},
+               6};
+    void *c = make("plenoptic", &s, W, H, err);
+    CHECK_MSG(c != NULL, "%s", err);
+    if (!c) {
+        lf_lens_free(&lens);
+        return;
+    }
+    if (mla_scale == 1.0)
+        CHECK_MSG(last_warning[0] == '\0', "matched compound design warned: %s", last_warning);
+    else
+        CHECK_MSG(strstr(last_warning, "microlens images overlap") != NULL, "%s", last_warning);
+    attrs m;
+    collect("plenoptic", c, &m);
+    layout L;
+    read_layout(&m, &L);
+    CHECK_MSG(fabs(L.pitch - 11.02) < 1e-6, "image spacing %.9g px, expected 11.02 (p (Z + f_mla)/Z)", L.pitch);
+    CHECK(L.count[0] == nl && L.count[1] == nl);
+    const attr *a = get(&m, "lensfield:lens_file");
+    CHECK(a && strstr(a->str, "dgauss.50mm.dat"));
+    CHECK_NEAR(attr_v(&m, "lensfield:lens_efl_mm"), px.efl_mm, 1e-9);
+    CHECK_NEAR(attr_v(&m, "lensfield:lens_working_fnumber"), Nw, 1e-9);
+    CHECK_NEAR(attr_v(&m, "lensfield:lens_film_distance_mm"), lens.film_distance_mm, 1e-9);
+    /* the equivalent thin lens: f = EFL, z_i from H', same image-side cone,
+     * in focus at z_o (from H) with 1/z_o + 1/z_i = 1/f */
+    double zi = lens.film_distance_mm - px.rear_principal_mm;
+    CHECK_NEAR(attr_v(&m, "lensfield:main_focal_mm"), px.efl_mm, 1e-9);
+    CHECK_NEAR(attr_v(&m, "lensfield:mla_distance_mm"), zi, 1e-9);
+    CHECK_NEAR(attr_v(&m, "lensfield:main_fstop"), px.efl_mm * Nw / zi, 1e-9);
+    CHECK_NEAR(attr_v(&m, "lensfield:focus_distance_m"), 1e-3 / (1 / px.efl_mm - 1 / zi), 1e-9);
+    /* H (the camera origin) to the MLA, for the back-trace */
+    double h2mla = lens.film_distance_mm + px.total_length_mm - px.front_principal_mm;
+
+    /* every weight finite and >= 0, every direction unit, over the sensor */
+    int bad = 0, lit = 0;
+    for (int q = 0; q < 20000; q++) {
+        lf_camera_sample cs = {fmod(q * 0.618034, W), fmod(q * 0.414214, H), fmod(q * 0.7548777, 1),
+                               fmod(q * 0.5698403, 1), 0, 0.5};
+        lf_camera_ray r;
+        double w = t->generate_ray(c, &cs, &r);
+        bad += !isfinite(w) || w < 0;
+        if (w > 0) {
+            lit++;
+            double l = sqrt(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]);
+            bad += fabs(l - 1) > 1e-12 || !(r.dir[2] > 0) || !isfinite(r.origin[0] + r.origin[1] + r.origin[2]);
+        }
+    }
+    CHECK_MSG(bad == 0 && lit > 5000, "%d bad rays, %d lit of 20000", bad, lit);
+
+    /* Which microlens each ray came through: camera -> lens space, back
+     * through the prescription to the MLA plane z = 0.  Weighted fraction of
+     * the light in the middle 3 x 3 images that arrives outside the image
+     * cell (nearest image centre) of its own microlens. */
+    double w_all = 0, w_out = 0;
+    int n = 4, traced_back_failed = 0;
+    for (int y = (mid - 1) * 11; y < (mid + 2) * 11 + 1; y++)
+        for (int x = (mid - 1) * 11; x < (mid + 2) * 11 + 1; x++)
+            for (int k = 0; k < n * n * n * n; k++) {
+                int fi = k % (n * n), li = k / (n * n);
+                lf_camera_sample cs = {x + (fi % n + 0.5) / n, y + (fi / n + 0.5) / n, (li % n + 0.5) / n,
+                                       (li / n + 0.5) / n, 0, 0.5};
+                lf_camera_ray r;
+                double w = t->generate_ray(c, &cs, &r);
+                if (!(w > 0))
+                    continue;
+                /* light travels -dir (camera), i.e. (-dx, -dy, +dz) in lens space; start 1 mm upstream */
+                lf_lens_ray in = {{r.origin[0] * 1e3 + r.dir[0], r.origin[1] * 1e3 + r.dir[1],
+                                   -r.origin[2] * 1e3 - h2mla - r.dir[2]},
+                                  {-r.dir[0], -r.dir[1], r.dir[2]}},
+                            out;
+                if (lf_lens_trace_from_scene(&lens, &in, &out, NULL) != LF_LENS_PASSED) {
+                    traced_back_failed++;
+                    continue;
+                }
+                double tt = -out.o[2] / out.d[2];
+                double ux = -(out.o[0] + tt * out.d[0]), uy = -(out.o[1] + tt * out.d[1]); /* upright, mm */
+                int li2 = (int)floor(ux / p + nl / 2.0), lj2 = (int)floor(-uy / p + nl / 2.0);
+                /* the sample's own cell: nearest image centre */
+                int ci = (int)floor((cs.film_x - L.off[0]) / L.pitch + 0.5);
+                int cj = (int)floor((cs.film_y - L.off[1]) / L.pitch + 0.5);
+                w_all += w;
+                if (li2 != ci || lj2 != cj)
+                    w_out += w;
+            }
+    CHECK(traced_back_failed == 0);
+    *outside_fraction = w_all > 0 ? w_out / w_all : 1;
+    printf("note: compound main lens (dgauss 50 mm, stop %g mm, working f/%.4g), f_mla = %.2f p N_w: %.4f%% of the "
+           "light lands outside its microlens's image cell\n",
+           stop_mm, Nw, mla_scale, 100 * *outside_fraction);
+    t->destroy(c);
+    lf_lens_free(&lens);
+}
+
+static void test_plenoptic_compound_cases(void)
+{
+    double matched = 1, mismatched = 0;
+    test_plenoptic_compound(1.0, &matched);
+    test_plenoptic_compound(1.5, &mismatched);
+    /* matched: images touch and do not overlap (0 for the paraxial design;
+     * what remains is the real lens's pupil aberration); a microlens 1.5x
+     * too slow spills a large share into the neighbours */
+    CHECK_MSG(matched < 0.002, "matched: %.4f of the light outside its image", matched);
+    CHECK_MSG(mismatched > 0.05, "mismatched: only %.4f of the light outside its image", mismatched);
+    /* errors: unknown file, no focal power is the lens library's */
+    store s = {{{"lensfile", {0}, 0, "lenses/nonexistent.dat"}}, 1};
+    char err[512] = "";
+    CHECK(make("plenoptic", &s, 40, 40, err) == NULL && strstr(err, "nonexistent"));
+}
+
 int main(void)
 {
     test_array_layout();
@@ -754,5 +896,6 @@ int main(void)
     test_plenoptic_matched(8.0, 9);
     test_plenoptic_hard_cases();
     test_plenoptic_focused();
+    test_plenoptic_compound_cases();
     return lf_test_end();
 }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "camera/lens.h"
 #include "camera/lf_camera.h"
 #include "lf_test.h"
 #include "render/lf_render.h"
@@ -257,13 +258,38 @@ static void test_plenoptic_white(void)
  * maxdepth 1: no light-sampling noise).  Both images are divided by their
  * means after removing the plenoptic image's natural cos^4 falloff (the
  * pinhole is radiance, the plenoptic exposure). */
-static void test_plenoptic_centre_view(void)
+static void test_plenoptic_centre_view(int compound)
 {
     const int P = 9, nlx = 24, nly = 16, W = P * nlx, H = P * nly;
-    const double f = 50, N = 4, zo = 3000, D = f / N, zi = f * zo / (zo - f);
+    double f = 50, N = 4, zo = 3000, D = f / N, zi = f * zo / (zo - f);
+    /* Compound: scenes/lenses/dgauss.50mm.dat, stop 8 mm, focused at 3 m
+     * from the MLA.  From the lens library's paraxial analysis: the lattice
+     * sees the exit pupil (Z from the MLA, diameter D_xp, Z/D_xp = N_w) in
+     * place of the thin lens (zi, D); the centre view is a pinhole at the
+     * entrance pupil whose film distance is (Z + f_mla) D_ep/D_xp (chief
+     * rays: tan theta_object = tan theta_image D_xp/D_ep, paraxially). */
+    double pin_z = 0, mag = 1;
+    if (compound) {
+        lf_lens lens;
+        char err[512], warn[512];
+        lf_lens_paraxial px;
+        if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+            return;
+        }
+        lf_lens_set_stop_diameter(&lens, 8.0, warn, sizeof warn);
+        lf_lens_paraxial_analyse(&lens, &px);
+        lf_lens_focus_thick(&lens, zo, &lens.film_distance_mm, err, sizeof err);
+        zi = lens.film_distance_mm - px.exit_pupil_mm, D = px.exit_pupil_diameter_mm;
+        mag = px.entrance_pupil_diameter_mm / px.exit_pupil_diameter_mm;
+        pin_z = (px.front_principal_mm - px.entrance_pupil_mm) * 1e-3; /* camera origin at H */
+        printf("note: dgauss 50 mm at stop 8 mm: exit pupil %.4g mm wide %.4g mm before the MLA (f/%.4g), pupil "
+               "magnification %.4f\n", D, zi, zi / D, 1 / mag);
+        lf_lens_free(&lens);
+    }
     /* matched design, "microlenses" 24 across 36 mm: image spacing Pm = p (1 + p/D) */
     double Pm = 36.0 / nlx, p = D * (sqrt(1 + 4 * Pm / D) - 1) / 2, fm = p * zi / D, zs = zi + fm;
-    double fov = 2 * atan(0.5 * 24.0 / zs) * 180 / M_PI; /* across the shorter side: 24 mm */
+    double fov = 2 * atan(0.5 * 24.0 / (zs * mag)) * 180 / M_PI; /* across the shorter side: 24 mm */
     const char *world =
         "WorldBegin\n"
         "LightSource \"distant\" \"point3 from\" [-1 2 -2] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3]\n"
@@ -274,15 +300,21 @@ static void test_plenoptic_centre_view(void)
         " Translate 0.4 -0.1 3.2\n Shape \"sphere\" \"float radius\" [0.35]\nAttributeEnd\n"
         "AttributeBegin\n Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
         " Shape \"bilinearmesh\" \"point3 P\" [-3 -3 3.6  3 -3 3.6  -3 3 3.6  3 3 3.6]\nAttributeEnd\n";
-    char scene[4096];
+    char scene[4096], main_lens[256];
+    if (compound)
+        snprintf(main_lens, sizeof main_lens,
+                 "\"string lensfile\" \"%s/scenes/lenses/dgauss.50mm.dat\" \"float aperturediameter\" [8]",
+                 LF_SOURCE_DIR);
+    else
+        snprintf(main_lens, sizeof main_lens, "\"float focallength\" [%g] \"float fstop\" [%g]", f, N);
     snprintf(scene, sizeof scene,
              "LookAt 0 0 0  0 0 1  0 1 0\n"
-             "Camera \"plenoptic\" \"float focallength\" [%g] \"float fstop\" [%g] \"float focusdistance\" [%g]\n"
+             "Camera \"plenoptic\" %s \"float focusdistance\" [%g]\n"
              "  \"integer microlenses\" [%d] \"float sensorsize\" [36 24]\n"
              "Film \"rgb\" \"integer xresolution\" [%d] \"integer yresolution\" [%d]\n"
              "Sampler \"zsobol\" \"integer pixelsamples\" [64]\nPixelFilter \"box\"\n"
              "Integrator \"path\" \"integer maxdepth\" [1]\n%s",
-             f, N, zo / 1000, nlx, W, H, world);
+             main_lens, zo / 1000, nlx, W, H, world);
     lf_image plen, pin;
     char msg[1024];
     if (render_text(scene, 0, NULL, &plen, NULL, msg, sizeof msg)) {
@@ -290,11 +322,11 @@ static void test_plenoptic_centre_view(void)
         return;
     }
     snprintf(scene, sizeof scene,
-             "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" [%.17g]\n"
+             "LookAt 0 0 %.17g  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" [%.17g]\n"
              "Film \"rgb\" \"integer xresolution\" [%d] \"integer yresolution\" [%d]\n"
              "Sampler \"zsobol\" \"integer pixelsamples\" [64]\nPixelFilter \"box\"\n"
              "Integrator \"path\" \"integer maxdepth\" [1]\n%s",
-             fov, nlx, nly, world);
+             pin_z, fov, nlx, nly, world);
     if (render_text(scene, 0, NULL, &pin, NULL, msg, sizeof msg)) {
         CHECK_MSG(0, "pinhole render failed: %s", msg);
         lf_image_free(&plen);
@@ -342,8 +374,9 @@ static void test_plenoptic_centre_view(void)
      * aperture patch), and sphere-edge pixels whose coverage differs by up
      * to ~20 %; those are ~10 % of the view, giving ~0.03-0.05.  A wrong
      * orientation gives > 0.15 (checked below). */
-    printf("note: centre sub-aperture view vs pinhole: relative RMSE %.4f (threshold 0.06), exposure ratio x N^2 = %.4f\n",
-           rel_rmse, (sv / sp) * pow(zi / D, 2));
+    printf("note: %s main lens: centre sub-aperture view vs pinhole: relative RMSE %.4f (threshold 0.06), exposure "
+           "ratio x N^2 = %.4f\n",
+           compound ? "compound (dgauss 50 mm)" : "thin", rel_rmse, (sv / sp) * pow(zi / D, 2));
     CHECK_MSG(rel_rmse < 0.06, "centre view vs pinhole: relative RMSE %.4f", rel_rmse);
     /* and the exposure: radiance x (p/f_mla)^2 cos^4 ~ radiance / N_image^2 */
     double ratio = (sv / (3 * nlx * nly)) / (sp / (3 * nlx * nly)), Ni = zi / D;
@@ -358,6 +391,7 @@ int main(void)
 {
     test_array_matches_pinholes();
     test_plenoptic_white();
-    test_plenoptic_centre_view();
+    test_plenoptic_centre_view(0);
+    test_plenoptic_centre_view(1);
     return lf_test_end();
 }

@@ -31,6 +31,11 @@ static inline void lf_cam_concentric_disk(double u, double v, double *x, double 
     *y = r * sin(th);
 }
 
+/* "string sensor" (named format) or "float sensorsize" [w h] mm; default
+ * full frame.  Returns 0, or -1 with a message in err. (camera/sensor.c) */
+int lf_cam_read_sensor(const lf_camera_params *p, double *w_mm, double *h_mm, char *name, size_t name_size,
+                       char *err, size_t err_size);
+
 extern const lf_camera_type lf_camera_perspective;
 extern const lf_camera_type lf_camera_orthographic;
 extern const lf_camera_type lf_camera_thinlens;

@@ -40,18 +40,6 @@
 #include "aperture.h"
 #include "camera_internal.h"
 
-typedef struct sensor_size {
-    const char *name;
-    double width_mm, height_mm;
-} sensor_size;
-
-/* Nominal sizes of common formats (docs/thinlens.md lists crop factors). */
-static const sensor_size sensors[] = {
-    {"mediumformat", 53.7, 40.2}, {"fullframe", 36.0, 24.0}, {"apsh", 27.9, 18.6},    {"apsc", 23.6, 15.8},
-    {"fourthirds", 17.3, 13.0},   {"1inch", 13.2, 8.8},      {"1/1.63in", 8.38, 5.59}, {"1/2.3in", 6.16, 4.62},
-    {"1/3.2in", 4.54, 3.42},
-};
-#define N_SENSORS ((int)(sizeof sensors / sizeof sensors[0]))
 
 typedef struct thinlens {
     double focal_length;      /* f, metres */
@@ -115,35 +103,11 @@ static int thinlens_create(const lf_camera_create_args *a, void **state)
                     c->focus_distance, f_mm, c->focal_length);
 
     /* sensor: "float sensorsize" [w h] mm wins over "string sensor" */
-    double wh[2] = {0, 0};
-    int nsz = p->get_floats(p->ctx, "sensorsize", wh, 2);
-    const char *given = p->get_string(p->ctx, "sensor", NULL);
-    const char *name = given ? given : "fullframe";
-    if (nsz != 0 && given)
-        return fail(a, c, "give either \"sensor\" \"%s\" or \"sensorsize\", not both", given);
-    if (nsz != 0) {
-        if (nsz != 2 || !(wh[0] > 0.0) || !(wh[1] > 0.0) || !isfinite(wh[0]) || !isfinite(wh[1]))
-            return fail(a, c, "\"sensorsize\" needs two positive values [width height] in mm (got %d values)", nsz);
-        c->nominal_w_mm = wh[0];
-        c->nominal_h_mm = wh[1];
-        snprintf(c->sensor_name, sizeof c->sensor_name, "custom");
-    } else {
-        int k = -1;
-        for (int i = 0; i < N_SENSORS; i++)
-            if (!strcmp(name, sensors[i].name))
-                k = i;
-        if (k < 0) {
-            char names[512] = "";
-            for (int i = 0; i < N_SENSORS; i++) {
-                strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
-                strncat(names, sensors[i].name, sizeof names - strlen(names) - 1);
-            }
-            return fail(a, c, "unknown \"sensor\" \"%s\" (known: %s; or give \"float sensorsize\" [w h] mm)", name,
-                        names);
-        }
-        c->nominal_w_mm = sensors[k].width_mm;
-        c->nominal_h_mm = sensors[k].height_mm;
-        snprintf(c->sensor_name, sizeof c->sensor_name, "%s", sensors[k].name);
+    {
+        char msg[512];
+        if (lf_cam_read_sensor(p, &c->nominal_w_mm, &c->nominal_h_mm, c->sensor_name, sizeof c->sensor_name, msg,
+                               sizeof msg))
+            return fail(a, c, "%s", msg);
     }
     /* the width maps to the image width; square pixels fix the height */
     c->sensor_w = c->nominal_w_mm * 1e-3;

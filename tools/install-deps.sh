@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools
   clang libclang-rt-14-dev
+  chromium nodejs
 )
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

@@ -1,0 +1,1056 @@
+/* grade.c - grading one submission against a rubric.
+ *
+ * For each check: find the submitted file (safeio.c), render what the
+ * assignment asks for with the reference implementation (two seeds, cached
+ * on disk by a hash of the edited scene text and settings), compare
+ * (metrics.c), and when the image is wrong, name the known mistake
+ * (a rubric "variant") whose reference it matches. */
+#define _GNU_SOURCE
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "../lightfield/lf_lightfield.h"
+#include "../render/lf_render.h"
+#include "grade_internal.h"
+
+int lf_grade_report_student(const char *report_dir, const char *title, const lf_grade_result *r, lf_error *err);
+
+typedef struct cached_ref {
+    uint64_t key;
+    lf_image img;
+    lf_attrs meta;
+} cached_ref;
+
+struct lf_grade_ctx {
+    lf_grade_rubric rubric;
+    char dir[1024], cache[1024], report[1024];
+    int threads;
+    cached_ref *refs;
+    int nrefs;
+};
+
+lf_grade_opts lf_grade_opts_default(void)
+{
+    lf_grade_opts o = {0};
+    return o;
+}
+
+static int mkdirs(const char *path)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", path);
+    for (char *s = p + 1; *s; s++)
+        if (*s == '/') {
+            *s = 0;
+            if (mkdir(p, 0755) && errno != EEXIST)
+                return -1;
+            *s = '/';
+        }
+    return mkdir(p, 0755) && errno != EEXIST ? -1 : 0;
+}
+
+int lf_grade_ctx_new(const char *assignment_dir, const lf_grade_opts *o, lf_grade_ctx **out, lf_error *err)
+{
+    *out = NULL;
+    lf_grade_ctx *g = calloc(1, sizeof *g);
+    if (!g)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    snprintf(g->dir, sizeof g->dir, "%s", assignment_dir);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/rubric.txt", assignment_dir);
+    if (lf_grade_rubric_parse(path, &g->rubric, err)) {
+        free(g);
+        return err->code;
+    }
+    if (o && o->cache_dir)
+        snprintf(g->cache, sizeof g->cache, "%s", o->cache_dir);
+    else if (getenv("XDG_CACHE_HOME") && getenv("XDG_CACHE_HOME")[0])
+        snprintf(g->cache, sizeof g->cache, "%s/lensfield", getenv("XDG_CACHE_HOME"));
+    else
+        snprintf(g->cache, sizeof g->cache, "%s/.cache/lensfield", getenv("HOME") ? getenv("HOME") : "/tmp");
+    if (o && o->report_dir)
+        snprintf(g->report, sizeof g->report, "%s", o->report_dir);
+    g->threads = o ? o->threads : 0;
+    *out = g;
+    return 0;
+}
+
+void lf_grade_ctx_release(lf_grade_ctx *g)
+{
+    if (!g)
+        return;
+    for (int i = 0; i < g->nrefs; i++)
+        lf_image_free(&g->refs[i].img), lf_attrs_free(&g->refs[i].meta);
+    free(g->refs);
+    lf_grade_rubric_free(&g->rubric);
+    free(g);
+}
+
+const char *lf_grade_title(const lf_grade_ctx *g) { return g->rubric.title; }
+
+int lf_grade_max_points(const lf_grade_ctx *g)
+{
+    int m = 0;
+    for (int i = 0; i < g->rubric.nchecks; i++)
+        m += g->rubric.checks[i].points;
+    return m;
+}
+
+void lf_grade_result_free(lf_grade_result *r)
+{
+    free(r->checks);
+    memset(r, 0, sizeof *r);
+}
+
+/* ---------- reference renders ---------- */
+
+static char *read_text(const char *path, lf_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        lf_error_set(err, LF_ERR_IO, "%s: cannot open", path);
+        return NULL;
+    }
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (!s || fread(s, 1, (size_t)n, f) != (size_t)n) {
+        free(s);
+        fclose(f);
+        lf_error_set(err, LF_ERR_IO, "%s: cannot read", path);
+        return NULL;
+    }
+    s[n] = 0;
+    fclose(f);
+    return s;
+}
+
+static char *edit_text(const char *scene_path, const lf_grade_edit *edits, int nedits, lf_error *err)
+{
+    char *text = read_text(scene_path, err);
+    for (int i = 0; text && i < nedits; i++) {
+        char *at = strstr(text, edits[i].find);
+        if (!at) {
+            lf_error_set(err, LF_ERR_PARAM, "%s: variant edit: text '%s' not found", scene_path, edits[i].find);
+            free(text);
+            return NULL;
+        }
+        size_t lf = strlen(edits[i].find), lr = strlen(edits[i].replace), lt = strlen(text);
+        char *nt = malloc(lt - lf + lr + 1);
+        if (!nt) {
+            free(text);
+            lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+            return NULL;
+        }
+        size_t pre = (size_t)(at - text);
+        memcpy(nt, text, pre);
+        memcpy(nt + pre, edits[i].replace, lr);
+        memcpy(nt + pre + lr, at + lf, lt - pre - lf + 1);
+        free(text);
+        text = nt;
+    }
+    return text;
+}
+
+static int render_text(const char *text, const char *scene_path, int spp, uint32_t seed, int threads, lf_image *out,
+                       lf_attrs *meta, lf_error *err)
+{
+    lf_scene_desc d;
+    if (lf_scene_parse_string(text, scene_path, &d, err))
+        return err->code;
+    lf_render_opts o = lf_render_opts_default();
+    o.spp = spp;
+    o.seed = seed;
+    o.has_seed = 1;
+    o.threads = threads;
+    o.scene_path = scene_path;
+    lf_renderer *r;
+    int rc = lf_renderer_create(&d, &o, &r, err);
+    if (!rc) {
+        lf_attrs m = {0};
+        rc = lf_renderer_render(r, out, &m, err);
+        if (meta)
+            *meta = m;
+        else
+            lf_attrs_free(&m);
+        lf_renderer_free(r);
+    }
+    lf_scene_desc_free(&d);
+    return rc;
+}
+
+int lf_grade_render(const char *scene_path, const lf_grade_edit *edits, int nedits, int spp, uint32_t seed,
+                    int threads, lf_image *out, lf_attrs *meta, lf_error *err)
+{
+    char *text = edit_text(scene_path, edits, nedits, err);
+    if (!text)
+        return err->code;
+    int rc = render_text(text, scene_path, spp, seed, threads, out, meta, err);
+    free(text);
+    return rc;
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *s = p;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ s[i]) * 1099511628211ull;
+    return h;
+}
+
+static int copy_image(const lf_image *src, lf_image *dst)
+{
+    lf_error e = {0};
+    if (lf_image_alloc(dst, src->width, src->height, src->channels, &e))
+        return -1;
+    memcpy(dst->data, src->data, sizeof(float) * (size_t)src->width * src->height * src->channels);
+    return 0;
+}
+
+/* The reference for a scene (+ variant) at spp and seed; the image is owned
+ * by the context. */
+static int reference(lf_grade_ctx *g, const char *scene_rel, const lf_grade_variant *v, int spp, uint32_t seed,
+                     const lf_image **img, const lf_attrs **meta, lf_error *err)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", g->dir, scene_rel);
+    lf_grade_edit edits[LF_GRADE_MAX_EDITS] = {{0}};
+    int ne = v ? v->nedits : 0;
+    for (int i = 0; i < ne; i++)
+        edits[i].find = v->find[i], edits[i].replace = v->replace[i];
+    char *text = edit_text(path, edits, ne, err);
+    if (!text)
+        return err->code;
+    char settings[256];
+    snprintf(settings, sizeof settings, "lfgrade-ref-1|%d|%u|%s", spp, seed, v ? v->post : "");
+    uint64_t key = fnv(fnv(1469598103934665603ull, text, strlen(text)), settings, strlen(settings));
+    for (int i = 0; i < g->nrefs; i++)
+        if (g->refs[i].key == key) {
+            free(text);
+            *img = &g->refs[i].img, *meta = &g->refs[i].meta;
+            return 0;
+        }
+    cached_ref *nr = realloc(g->refs, sizeof *nr * (size_t)(g->nrefs + 1));
+    if (!nr) {
+        free(text);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    g->refs = nr;
+    cached_ref *c = &g->refs[g->nrefs];
+    memset(c, 0, sizeof *c);
+    c->key = key;
+    char file[1400];
+    snprintf(file, sizeof file, "%s/ref-%016llx.exr", g->cache, (unsigned long long)key);
+    lf_error cerr = {0};
+    int rc = 0;
+    if (lf_image_read(file, &c->img, &c->meta, &cerr)) {
+        rc = render_text(text, path, spp, seed, g->threads, &c->img, &c->meta, err);
+        if (!rc && v && v->post[0])
+            rc = lf_grade_post(v->post, &c->img, err);
+        if (!rc) {
+            if (mkdirs(g->cache))
+                rc = lf_error_set(err, LF_ERR_IO, "%s: cannot create the cache directory: %s", g->cache,
+                                  strerror(errno));
+            else
+                rc = lf_image_write(file, &c->img, &c->meta, NULL, err);
+        }
+    }
+    free(text);
+    if (rc) {
+        lf_image_free(&c->img), lf_attrs_free(&c->meta);
+        return rc;
+    }
+    g->nrefs++;
+    *img = &c->img, *meta = &c->meta;
+    return 0;
+}
+
+/* ---------- a submission ---------- */
+
+typedef struct sub_image {
+    char base[64];
+    char file[96];
+    int state; /* 0 not looked at, 1 header ok, 2 decoded, -1 problem */
+    char why[512];
+    const char *format;
+    int w, h;
+    unsigned char *bytes;
+    size_t nbytes;
+    lf_image img;
+} sub_image;
+
+typedef struct submission {
+    const char *dir;
+    char *md;
+    char md_why[512];
+    int md_state; /* 0 not read, 1 ok, -1 problem */
+    sub_image imgs[16];
+    int nimgs;
+} submission;
+
+static void set_why(sub_image *im, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_why(sub_image *im, const char *fmt, ...)
+{
+    char msg[1200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    size_t l = strlen(msg);
+    if (l >= sizeof im->why)
+        l = sizeof im->why - 1;
+    memcpy(im->why, msg, l);
+    im->why[l] = 0;
+}
+
+static sub_image *find_image(submission *s, const char *base)
+{
+    for (int i = 0; i < s->nimgs; i++)
+        if (!strcmp(s->imgs[i].base, base))
+            return &s->imgs[i];
+    if (s->nimgs == 16)
+        return NULL;
+    sub_image *im = &s->imgs[s->nimgs++];
+    memset(im, 0, sizeof *im);
+    snprintf(im->base, sizeof im->base, "%s", base);
+    /* EXR preferred when both exist (lossless) */
+    static const char *exts[] = {"exr", "png"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(im->file, sizeof im->file, "%s.%s", base, exts[k]);
+        char why[512];
+        int rc = lf_grade_read_inside(s->dir, im->file, LF_GRADE_MAX_FILE, &im->bytes, &im->nbytes, why, sizeof why);
+        if (rc == 1)
+            continue;
+        if (rc < 0) {
+            im->state = -1;
+            set_why(im, "%s", why);
+            return im;
+        }
+        if (lf_grade_image_header(im->bytes, im->nbytes, &im->format, &im->w, &im->h, why, sizeof why)) {
+            im->state = -1;
+            set_why(im, "%s: %s", im->file, why);
+            return im;
+        }
+        if ((!strcmp(im->format, "png")) != (k == 1)) {
+            im->state = -1;
+            set_why(im, "%s: the file is a %s image (name and contents disagree)", im->file, im->format);
+            return im;
+        }
+        im->state = 1;
+        return im;
+    }
+    im->state = -1;
+    snprintf(im->file, sizeof im->file, "%s.png", base);
+    set_why(im, "missing: neither %s.png nor %s.exr in the submission", base, base);
+    return im;
+}
+
+/* The decoded image if it has the expected size; else NULL and a reason. */
+static sub_image *get_image(submission *s, const char *base, int w, int h, char *why, size_t wn)
+{
+    sub_image *im = find_image(s, base);
+    if (!im) {
+        snprintf(why, wn, "too many images");
+        return NULL;
+    }
+    if (im->state < 0) {
+        snprintf(why, wn, "%s", im->why);
+        return NULL;
+    }
+    if (im->w != w || im->h != h) {
+        snprintf(why, wn, "%s: wrong size: %dx%d, expected %dx%d (not compared)", im->file, im->w, im->h, w, h);
+        return NULL;
+    }
+    if (im->state == 1) {
+        char msg[400];
+        if (lf_grade_image_decode(im->bytes, im->nbytes, im->format, &im->img, msg, sizeof msg)) {
+            im->state = -1;
+            set_why(im, "%s: %s", im->file, msg);
+            snprintf(why, wn, "%s", im->why);
+            return NULL;
+        }
+        if (im->img.width != w || im->img.height != h) {
+            im->state = -1;
+            set_why(im, "%s: decodes to %dx%d, expected %dx%d", im->file, im->img.width, im->img.height, w, h);
+            snprintf(why, wn, "%s", im->why);
+            return NULL;
+        }
+        size_t bad = lf_image_count_nonfinite(&im->img);
+        if (bad) {
+            im->state = -1;
+            set_why(im, "%s: %zu NaN/Inf pixel values (not compared)", im->file, bad);
+            snprintf(why, wn, "%s", im->why);
+            return NULL;
+        }
+        im->state = 2;
+    }
+    return im;
+}
+
+static const char *get_md(submission *s)
+{
+    if (s->md_state == 0) {
+        unsigned char *d;
+        size_t n;
+        int rc = lf_grade_read_inside(s->dir, "Submission.md", LF_GRADE_MAX_MD, &d, &n, s->md_why, sizeof s->md_why);
+        if (rc == 1)
+            snprintf(s->md_why, sizeof s->md_why, "Submission.md: missing");
+        if (rc) {
+            s->md_state = -1;
+        } else {
+            for (size_t i = 0; i < n; i++)
+                if (d[i] == 0)
+                    d[i] = ' ';
+            s->md = (char *)d;
+            s->md_state = 1;
+        }
+    }
+    return s->md_state > 0 ? s->md : NULL;
+}
+
+static void free_submission(submission *s)
+{
+    free(s->md);
+    for (int i = 0; i < s->nimgs; i++)
+        free(s->imgs[i].bytes), lf_image_free(&s->imgs[i].img);
+}
+
+/* Section headings (# ...) whose text starts with name, case-insensitively;
+ * returns the body length (non-blank characters) or -1 when absent. */
+static int section_body(const char *md, const char *name, const char **body_start, const char **body_end)
+{
+    const char *p = md;
+    while (*p) {
+        const char *eol = strchr(p, '\n');
+        if (!eol)
+            eol = p + strlen(p);
+        if (*p == '#') {
+            const char *t = p;
+            while (*t == '#')
+                t++;
+            while (*t == ' ' || *t == '\t')
+                t++;
+            if (!strncasecmp(t, name, strlen(name))) {
+                const char *b = *eol ? eol + 1 : eol, *e = b;
+                int nonblank = 0;
+                while (*e) {
+                    if ((e == md || e[-1] == '\n') && *e == '#')
+                        break;
+                    if (!isspace((unsigned char)*e))
+                        nonblank++;
+                    e++;
+                }
+                if (body_start)
+                    *body_start = b, *body_end = e;
+                return nonblank;
+            }
+        }
+        p = *eol ? eol + 1 : eol;
+    }
+    return -1;
+}
+
+/* The first line mentioning "lftool WORD" (the Commands section first),
+ * copied without markdown decoration. */
+static int find_command(const char *md, const char *word, char *line, size_t n)
+{
+    char pat[64];
+    snprintf(pat, sizeof pat, "lftool %s", word);
+    const char *at = strstr(md, pat);
+    if (!at)
+        return -1;
+    const char *eol = strchr(at, '\n');
+    size_t len = eol ? (size_t)(eol - at) : strlen(at);
+    if (len >= n)
+        len = n - 1;
+    memcpy(line, at, len);
+    line[len] = 0;
+    /* drop inline-code backticks and a trailing carriage return */
+    char *bt = strchr(line, '`');
+    if (bt && !strpbrk(bt + 1, ";|&$<>\\(){}")) {
+        char *q = bt;
+        while (*q == '`' || *q == ' ' || *q == '\r')
+            q++;
+        if (!*q)
+            *bt = 0;
+    }
+    size_t l = strlen(line);
+    while (l && (line[l - 1] == '\r' || line[l - 1] == ' '))
+        line[--l] = 0;
+    return 0;
+}
+
+static int parse_num(const char *s, double *v)
+{
+    char *end;
+    errno = 0;
+    *v = strtod(s, &end);
+    return end != s && !*end && !errno && isfinite(*v) ? 0 : -1;
+}
+
+/* What a student's `lftool synth|refocus ...` asked for, re-implemented. */
+typedef struct declared {
+    int ok;
+    char why[512];
+    lf_lf_synth_opts synth;
+    int have_outfov, have_outdim, have_pos, have_focal;
+    char flags_seen[512]; /* " lensradius focaldistance ..." */
+    double values[32];
+    char names[32][24];
+    int nvalues;
+    /* refocus */
+    int focus_kind; /* 0 none, 1 depth, 2 disparity, 3 alpha */
+    double focus, aperture;
+    int have_aperture;
+} declared;
+
+static void remember(declared *d, const char *name, double v)
+{
+    if (d->nvalues < 32) {
+        snprintf(d->names[d->nvalues], sizeof d->names[0], "%s", name);
+        d->values[d->nvalues++] = v;
+    }
+}
+
+static int declared_value(const declared *d, const char *name, double *v)
+{
+    for (int i = d->nvalues - 1; i >= 0; i--)
+        if (!strcmp(d->names[i], name)) {
+            *v = d->values[i];
+            return 1;
+        }
+    return 0;
+}
+
+static void parse_declared(const char *md, const char *word, declared *d)
+{
+    memset(d, 0, sizeof *d);
+    d->synth = lf_lf_synth_defaults();
+    char line[2048];
+    if (!md) {
+        snprintf(d->why, sizeof d->why, "no Submission.md to read the lftool %s command from", word);
+        return;
+    }
+    if (find_command(md, word, line, sizeof line)) {
+        snprintf(d->why, sizeof d->why, "Submission.md: no `lftool %s ...` command found", word);
+        return;
+    }
+    char **v;
+    int n;
+    char why[400];
+    if (lf_grade_tokenize(line, &v, &n, why, sizeof why)) {
+        snprintf(d->why, sizeof d->why, "Submission.md: the lftool %s command %s", word, why);
+        return;
+    }
+    static const struct {
+        const char *flag;
+        int n;
+    } flags[] = {{"--samplesperpixel", 1}, {"--focaldistance", 1}, {"--camerapos", 3}, {"--camerarot", 3},
+                 {"--inputfov", 1},        {"--outputfov", 1},     {"--lensradius", 1}, {"--griddim", 4},
+                 {"--camsperdim", 2},      {"--outputdim", 2},     {"--seed", 1},       {"--threads", 1},
+                 {"--depth", 1},           {"--disparity", 1},     {"--alpha", 1},      {"--aperture", 1}};
+    int positional = 0;
+    d->ok = 1;
+    for (int i = 2; i < n && d->ok; i++) {
+        const char *a = v[i];
+        if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--coverage") || !strcmp(a, "--method")) {
+            i++;
+            continue;
+        }
+        if (a[0] != '-') {
+            positional++;
+            continue;
+        }
+        int k = -1;
+        for (size_t f = 0; f < sizeof flags / sizeof *flags; f++)
+            if (!strcmp(a, flags[f].flag))
+                k = (int)f;
+        if (k < 0) {
+            d->ok = 0;
+            snprintf(d->why, sizeof d->why, "Submission.md: lftool %s: unknown flag %.60s", word, a);
+            break;
+        }
+        double x[4];
+        for (int j = 0; j < flags[k].n; j++) {
+            if (i + 1 + j >= n || parse_num(v[i + 1 + j], &x[j])) {
+                d->ok = 0;
+                snprintf(d->why, sizeof d->why, "Submission.md: lftool %s: %s needs %d finite number(s)", word, a,
+                         flags[k].n);
+                break;
+            }
+        }
+        if (!d->ok)
+            break;
+        i += flags[k].n;
+        const char *name = a + 2;
+        remember(d, name, x[0]);
+        if (!strcmp(name, "samplesperpixel")) {
+            if (x[0] < 1 || x[0] > 1024)
+                d->ok = 0, snprintf(d->why, sizeof d->why, "--samplesperpixel %g outside 1..1024", x[0]);
+            d->synth.spp = (int)x[0];
+        } else if (!strcmp(name, "focaldistance"))
+            d->synth.focal_distance = x[0], d->have_focal = 1;
+        else if (!strcmp(name, "camerapos"))
+            memcpy(d->synth.pos, x, sizeof d->synth.pos), d->have_pos = 1;
+        else if (!strcmp(name, "camerarot"))
+            memcpy(d->synth.rot_deg, x, sizeof d->synth.rot_deg);
+        else if (!strcmp(name, "outputfov"))
+            d->synth.fov_deg = x[0], d->have_outfov = 1;
+        else if (!strcmp(name, "lensradius"))
+            d->synth.lens_radius = x[0];
+        else if (!strcmp(name, "outputdim")) {
+            if (x[0] < 1 || x[1] < 1 || x[0] > 2048 || x[1] > 2048)
+                d->ok = 0, snprintf(d->why, sizeof d->why, "--outputdim %g %g outside 1..2048", x[0], x[1]);
+            d->synth.width = (int)x[0], d->synth.height = (int)x[1], d->have_outdim = 1;
+        } else if (!strcmp(name, "seed"))
+            d->synth.seed = (uint32_t)fabs(x[0]);
+        else if (!strcmp(name, "depth"))
+            d->focus_kind = 1, d->focus = x[0];
+        else if (!strcmp(name, "disparity"))
+            d->focus_kind = 2, d->focus = x[0];
+        else if (!strcmp(name, "alpha"))
+            d->focus_kind = 3, d->focus = x[0];
+        else if (!strcmp(name, "aperture"))
+            d->aperture = x[0], d->have_aperture = 1;
+    }
+    if (d->ok && positional < 1) {
+        d->ok = 0;
+        snprintf(d->why, sizeof d->why, "Submission.md: lftool %s: no input file", word);
+    }
+    lf_grade_free_argv(v, n);
+}
+
+/* Applies "key:value,key:value" overrides (variants) to a declaration. */
+static void apply_set(declared *d, const char *set)
+{
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", set);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        char *colon = strchr(tok, ':');
+        if (!colon)
+            continue;
+        *colon = 0;
+        double x = atof(colon + 1);
+        if (!strcmp(tok, "lensradius"))
+            d->synth.lens_radius = x;
+        else if (!strcmp(tok, "focaldistance"))
+            d->synth.focal_distance = x, d->have_focal = 1;
+        else if (!strcmp(tok, "outputfov"))
+            d->synth.fov_deg = x, d->have_outfov = 1;
+        else if (!strcmp(tok, "depth"))
+            d->focus_kind = 1, d->focus = x;
+        else if (!strcmp(tok, "disparity"))
+            d->focus_kind = 2, d->focus = x;
+    }
+}
+
+/* Light-field pipelines on a reference raw: synth (CS348B Part 2) or refocus. */
+static int lightfield_product(const lf_image *raw, const lf_attrs *meta, const declared *d, int refocus, int threads,
+                              lf_image *out, char *why, size_t wn)
+{
+    lf_error err = {0};
+    lf_lf_layout file, flags, lay;
+    lf_lf_layout_init(&flags);
+    lf_lightfield lf;
+    memset(&lf, 0, sizeof lf);
+    if (lf_lf_layout_from_attrs(meta, &file, &err) ||
+        lf_lf_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &err) ||
+        lf_lf_decode(raw, &lay, NULL, &lf, &err)) {
+        snprintf(why, wn, "grader: reference light field: %s", err.msg);
+        lf_lf_free(&lf);
+        return -1;
+    }
+    int rc;
+    if (!refocus) {
+        lf_lf_synth_opts s = d->synth;
+        s.threads = threads > 0 ? threads : 2;
+        if (!d->have_outfov)
+            s.fov_deg = lay.fov_deg;
+        if (!d->have_outdim)
+            s.width = lf.ns, s.height = lf.nt;
+        if (!d->have_pos) {
+            s.pos[0] = 0.5 * (lay.grid_bounds[0] + lay.grid_bounds[1]);
+            s.pos[1] = 0.5 * (lay.grid_bounds[2] + lay.grid_bounds[3]);
+            s.pos[2] = 0;
+        }
+        if (!d->have_focal && (lay.have & LF_LF_HAVE_CAM_LENS) && lay.focal_distance > 0)
+            s.focal_distance = lay.focal_distance;
+        rc = lf_lf_synth(&lf, &s, out, NULL, NULL, &err);
+    } else {
+        lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+        if (d->have_aperture)
+            ro.aperture_radius = d->aperture;
+        double disp = 0;
+        rc = 0;
+        if (d->focus_kind == 1)
+            rc = lf_lf_depth_to_disparity(&lf, d->focus, &disp, &err);
+        else if (d->focus_kind == 3)
+            rc = lf_lf_alpha_to_disparity(&lf, d->focus, &disp, &err);
+        else if (d->focus_kind == 2)
+            disp = d->focus;
+        ro.disparity_px = disp;
+        if (!rc)
+            rc = lf_lf_refocus(&lf, &ro, out, &err);
+    }
+    lf_lf_free(&lf);
+    if (rc)
+        snprintf(why, wn, "the declared command cannot be reproduced: %s", err.msg);
+    return rc ? -1 : 0;
+}
+
+/* ---------- comparing ---------- */
+
+typedef struct compare_job {
+    lf_grade_ctx *g;
+    const lf_grade_check *c;
+    lf_grade_check_result *res;
+    const char *student_dir; /* report folder, or NULL */
+    /* reference producer: seed 0 = A, 1 = B; variant may be NULL */
+    int (*make)(struct compare_job *j, const lf_grade_variant *v, int which, lf_image *out, char *why, size_t wn);
+    declared decl;
+    int spp;
+    uint32_t seed;
+} compare_job;
+
+static int make_render(compare_job *j, const lf_grade_variant *v, int which, lf_image *out, char *why, size_t wn)
+{
+    const lf_image *img;
+    const lf_attrs *meta;
+    lf_error err = {0};
+    if (reference(j->g, lf_grade_check_get(j->c, "scene", ""), v, j->spp, j->seed + (uint32_t)which, &img, &meta,
+                  &err)) {
+        snprintf(why, wn, "grader: reference %s: %s", v ? v->name : "render", err.msg);
+        return -2;
+    }
+    return copy_image(img, out);
+}
+
+static int make_lightfield(compare_job *j, const lf_grade_variant *v, int which, lf_image *out, char *why, size_t wn,
+                           int refocus)
+{
+    const lf_image *img;
+    const lf_attrs *meta;
+    lf_error err = {0};
+    if (reference(j->g, lf_grade_check_get(j->c, "scene", ""), NULL, j->spp, j->seed + (uint32_t)which, &img, &meta,
+                  &err)) {
+        snprintf(why, wn, "grader: reference light field: %s", err.msg);
+        return -2;
+    }
+    declared d = j->decl;
+    if (v && v->set[0])
+        apply_set(&d, v->set);
+    d.synth.seed = 7 + (uint32_t)which;
+    return lightfield_product(img, meta, &d, refocus, j->g->threads, out, why, wn);
+}
+static int make_synth(compare_job *j, const lf_grade_variant *v, int which, lf_image *out, char *why, size_t wn)
+{
+    return make_lightfield(j, v, which, out, why, wn, 0);
+}
+static int make_refocus(compare_job *j, const lf_grade_variant *v, int which, lf_image *out, char *why, size_t wn)
+{
+    return make_lightfield(j, v, which, out, why, wn, 1);
+}
+
+static void fail(lf_grade_check_result *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void fail(lf_grade_check_result *r, const char *fmt, ...)
+{
+    r->status = LF_GRADE_FAIL;
+    r->earned = 0;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->reason, sizeof r->reason, fmt, ap);
+    va_end(ap);
+}
+
+static void write_png(const char *dir, const char *id, const char *what, const lf_image *img)
+{
+    if (!dir)
+        return;
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s-%s.png", dir, id, what);
+    lf_error e = {0};
+    lf_image_write(path, img, NULL, NULL, &e);
+}
+
+/* Returns 0, or -2 on a grader-side failure (err filled). */
+static int compare(compare_job *j, submission *s, lf_error *err)
+{
+    lf_grade_check_result *r = j->res;
+    char why[700];
+    lf_image a = {0}, b = {0};
+    int rc = j->make(j, NULL, 0, &a, why, sizeof why);
+    if (!rc)
+        rc = j->make(j, NULL, 1, &b, why, sizeof why);
+    if (rc) {
+        lf_image_free(&a), lf_image_free(&b);
+        if (rc == -2)
+            return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
+        fail(r, "%s", why);
+        return 0;
+    }
+    sub_image *im = get_image(s, lf_grade_check_get(j->c, "image", j->c->id), a.width, a.height, why, sizeof why);
+    if (!im) {
+        fail(r, "%s", why);
+        lf_image_free(&a), lf_image_free(&b);
+        return 0;
+    }
+    int eight_bit = !strcmp(im->format, "png");
+    if (eight_bit)
+        lf_grade_quantize8(&a), lf_grade_quantize8(&b);
+    double max_ratio = atof(lf_grade_check_get(j->c, "max_ratio", "3"));
+    r->noise_ratio = lf_grade_noise_ratio(&im->img, &a, &a, &b);
+    r->ssim = lf_grade_ssim(&im->img, &a);
+    r->ssim_noise = lf_grade_ssim(&b, &a);
+    lf_image_psnr(&im->img, &a, &r->psnr_db, NULL);
+    if (j->student_dir) {
+        lf_image heat;
+        write_png(j->student_dir, j->c->id, "submission", &im->img);
+        write_png(j->student_dir, j->c->id, "reference", &a);
+        if (!lf_grade_heatmap(&im->img, &a, &b, &heat)) {
+            write_png(j->student_dir, j->c->id, "diff", &heat);
+            lf_image_free(&heat);
+        }
+    }
+    if (r->noise_ratio <= max_ratio) {
+        lf_image_free(&a), lf_image_free(&b);
+        return 0;
+    }
+    /* which known mistake does it look like? */
+    r->variant_ratio = INFINITY;
+    const lf_grade_variant *best = NULL;
+    for (int k = 0; k < j->c->nvariants; k++) {
+        /* each variant with its own two seeds: its noise can differ (a pinhole is noisier) */
+        lf_image va = {0}, vb = {0};
+        rc = j->make(j, &j->c->variants[k], 0, &va, why, sizeof why);
+        if (!rc)
+            rc = j->make(j, &j->c->variants[k], 1, &vb, why, sizeof why);
+        if (rc == -2) {
+            lf_image_free(&va), lf_image_free(&vb);
+            lf_image_free(&a), lf_image_free(&b);
+            return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
+        }
+        if (rc || va.width != a.width || va.height != a.height || vb.width != a.width || vb.height != a.height) {
+            lf_image_free(&va), lf_image_free(&vb);
+            continue;
+        }
+        if (eight_bit)
+            lf_grade_quantize8(&va), lf_grade_quantize8(&vb);
+        double rv = lf_grade_noise_ratio(&im->img, &va, &va, &vb);
+        if (rv < r->variant_ratio)
+            r->variant_ratio = rv, best = &j->c->variants[k];
+        lf_image_free(&va), lf_image_free(&vb);
+    }
+    if (best)
+        snprintf(r->best_variant, sizeof r->best_variant, "%s", best->name);
+    if (best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio)
+        fail(r, "%s: %s (matches the reference for that mistake at %.2fx the Monte Carlo noise level; the correct "
+                "reference: %.1fx, pass <= %.1fx)",
+             im->file, best->reason, r->variant_ratio, r->noise_ratio, max_ratio);
+    else if (best)
+        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx); no known "
+                "mistake matches (closest: %s, %.1fx)",
+             im->file, r->noise_ratio, j->spp, max_ratio, best->name, r->variant_ratio);
+    else
+        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx)", im->file,
+             r->noise_ratio, j->spp, max_ratio);
+    lf_image_free(&a), lf_image_free(&b);
+    return 0;
+}
+
+/* ---------- checks ---------- */
+
+static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r,
+                     const char *student_dir, lf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    snprintf(r->id, sizeof r->id, "%s", c->id);
+    snprintf(r->kind, sizeof r->kind, "%s", c->kind);
+    r->points = r->earned = c->points;
+    r->status = LF_GRADE_PASS;
+    r->noise_ratio = r->ssim = r->ssim_noise = r->psnr_db = r->variant_ratio = NAN;
+    const char *md = get_md(s);
+    if (!strcmp(c->kind, "files")) {
+        char list[256], missing[900] = "";
+        snprintf(list, sizeof list, "%s", lf_grade_check_get(c, "images", ""));
+        if (!md)
+            snprintf(missing, sizeof missing, "%s", s->md_why);
+        for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
+            sub_image *im = find_image(s, t);
+            if (im && im->state < 0) {
+                size_t l = strlen(missing);
+                snprintf(missing + l, sizeof missing - l, "%s%s", l ? "; " : "", im->why);
+            }
+        }
+        if (missing[0])
+            fail(r, "%s", missing);
+        return 0;
+    }
+    if (!strcmp(c->kind, "sections")) {
+        if (!md) {
+            fail(r, "%s", s->md_why);
+            return 0;
+        }
+        char list[256], bad[600] = "";
+        snprintf(list, sizeof list, "%s", lf_grade_check_get(c, "require", ""));
+        for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
+            int body = section_body(md, t, NULL, NULL);
+            if (body <= 0) {
+                size_t l = strlen(bad);
+                snprintf(bad + l, sizeof bad - l, "%s\"## %s\" %s", l ? "; " : "", t, body < 0 ? "missing" : "empty");
+            }
+        }
+        if (bad[0])
+            fail(r, "Submission.md: required sections: %s", bad);
+        return 0;
+    }
+    if (!strcmp(c->kind, "size")) {
+        int w = atoi(lf_grade_check_get(c, "width", "0")), h = atoi(lf_grade_check_get(c, "height", "0"));
+        sub_image *im = find_image(s, lf_grade_check_get(c, "image", c->id));
+        if (!im)
+            fail(r, "too many images");
+        else if (im->state < 0)
+            fail(r, "%s", im->why);
+        else if (im->w != w || im->h != h)
+            fail(r, "%s: wrong size: %dx%d, expected %dx%d", im->file, im->w, im->h, w, h);
+        return 0;
+    }
+    if (!strcmp(c->kind, "answer")) {
+        const char *key = lf_grade_check_get(c, "key", "");
+        double want = atof(lf_grade_check_get(c, "value", "0")), tol = atof(lf_grade_check_get(c, "tol", "0"));
+        const char *at = md ? strstr(md, key) : NULL;
+        if (!md) {
+            fail(r, "%s", s->md_why);
+            return 0;
+        }
+        if (!at || !key[0]) {
+            fail(r, "Submission.md: no \"%s = VALUE\" answer", key);
+            return 0;
+        }
+        at += strlen(key);
+        while (*at == ' ' || *at == '=' || *at == ':' || *at == '*' || *at == '`')
+            at++;
+        char *end;
+        double got = strtod(at, &end);
+        if (end == at || !isfinite(got))
+            fail(r, "Submission.md: %s has no number", key);
+        else if (fabs(got - want) > tol)
+            fail(r, "Submission.md: %s = %g, expected %g +- %g", key, got, want, tol);
+        return 0;
+    }
+    compare_job j;
+    memset(&j, 0, sizeof j);
+    j.g = g, j.c = c, j.res = r, j.student_dir = student_dir;
+    j.spp = atoi(lf_grade_check_get(c, "spp", "16"));
+    j.seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
+    if (!strcmp(c->kind, "constraint")) {
+        const char *cmd = lf_grade_check_get(c, "command", "synth"), *flag = lf_grade_check_get(c, "flag", "");
+        parse_declared(md, cmd, &j.decl);
+        if (!j.decl.ok) {
+            fail(r, "%s", j.decl.why);
+            return 0;
+        }
+        double v = atof(lf_grade_check_get(c, "default", "0"));
+        int have = declared_value(&j.decl, flag, &v);
+        const char *gt = lf_grade_check_get(c, "gt", NULL), *lt = lf_grade_check_get(c, "lt", NULL);
+        if ((gt && !(v > atof(gt))) || (lt && !(v < atof(lt))))
+            fail(r, "%s (--%s is %g%s; required %s %s)", lf_grade_check_get(c, "reason", "constraint violated"), flag,
+                 v, have ? "" : ", the default", gt ? ">" : "<", gt ? gt : lt);
+        return 0;
+    }
+    if (!strcmp(c->kind, "render")) {
+        j.make = make_render;
+        return compare(&j, s, err);
+    }
+    if (!strcmp(c->kind, "synth") || !strcmp(c->kind, "refocus")) {
+        int refocus = !strcmp(c->kind, "refocus");
+        if (lf_grade_check_get(c, "optional", NULL)) {
+            sub_image *im = find_image(s, lf_grade_check_get(c, "image", c->id));
+            if (im && im->state < 0 && strstr(im->why, "missing:")) {
+                fail(r, "optional part not submitted");
+                return 0;
+            }
+        }
+        parse_declared(md, refocus ? "refocus" : "synth", &j.decl);
+        if (!j.decl.ok) {
+            fail(r, "%s", j.decl.why);
+            return 0;
+        }
+        j.make = refocus ? make_refocus : make_synth;
+        return compare(&j, s, err);
+    }
+    return lf_error_set(err, LF_ERR_INTERNAL, "check %s: kind %s not implemented", c->id, c->kind);
+}
+
+static void student_name(const char *dir, char *out, size_t n)
+{
+    char tmp[1024];
+    snprintf(tmp, sizeof tmp, "%s", dir);
+    size_t l = strlen(tmp);
+    while (l > 1 && tmp[l - 1] == '/')
+        tmp[--l] = 0;
+    const char *b = strrchr(tmp, '/');
+    b = b ? b + 1 : tmp;
+    size_t k = 0;
+    for (; *b && k + 1 < n; b++)
+        out[k++] = (isalnum((unsigned char)*b) || *b == '-' || *b == '_' || *b == '.') ? *b : '_';
+    out[k] = 0;
+    if (!k || out[0] == '.')
+        snprintf(out, n, "submission");
+}
+
+int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_result *res, lf_error *err)
+{
+    memset(res, 0, sizeof *res);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    student_name(submission_dir, res->student, sizeof res->student);
+    snprintf(res->path, sizeof res->path, "%s", submission_dir);
+    res->checks = calloc((size_t)g->rubric.nchecks, sizeof *res->checks);
+    if (!res->checks)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    res->nchecks = g->rubric.nchecks;
+    char sdir[1400], *student_dir = NULL;
+    if (g->report[0]) {
+        snprintf(sdir, sizeof sdir, "%s/%s", g->report, res->student);
+        if (mkdirs(sdir))
+            return lf_error_set(err, LF_ERR_IO, "%s: cannot create: %s", sdir, strerror(errno));
+        student_dir = sdir;
+    }
+    submission s;
+    memset(&s, 0, sizeof s);
+    s.dir = submission_dir;
+    struct stat st;
+    int rc = 0;
+    int no_dir = stat(submission_dir, &st) || !S_ISDIR(st.st_mode);
+    for (int i = 0; i < g->rubric.nchecks && !rc; i++) {
+        lf_grade_check_result *r = &res->checks[i];
+        if (no_dir) {
+            memset(r, 0, sizeof *r);
+            snprintf(r->id, sizeof r->id, "%s", g->rubric.checks[i].id);
+            snprintf(r->kind, sizeof r->kind, "%s", g->rubric.checks[i].kind);
+            r->points = g->rubric.checks[i].points;
+            r->noise_ratio = r->ssim = r->ssim_noise = r->psnr_db = r->variant_ratio = NAN;
+            fail(r, "%s: not a folder", submission_dir);
+        } else {
+            rc = run_check(g, &g->rubric.checks[i], &s, r, student_dir, err);
+        }
+        res->max += r->points;
+        res->score += r->earned;
+    }
+    free_submission(&s);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    res->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    if (!rc && student_dir)
+        rc = lf_grade_report_student(student_dir, g->rubric.title, res, err);
+    return rc;
+}

@@ -1,0 +1,225 @@
+/* rubric.c - assignments/<name>/rubric.txt, one directive per line:
+ *
+ *   assignment NAME
+ *   title TEXT
+ *   check ID POINTS KIND key=value ...
+ *   variant CHECK_ID NAME reason='...' [replace='...' with='...']... [post=OP] [set=key:value,...]
+ *
+ * Values may be quoted with '...' or "..." (no escapes).  Kinds and keys:
+ * docs/grading.md. */
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grade_internal.h"
+
+static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, char *why, size_t wn)
+{
+    if (strict) {
+        const char *bad = strpbrk(line, ";|&$`<>\\(){}\n\r");
+        if (bad) {
+            snprintf(why, wn, "contains shell syntax '%c': commands are read as data and never run, so this line is "
+                              "not accepted",
+                     *bad == '\n' || *bad == '\r' ? ' ' : *bad);
+            return -1;
+        }
+    }
+    int cap = 16, n = 0;
+    char **v = malloc(sizeof *v * (size_t)cap);
+    size_t len = strlen(line);
+    char *buf = malloc(len + 1);
+    if (!v || !buf) {
+        free(v), free(buf);
+        snprintf(why, wn, "out of memory");
+        return -1;
+    }
+    const char *p = line;
+    for (;;) {
+        while (*p && isspace((unsigned char)*p))
+            p++;
+        if (!*p || (*p == '#' && !strict))
+            break;
+        size_t k = 0;
+        while (*p && !isspace((unsigned char)*p)) {
+            if (*p == '\'' || *p == '"') {
+                char q = *p++;
+                const char *e = strchr(p, q);
+                if (!e) {
+                    for (int i = 0; i < n; i++)
+                        free(v[i]);
+                    free(v), free(buf);
+                    snprintf(why, wn, "unterminated %c quote", q);
+                    return -1;
+                }
+                memcpy(buf + k, p, (size_t)(e - p));
+                k += (size_t)(e - p);
+                p = e + 1;
+            } else {
+                buf[k++] = *p++;
+            }
+        }
+        buf[k] = 0;
+        if (n == cap) {
+            cap *= 2;
+            char **nv = realloc(v, sizeof *v * (size_t)cap);
+            if (!nv)
+                break;
+            v = nv;
+        }
+        v[n++] = strdup(buf);
+    }
+    free(buf);
+    *argv_out = v;
+    *argc_out = n;
+    return 0;
+}
+
+int lf_grade_tokenize(const char *line, char ***argv, int *argc, char *why, size_t why_size)
+{
+    return tokenize(line, 1, argv, argc, why, why_size);
+}
+
+void lf_grade_free_argv(char **argv, int argc)
+{
+    for (int i = 0; i < argc; i++)
+        free(argv[i]);
+    free(argv);
+}
+
+static const char *kinds[] = {"files", "sections", "size", "render", "synth", "refocus", "constraint", "answer"};
+
+const char *lf_grade_check_get(const lf_grade_check *c, const char *key, const char *def)
+{
+    for (int i = 0; i < c->nkv; i++)
+        if (!strcmp(c->key[i], key))
+            return c->val[i];
+    return def;
+}
+
+void lf_grade_rubric_free(lf_grade_rubric *r)
+{
+    for (int i = 0; i < r->nchecks; i++) {
+        lf_grade_check *c = &r->checks[i];
+        for (int k = 0; k < c->nkv; k++)
+            free(c->key[k]), free(c->val[k]);
+        for (int v = 0; v < c->nvariants; v++)
+            for (int e = 0; e < c->variants[v].nedits; e++)
+                free(c->variants[v].find[e]), free(c->variants[v].replace[e]);
+    }
+    free(r->checks);
+    memset(r, 0, sizeof *r);
+}
+
+int lf_grade_rubric_parse(const char *path, lf_grade_rubric *r, lf_error *err)
+{
+    memset(r, 0, sizeof *r);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot open the rubric", path);
+    char line[4096];
+    int lineno = 0, rc = 0;
+    while (!rc && fgets(line, sizeof line, f)) {
+        lineno++;
+        char **v;
+        int n;
+        char why[256];
+        if (tokenize(line, 0, &v, &n, why, sizeof why)) {
+            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s", path, lineno, why);
+            break;
+        }
+        if (n == 0) {
+            lf_grade_free_argv(v, n);
+            continue;
+        }
+        if (!strcmp(v[0], "assignment") && n == 2) {
+            snprintf(r->assignment, sizeof r->assignment, "%s", v[1]);
+        } else if (!strcmp(v[0], "title") && n >= 2) {
+            r->title[0] = 0;
+            for (int i = 1; i < n; i++) {
+                size_t l = strlen(r->title);
+                snprintf(r->title + l, sizeof r->title - l, "%s%s", i > 1 ? " " : "", v[i]);
+            }
+        } else if (!strcmp(v[0], "check") && n >= 4) {
+            lf_grade_check *nc = realloc(r->checks, sizeof *nc * (size_t)(r->nchecks + 1));
+            if (!nc) {
+                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+            } else {
+                r->checks = nc;
+                lf_grade_check *c = &r->checks[r->nchecks++];
+                memset(c, 0, sizeof *c);
+                c->line = lineno;
+                snprintf(c->id, sizeof c->id, "%s", v[1]);
+                char *end;
+                long pts = strtol(v[2], &end, 10);
+                if (*end || pts < 0 || pts > 1000)
+                    rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: points '%s' is not an integer in 0..1000", path,
+                                      lineno, v[2]);
+                c->points = (int)pts;
+                snprintf(c->kind, sizeof c->kind, "%s", v[3]);
+                int known = 0;
+                for (size_t k = 0; k < sizeof kinds / sizeof *kinds; k++)
+                    known |= !strcmp(kinds[k], v[3]);
+                if (!known && !rc)
+                    rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: unknown check kind '%s'", path, lineno, v[3]);
+                for (int i = 4; i < n && !rc; i++) {
+                    char *eq = strchr(v[i], '=');
+                    if (!eq || c->nkv == 24) {
+                        rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected key=value, got '%s'", path, lineno, v[i]);
+                        break;
+                    }
+                    *eq = 0;
+                    c->key[c->nkv] = strdup(v[i]);
+                    c->val[c->nkv++] = strdup(eq + 1);
+                }
+            }
+        } else if (!strcmp(v[0], "variant") && n >= 4) {
+            lf_grade_check *c = NULL;
+            for (int i = 0; i < r->nchecks; i++)
+                if (!strcmp(r->checks[i].id, v[1]))
+                    c = &r->checks[i];
+            if (!c || c->nvariants == LF_GRADE_MAX_VARIANTS) {
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: variant of %s: %s", path, lineno, v[1],
+                                  c ? "too many variants" : "no such check above");
+            } else {
+                lf_grade_variant *va = &c->variants[c->nvariants++];
+                memset(va, 0, sizeof *va);
+                snprintf(va->name, sizeof va->name, "%s", v[2]);
+                for (int i = 3; i < n && !rc; i++) {
+                    char *eq = strchr(v[i], '=');
+                    if (!eq) {
+                        rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected key=value, got '%s'", path, lineno, v[i]);
+                        break;
+                    }
+                    *eq = 0;
+                    const char *val = eq + 1;
+                    if (!strcmp(v[i], "reason"))
+                        snprintf(va->reason, sizeof va->reason, "%s", val);
+                    else if (!strcmp(v[i], "post"))
+                        snprintf(va->post, sizeof va->post, "%s", val);
+                    else if (!strcmp(v[i], "set"))
+                        snprintf(va->set, sizeof va->set, "%s", val);
+                    else if (!strcmp(v[i], "replace") && va->nedits < LF_GRADE_MAX_EDITS)
+                        va->find[va->nedits] = strdup(val), va->replace[va->nedits] = NULL;
+                    else if (!strcmp(v[i], "with") && va->find[va->nedits] && !va->replace[va->nedits])
+                        va->replace[va->nedits++] = strdup(val);
+                    else
+                        rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: unexpected '%s' in a variant", path, lineno, v[i]);
+                }
+                if (!rc && va->nedits < LF_GRADE_MAX_EDITS && va->find[va->nedits])
+                    rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: replace= without with=", path, lineno);
+                if (!rc && !va->reason[0])
+                    rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: a variant needs reason=", path, lineno);
+            }
+        } else {
+            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: unknown directive '%s' (or missing fields)", path, lineno, v[0]);
+        }
+        lf_grade_free_argv(v, n);
+    }
+    fclose(f);
+    if (!rc && !r->nchecks)
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: no checks", path);
+    if (rc)
+        lf_grade_rubric_free(r);
+    return rc;
+}

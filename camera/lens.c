@@ -674,6 +674,70 @@ static double bisect_y(pupil_ctx *c, double x, double y_pass, double y_fail)
     return y_pass;
 }
 
+/* Stack room for the chief-ray search; longer prescriptions skip it. */
+#define LF_LENS_MAX_SURFACES 64
+
+/* Where a meridional ray from the film point, aimed at rear-plane x, crosses
+ * the stop plane (traced with the stop opened to its full clear radius);
+ * 0 if it does not get that far. */
+static int stop_crossing(pupil_ctx *c, const lf_lens *open, double x, double *h)
+{
+    double path[LF_LENS_MAX_SURFACES + 1][3];
+    lf_lens_ray in = {{c->fx, 0, 0}, {x - c->fx, 0, -c->Z}};
+    lf_lens_trace_opts o = {0};
+    o.lambda_nm = c->n_lambda ? c->lambda[0] : 0.0;
+    o.path = path;
+    c->traces++;
+    trace(open, &in, NULL, &o, 1);
+    int k = open->n - 1 - open->stop; /* surfaces are met rear first */
+    if (o.path_count <= k)
+        return 0;
+    *h = path[k][0];
+    return 1;
+}
+
+/* The rear-plane x of the chief ray (through the stop centre) by scan and
+ * bisection of the stop crossing; 0 if there is none. */
+static int chief_ray_x(pupil_ctx *c, double rs, double *x_out)
+{
+    const lf_lens *L = c->L;
+    if (L->stop < 0 || L->n > LF_LENS_MAX_SURFACES)
+        return 0;
+    lf_lens_surface surf[LF_LENS_MAX_SURFACES];
+    memcpy(surf, L->s, sizeof(lf_lens_surface) * (size_t)L->n);
+    double full = L->stop_max_radius_mm > surf[L->stop].aperture_radius_mm ? L->stop_max_radius_mm
+                                                                           : surf[L->stop].aperture_radius_mm;
+    surf[L->stop].aperture_radius_mm = full > 0 ? full : 1e9;
+    lf_lens open = *L;
+    open.s = surf;
+    enum { M = 96 };
+    double step = 2.0 * rs / (M - 1), prev_x = 0, prev_h = 0;
+    int have_prev = 0;
+    for (int i = 0; i < M; i++) {
+        double x = -rs + i * step, h;
+        if (!stop_crossing(c, &open, x, &h)) {
+            have_prev = 0;
+            continue;
+        }
+        if (have_prev && (prev_h <= 0) != (h <= 0)) {
+            double a = prev_x, b = x, ha = prev_h;
+            for (int it = 0; it < 60; it++) {
+                double m = 0.5 * (a + b), hm;
+                if (!stop_crossing(c, &open, m, &hm))
+                    break;
+                if ((ha <= 0) == (hm <= 0))
+                    a = m, ha = hm;
+                else
+                    b = m;
+            }
+            *x_out = 0.5 * (a + b);
+            return 1;
+        }
+        prev_x = x, prev_h = h, have_prev = 1;
+    }
+    return 0;
+}
+
 /* The passing interval on the meridional line y = 0; 0 if none. */
 static int meridional_interval(pupil_ctx *c, double rs, double *xlo, double *xhi)
 {
@@ -686,8 +750,22 @@ static int meridional_interval(pupil_ctx *c, double rs, double *xlo, double *xhi
                 first = i;
             last = i;
         }
-    if (first < 0)
-        return 0;
+    if (first < 0) {
+        /* A stop much smaller than the scan step (f/1000 and beyond) lets
+         * light through a sliver the grid misses: find the chief ray, the
+         * one through the stop's centre, and start from it. */
+        double xc;
+        if (!chief_ray_x(c, rs, &xc) || !passes(c, xc, 0.0))
+            return 0;
+        double lo = xc, hi = xc, w = 1e-9 * rs;
+        while (lo - w > -rs && passes(c, lo - w, 0.0))
+            lo -= w, w *= 2;
+        while (hi + w < rs && passes(c, hi + w, 0.0))
+            hi += w, w *= 2;
+        *xlo = bisect_x(c, 0.0, lo, lo - w > -rs ? lo - w : -rs);
+        *xhi = bisect_x(c, 0.0, hi, hi + w < rs ? hi + w : rs);
+        return 1;
+    }
     *xlo = first > 0 ? bisect_x(c, 0.0, -rs + first * step, -rs + (first - 1) * step) : -rs;
     *xhi = last < M - 1 ? bisect_x(c, 0.0, -rs + last * step, -rs + (last + 1) * step) : rs;
     return 1;

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "image_internal.h"
 
@@ -500,6 +501,21 @@ int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *att
     if (rv) {
         rc = lf_error_set(err, read_code(rv), "cannot read '%s': %s", name, exr_msg(rv));
         goto done;
+    }
+    {
+        /* No EXR codec packs more than about 1000:1 (deflate's limit; RLE,
+         * PIZ and B44 far less), so a header promising more pixels than
+         * 2048 times the file's bytes (beyond a 256 MiB floor) is a lie:
+         * refuse it before allocating (a 747-byte file once asked for 2.4 GB). */
+        struct stat st;
+        double need = (double)width * (double)height * (double)nout * 4.0;
+        if (stat(file, &st) == 0 && need > 268435456.0 && need > 2048.0 * (double)st.st_size) {
+            rc = lf_error_set(err, LF_ERR_PARSE,
+                              "cannot read '%s': its header claims %lldx%lld pixels (%.0f MB) but the file has only "
+                              "%lld bytes",
+                              name, (long long)width, (long long)height, need / 1e6, (long long)st.st_size);
+            goto done;
+        }
     }
     if ((rc = lf_image_alloc(img, (int)width, (int)height, nout, err)) != 0)
         goto done;

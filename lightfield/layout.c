@@ -46,6 +46,21 @@ static int attr_vec(const lf_attrs *a, const char *name, int n, double *v, lf_er
     return 1;
 }
 
+/* Attribute values come from files: every number is range-checked before
+ * it is converted or used (fuzzing found NaN pitches and 65536^2 grids). */
+static int whole_in(double v, double lo, double hi)
+{
+    return isfinite(v) && v >= lo && v <= hi && v == floor(v);
+}
+
+static int finite_within(const double *v, int n, double limit)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i]) || fabs(v[i]) > limit)
+            return 0;
+    return 1;
+}
+
 int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
 {
     lf_lf_layout_init(lay);
@@ -67,12 +82,18 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
     if ((r = attr_vec(a, "lensfield:cameras_per_dim", 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
-        lay->cams_x = (int)lrint(v[0]);
-        lay->cams_y = (int)lrint(v[1]);
+        if (!whole_in(v[0], 1, 4096) || !whole_in(v[1], 1, 4096))
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "attribute lensfield:cameras_per_dim: expected whole numbers in 1..4096, got %g x %g",
+                                v[0], v[1]);
+        lay->cams_x = (int)v[0];
+        lay->cams_y = (int)v[1];
         lay->have |= LF_LF_HAVE_CAMS;
     }
     if ((r = attr_vec(a, "lensfield:camera_grid_bounds", 4, lay->grid_bounds, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
+    if (r && !finite_within(lay->grid_bounds, 4, 1e12))
+        return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:camera_grid_bounds: values must be finite");
     if (r)
         lay->have |= LF_LF_HAVE_BOUNDS;
     if ((r = attr_num(a, "lensfield:fov_deg", &lay->fov_deg, err)) < 0)
@@ -82,8 +103,10 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
     if ((r = attr_vec(a, "lensfield:tile_size", 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
-        lay->tile_w = (int)lrint(v[0]);
-        lay->tile_h = (int)lrint(v[1]);
+        if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
+            return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:tile_size: expected whole numbers in 1..2^20");
+        lay->tile_w = (int)v[0];
+        lay->tile_h = (int)v[1];
         lay->have |= LF_LF_HAVE_TILE;
     }
     int lr = attr_num(a, "lensfield:lens_radius", &lay->lens_radius, err);
@@ -115,8 +138,11 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
     if ((r = attr_vec(a, "lensfield:microlens_count", 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
-        lay->lens_x = (int)lrint(v[0]);
-        lay->lens_y = (int)lrint(v[1]);
+        if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "attribute lensfield:microlens_count: expected whole numbers in 1..2^20");
+        lay->lens_x = (int)v[0];
+        lay->lens_y = (int)v[1];
         lay->have |= LF_LF_HAVE_LENS_COUNT;
     }
     int n = 0;
@@ -130,6 +156,16 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
         return err->code;
     if (n == 4)
         lay->have |= LF_LF_HAVE_MAIN_LENS;
+    double scalars[] = {lay->fov_deg, lay->pitch_px, lay->rotation_rad, lay->lens_radius, lay->focal_distance};
+    if (((lay->have & LF_LF_HAVE_FOV) && !(isfinite(lay->fov_deg) && lay->fov_deg > 0 && lay->fov_deg < 180)) ||
+        ((lay->have & LF_LF_HAVE_PITCH) && !(isfinite(lay->pitch_px) && lay->pitch_px > 0 && lay->pitch_px <= 1e6)) ||
+        ((lay->have & LF_LF_HAVE_OFFSET) && !finite_within(lay->offset_px, 2, 1e9)) ||
+        !finite_within(scalars + 2, 1, 1e6) ||
+        ((lay->have & LF_LF_HAVE_CAM_LENS) && !finite_within(scalars + 3, 2, 1e12)))
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "light-field layout attributes out of range (fov %g deg, pitch %g px, offset %g %g, "
+                            "rotation %g)",
+                            lay->fov_deg, lay->pitch_px, lay->offset_px[0], lay->offset_px[1], lay->rotation_rad);
     return LF_OK;
 }
 
@@ -231,8 +267,12 @@ int lf_lf_layout_resolve(const lf_lf_layout *file, const lf_lf_layout *flags, in
             return lf_error_set(err, LF_ERR_PARAM,
                                 "plenoptic layout incomplete, missing:%s (or run lftool calibrate on a white image)",
                                 missing);
-        if (!(out->pitch_px >= 2.0) || !isfinite(out->pitch_px))
-            return lf_error_set(err, LF_ERR_PARAM, "microlens pitch %g px is too small (need >= 2)", out->pitch_px);
+        if (!(out->pitch_px >= 2.0) || !isfinite(out->pitch_px) || out->pitch_px > 1e6)
+            return lf_error_set(err, LF_ERR_PARAM, "microlens pitch %g px is out of range (need 2 .. 1e6)",
+                                out->pitch_px);
+        if (!finite_within(out->offset_px, 2, 1e9))
+            return lf_error_set(err, LF_ERR_PARAM, "microlens offset (%g, %g) px is out of range", out->offset_px[0],
+                                out->offset_px[1]);
         if (!(out->have & LF_LF_HAVE_LENS_COUNT)) {
             double py = out->pitch_px * (out->grid == LF_LF_GRID_HEX ? sqrt(3.0) / 2 : 1.0);
             out->lens_x = (int)floor((raw_w - out->offset_px[0]) / out->pitch_px) + 1;

@@ -239,7 +239,8 @@ static int parse_header(ply_reader *r, ply_element **out_els, size_t *out_n)
             }
             if (bad) {
                 free_elements(els, n_els);
-                return ply_fail(r, 1, bad, strstr(bad, "type") && nw >= 2 ? w[nw - 1] : NULL);
+                /* split_words counts every word but stores at most 6 */
+                return ply_fail(r, 1, bad, strstr(bad, "type") && nw >= 2 ? w[(nw < 6 ? nw : 6) - 1] : NULL);
             }
             ply_element *el = &els[n_els - 1];
             ply_property *np = realloc(el->props, (el->n_props + 1) * sizeof *np);

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/) with clang into build-fuzz and runs each
+# for SECONDS (default 60), printing the executions per target.
+#
+#   bash bench/fuzz.sh [SECONDS] [TARGET ...]     # targets: scene_parser ply lens_file lf_attributes image_exr
+#
+# Each target starts from its seeds in fuzz/corpus/<target>/ and grows a
+# working corpus in build-fuzz/corpus/<target>/ (not in git).  A crash, leak,
+# timeout or out-of-memory input is copied to fuzz/regressions/<target>/,
+# where tests/test_fuzz_regressions.c replays it in every ctest run; its
+# report is in build-fuzz/logs/<target>.log.  Exit status: 0 if no target
+# found anything, 1 otherwise.  Results and the command: docs/fuzzing.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET="${1:-60}"
+shift || true
+TARGETS=("$@")
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(scene_parser ply lens_file lf_attributes image_exr)
+B="${LF_FUZZ_BUILD:-build-fuzz}"
+
+cmake -S . -B "$B" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLF_FUZZ=ON >/dev/null
+cmake --build "$B" --target lf_fuzz -j"$(nproc)"
+
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
+found=0
+printf '%-14s %10s %10s %8s  %s\n' target seconds execs exec/s findings
+for t in "${TARGETS[@]}"; do
+  bin="$B/bin/fuzz_$t"
+  [ -x "$bin" ] || { echo "fuzz.sh: no target $t" >&2; exit 2; }
+  mkdir -p "$B/corpus/$t" "$B/artifacts/$t" "$B/logs" "fuzz/regressions/$t"
+  log="$B/logs/$t.log"
+  # Fork mode keeps fuzzing after a crash, so one known bug does not end
+  # the run.  -timeout: one input taking 10 s is a finding; so is 2 GB RSS.
+  start=$(date +%s)
+  "$bin" "$B/corpus/$t" "fuzz/corpus/$t" -fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1 \
+    -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$B/artifacts/$t/" >"$log" 2>&1 || true
+  secs=$(( $(date +%s) - start ))
+  execs=$(sed -n 's/^#\([0-9][0-9]*\):.*/\1/p' "$log" | tail -1 || true)
+  execs=${execs:-0}
+  rate=$(( execs / (secs > 0 ? secs : 1) ))
+  n=0
+  for a in "$B/artifacts/$t"/*; do
+    [ -e "$a" ] || continue
+    n=$((n + 1))
+    [ $n -le 5 ] && cp "$a" "fuzz/regressions/$t/"  # a few examples; the rest repeat them
+    rm -f "$a"
+  done
+  findings=none
+  if [ $n -gt 0 ]; then
+    found=1
+    findings="$n inputs ($( [ $n -le 5 ] && echo all || echo 5 ) saved in fuzz/regressions/$t/)"
+    echo "fuzz.sh: $t: distinct reports (full log: $log):" >&2
+    # one line per place and kind: values replaced by N
+    grep -h 'SUMMARY: \|runtime error: ' "$log" | sed 's/==[0-9]*==//' |
+      awk -F'runtime error: ' 'NF > 1 { gsub(/-?(nan|inf|[0-9][0-9.e+-]*)/, "N", $2); print $1 "runtime error: " $2; next } { print }' |
+      sort | uniq -c | sort -rn >&2 || true
+  fi
+  printf '%-14s %10s %10s %8s  %s\n' "$t" "$secs" "$execs" "$rate" "$findings"
+done
+exit $found

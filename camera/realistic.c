@@ -9,6 +9,11 @@
  *                            (camera/aperture.h; also "blades", "aperturerotation", "anamorphic")
  *   "bool dispersion"        lensfield extension (default false): with Abbe numbers in the
  *                            lens file, n depends on wavelength and rays sample it
+ *   "string lensmodel"       lensfield extension: "traced" (default, Snell's law at every
+ *                            surface) or "polynomial" (camera/lens_poly.h: a fitted ray
+ *                            transfer; traced instead, with a warning, where the fit is poor)
+ *   "bool pupilbounds"       lensfield extension (default true): aim film rays at the
+ *                            exit-pupil bound; false: at the whole rear disk (for comparison)
  * The film's physical size comes from Film "diagonal" (mm) and the image aspect.
  *
  * Camera space is pbrt's: the film centre at the origin, the lens in front of
@@ -27,6 +32,7 @@
 #include "aperture.h"
 #include "camera_internal.h"
 #include "lens.h"
+#include "lens_poly.h"
 
 typedef struct realistic {
     lf_lens lens;
@@ -38,7 +44,17 @@ typedef struct realistic {
     double film_w_mm, film_h_mm, diagonal_mm;
     double focus_distance_mm, film_distance_search_mm, working_fnumber;
     double useful_fraction, lit_film_fraction, setup_seconds;
+    int pupil_bounds;     /* "pupilbounds": sample the exit-pupil bound (else the rear disk) */
+    int use_poly;         /* "lensmodel" "polynomial" and the fit is good enough */
+    int poly_requested;
+    lf_lens_poly poly;
 } realistic;
+
+/* The polynomial is used when 99% of its rays land within this many pixels
+ * of the traced ones on the focus plane and it blocks or passes the same
+ * rays but for 1%; otherwise the camera traces (docs/realistic.md). */
+#define POLY_MAX_P99_PX 0.1
+#define POLY_MAX_MISMATCH 0.01
 
 static double stop_shape(const void *ctx, double x, double y)
 {
@@ -56,6 +72,7 @@ static void film_point(const realistic *c, double raster_x, double raster_y, dou
 static void realistic_free(realistic *c)
 {
     lf_lens_free(&c->lens);
+    lf_lens_poly_free(&c->poly);
     lf_aperture_free(&c->aperture);
     free(c);
 }
@@ -113,6 +130,8 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
     double aperture_diameter = p->get_float(p->ctx, "aperturediameter", 1.0);
     double focus_m = p->get_float(p->ctx, "focusdistance", 10.0);
     int dispersion = p->get_bool(p->ctx, "dispersion", 0);
+    const char *lensmodel = p->get_string(p->ctx, "lensmodel", "traced");
+    c->pupil_bounds = p->get_bool(p->ctx, "pupilbounds", 1);
     if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
         free(c);
         return -1;
@@ -124,6 +143,12 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
                  "description file supplied!\"); see scenes/lenses/");
         goto fail;
     }
+    if (strcmp(lensmodel, "traced") && strcmp(lensmodel, "polynomial")) {
+        snprintf(a->error, a->error_size, "\"string lensmodel\" must be \"traced\" or \"polynomial\", got \"%s\"",
+                 lensmodel);
+        goto fail;
+    }
+    c->poly_requested = !strcmp(lensmodel, "polynomial");
     if (!(aperture_diameter > 0.0) || !isfinite(aperture_diameter)) {
         snprintf(a->error, a->error_size, "\"aperturediameter\" must be > 0 mm, got %g", aperture_diameter);
         goto fail;
@@ -194,6 +219,25 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
                  c->lens.film_distance_mm);
         goto fail;
     }
+    if (c->poly_requested && c->lens.dispersive) {
+        WARN("\"lensmodel\" \"polynomial\" has no wavelength input: tracing %s instead (dispersion is on)", path);
+    } else if (c->poly_requested) {
+        lf_lens_poly_opts po = lf_lens_poly_opts_default();
+        po.pixel_mm = c->film_w_mm / c->width;
+        po.focus_distance_mm = c->focus_distance_mm;
+        char msg[256] = "";
+        if (lf_lens_poly_fit(&c->lens, &c->pupil, &po, &c->poly, msg, sizeof msg)) {
+            WARN("\"lensmodel\" \"polynomial\": %s; tracing %s instead", msg, path);
+        } else if (!(c->poly.fit.p99_px <= POLY_MAX_P99_PX) || !(c->poly.fit.mismatch_fraction <= POLY_MAX_MISMATCH)) {
+            WARN("\"lensmodel\" \"polynomial\": the best fit (degree %d) of %s puts 1%% of rays %.2g pixels or "
+                 "more from the traced ones and passes or blocks %.2g%% of rays differently (limits %g px, %g%%); "
+                 "tracing instead",
+                 c->poly.degree, path, c->poly.fit.p99_px, 100.0 * c->poly.fit.mismatch_fraction, POLY_MAX_P99_PX,
+                 100.0 * POLY_MAX_MISMATCH);
+        } else {
+            c->use_poly = 1;
+        }
+    }
     estimate_useful_fraction(c);
     c->setup_seconds = seconds() - t0;
 #undef WARN
@@ -225,7 +269,10 @@ static double realistic_generate_ray(const void *state, const lf_camera_sample *
         opts.stop_ctx = &c->aperture;
     }
     lf_lens_ray out;
-    double w = lf_lens_sample_ray(&c->lens, &c->pupil, 1, fx, fy, s->lens_u, s->lens_v, &opts, &out);
+    double w = c->use_poly ? lf_lens_poly_sample_ray(&c->lens, &c->poly, &c->pupil, c->pupil_bounds, fx, fy, s->lens_u,
+                                                     s->lens_v, opts.stop_shape, opts.stop_ctx, &out)
+                           : lf_lens_sample_ray(&c->lens, &c->pupil, c->pupil_bounds, fx, fy, s->lens_u, s->lens_v,
+                                                &opts, &out);
     if (!(w > 0.0)) {
         r->origin[0] = r->origin[1] = r->origin[2] = 0.0;
         r->dir[0] = r->dir[1] = 0.0, r->dir[2] = 1.0;
@@ -251,6 +298,18 @@ static int realistic_describe(const void *state, char *buf, size_t size)
     double stop_d = L->stop >= 0 ? 2.0 * L->s[L->stop].aperture_radius_mm : 0.0;
     double stop_max = L->stop >= 0 ? 2.0 * L->stop_max_radius_mm : 0.0;
     static const char *const shapes[] = {"circular", "polygon", "star", "image"};
+    char model[512];
+    if (c->use_poly)
+        snprintf(model, sizeof model,
+                 "polynomial (fitted ray transfer, degree %d, %d clipping surfaces + stop, fit %.3f s; against "
+                 "tracing: rms %.3g px, 99%% within %.3g px on the focus plane, %.2g%% of rays passed/blocked "
+                 "differently)",
+                 c->poly.degree, c->poly.n_clip, c->poly.setup_seconds, c->poly.fit.rms_px, c->poly.fit.p99_px,
+                 100.0 * c->poly.fit.mismatch_fraction);
+    else
+        snprintf(model, sizeof model, "traced (Snell's law at every surface)%s",
+                 c->poly_requested ? "; \"polynomial\" was asked for but is not accurate enough or not possible here"
+                                   : "");
     int n = snprintf(
         buf, size,
         "model: real compound lens traced from the film (Kolb et al. 1995; pbrt-v4 \"realistic\"): %s, %d surfaces\n"
@@ -261,14 +320,18 @@ static int realistic_describe(const void *state, char *buf, size_t size)
         "film: %.4g x %.4g mm (diagonal %.4g mm)\n"
         "pupils: entrance %.4g mm wide, %.4g mm behind the front vertex; exit %.4g mm wide, %.4g mm from the rear "
         "vertex\n"
-        "exit-pupil bounds: %d film-radius bins x %d strips, %lld rays traced; camera set-up %.3f s\n"
+        "lens model: %s\n"
+        "exit-pupil bounds: %s%d film-radius bins x %d strips, %lld rays traced; camera set-up %.3f s\n"
         "expected useful-ray fraction: %.1f%% of traced camera rays (%.1f%% of the film receives light)\n"
         "aperture: %s%s\n"
         "dispersion: %s\n",
         L->path, L->n, c->px.efl_mm, c->working_fnumber, c->px.fnumber, stop_d, stop_max,
         c->focus_distance_mm * 1e-3, L->film_distance_mm, c->film_distance_search_mm, c->film_w_mm, c->film_h_mm,
         c->diagonal_mm, c->px.entrance_pupil_diameter_mm, c->px.entrance_pupil_mm, c->px.exit_pupil_diameter_mm,
-        c->px.exit_pupil_mm, c->pupil.n_bins, LF_LENS_PUPIL_STRIPS, c->pupil.traces, c->setup_seconds,
+        c->px.exit_pupil_mm, model,
+        c->pupil_bounds ? "" : "off (\"pupilbounds\" false: rays aimed at the whole rear disk; built for the polynomial's "
+                               "domain) ",
+        c->pupil.n_bins, LF_LENS_PUPIL_STRIPS, c->pupil.traces, c->setup_seconds,
         100.0 * c->useful_fraction, 100.0 * c->lit_film_fraction, shapes[c->aperture.kind],
         c->aperture.anamorphic != 1.0 ? " (anamorphic)" : "",
         L->dispersive ? "on (Cauchy n(lambda) = A + B/lambda^2 through n_d and V_d; rays sample 360-830 nm)"
@@ -286,6 +349,11 @@ static void realistic_metadata(const void *state, const lf_camera_attr_sink *sin
     sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance_mm * 1e-3);
     sink->set_double(sink->ctx, "lensfield:lens_film_distance_mm", c->lens.film_distance_mm);
     sink->set_int(sink->ctx, "lensfield:lens_dispersion", c->lens.dispersive);
+    sink->set_string(sink->ctx, "lensfield:lens_model", c->use_poly ? "polynomial" : "traced");
+    /* film to the front principal plane H: where a thin lens standing in for
+     * this lens goes (bench/accuracy.sh) */
+    sink->set_double(sink->ctx, "lensfield:lens_front_principal_from_film_mm",
+                     c->lens.film_distance_mm + c->px.total_length_mm - c->px.front_principal_mm);
 }
 
 const lf_camera_type lf_camera_realistic = {LF_CAMERA_ABI_VERSION,  "realistic",       realistic_create,

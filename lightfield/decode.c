@@ -11,6 +11,11 @@ int lf_lf_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err
     memset(lf, 0, sizeof *lf);
     if (nu < 1 || nv < 1 || ns < 1 || nt < 1)
         return lf_error_set(err, LF_ERR_PARAM, "empty light field %d x %d views of %d x %d", nu, nv, ns, nt);
+    /* 2^31 samples (24 GiB of RGB floats) is more than any raw can hold;
+     * a bigger request comes from a corrupt layout, not from data. */
+    double samples = (double)nu * nv * ns * nt;
+    if (samples > 2147483648.0)
+        return lf_error_set(err, LF_ERR_PARAM, "light field of %d x %d views of %d x %d is too large", nu, nv, ns, nt);
     size_t n = (size_t)nu * nv * ns * nt * 3;
     lf->data = calloc(n, sizeof(float));
     if (!lf->data)
@@ -127,6 +132,14 @@ int lf_lf_plenoptic_views(const lf_lf_layout *l)
  * is indexed by lens (lens_x x lens_y), one validity flag per sample. */
 static int decode_lenses(const lf_image *raw, const lf_lf_layout *l, lf_lightfield *lf, lf_error *err)
 {
+    /* A layout must fit its raw: the views of a lens come from its own
+     * pixels, so views x lenses cannot much exceed the raw's pixel count. */
+    double lens_px = l->pitch_px * l->pitch_px * (double)l->lens_x * l->lens_y;
+    if (l->pitch_px > 2.0 * (raw->width > raw->height ? raw->width : raw->height) ||
+        lens_px > 16.0 * ((double)raw->width + l->pitch_px) * ((double)raw->height + l->pitch_px))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "microlens layout (%d x %d lenses of pitch %g px) does not fit the %d x %d raw",
+                            l->lens_x, l->lens_y, l->pitch_px, raw->width, raw->height);
     int n = lf_lf_plenoptic_views(l), half = n / 2;
     if (lf_lf_alloc(lf, n, n, l->lens_x, l->lens_y, err) || ensure_valid(lf, err))
         return err ? err->code : LF_ERR_NOMEM;

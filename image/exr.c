@@ -367,11 +367,11 @@ static exr_result_t decode_chunk(exr_reader *r, const exr_chunk_info_t *ci, int6
     for (int c = 0; c < r->dec.channel_count; c++) {
         exr_coding_channel_info_t *ch = &r->dec.channels[c];
         int k = r->out_of_file[c];
-        if (k < 0) {
-            ch->decode_to_ptr = NULL; /* skipped */
-            continue;
-        }
-        ch->decode_to_ptr = (uint8_t *)(r->planes + (size_t)k * r->plane_size);
+        /* A channel we do not keep is decoded into a scratch plane (the one
+         * after the kept ones) rather than skipped with a NULL pointer:
+         * OpenEXRCore 3.1.5's specialised unpackers dereference every
+         * channel's pointer (fuzzing found the crash). */
+        ch->decode_to_ptr = (uint8_t *)(r->planes + (size_t)(k < 0 ? nc : k) * r->plane_size);
         ch->user_pixel_stride = sizeof(float);
         ch->user_line_stride = cw * (int32_t)sizeof(float);
         /* OpenEXRCore converts HALF to FLOAT but not UINT: those are decoded
@@ -523,7 +523,7 @@ int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *att
     int64_t chunk_w = storage == EXR_STORAGE_TILED && tile_w < width ? tile_w : width;
     int64_t chunk_h = step < height ? step : height;
     r.plane_size = (size_t)chunk_w * (size_t)chunk_h;
-    r.planes = malloc(r.plane_size * (size_t)nout * sizeof(float));
+    r.planes = malloc(r.plane_size * (size_t)(nout + 1) * sizeof(float)); /* + a scratch plane */
     if (!r.planes) {
         rc = lf_error_set(err, LF_ERR_NOMEM, "cannot read '%s': out of memory", name);
         goto done;

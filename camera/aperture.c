@@ -295,3 +295,18 @@ void lf_aperture_free(lf_aperture *a)
     }
     a->img = NULL;
 }
+
+const char *lf_aperture_name(const lf_aperture *a)
+{
+    switch (a->kind) {
+    case LF_APERTURE_CIRCLE:
+        return "circular";
+    case LF_APERTURE_POLYGON:
+        return "polygon";
+    case LF_APERTURE_STAR:
+        return "star";
+    case LF_APERTURE_IMAGE:
+        return "image";
+    }
+    return "?";
+}

@@ -51,6 +51,8 @@ double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, d
 /* Is (x, y) (radius units) inside the open region? Returns its transmission. */
 double lf_aperture_transmission(const lf_aperture *a, double x, double y);
 double lf_aperture_area(const lf_aperture *a);
+/* "circular", "polygon", "star" or "image" (for --explain and metadata). */
+const char *lf_aperture_name(const lf_aperture *a);
 void lf_aperture_free(lf_aperture *a);
 
 #endif

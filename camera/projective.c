@@ -152,21 +152,6 @@ static void projective_destroy(void *state)
     free(c);
 }
 
-static const char *aperture_name(const lf_aperture *a)
-{
-    switch (a->kind) {
-    case LF_APERTURE_CIRCLE:
-        return "circular";
-    case LF_APERTURE_POLYGON:
-        return "polygon";
-    case LF_APERTURE_STAR:
-        return "star";
-    case LF_APERTURE_IMAGE:
-        return "image";
-    }
-    return "?";
-}
-
 static int projective_describe(const void *state, char *buf, size_t size)
 {
     const projective *c = state;
@@ -188,7 +173,7 @@ static int projective_describe(const void *state, char *buf, size_t size)
             return n;
         n += snprintf(buf + n, size - n,
                       "aperture: %s, %d blades, rotation %g deg, anamorphic %g, open area %.6g x radius^2\n",
-                      aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
+                      lf_aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
                       c->aperture.rotation_rad * 180.0 / M_PI, c->aperture.anamorphic, lf_aperture_area(&c->aperture));
     }
     else

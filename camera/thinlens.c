@@ -182,21 +182,6 @@ static void thinlens_destroy(void *state)
     free(c);
 }
 
-static const char *aperture_name(const lf_aperture *a)
-{
-    switch (a->kind) {
-    case LF_APERTURE_CIRCLE:
-        return "circular";
-    case LF_APERTURE_POLYGON:
-        return "polygon";
-    case LF_APERTURE_STAR:
-        return "star";
-    case LF_APERTURE_IMAGE:
-        return "image";
-    }
-    return "?";
-}
-
 /* Appends with snprintf semantics; n stays the would-be length. */
 #define APPEND(...)                                                                     \
     do {                                                                                \
@@ -225,7 +210,7 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
     APPEND("f-number N: %g\n", N);
     APPEND("aperture diameter A = f/N: %.6g mm\n", A * 1e3);
     APPEND("aperture: %s, %d blades, rotation %g deg, anamorphic %g, open area %.6g mm^2\n",
-           aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
+           lf_aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
            c->aperture.rotation_rad * 180.0 / M_PI, c->aperture.anamorphic, c->open_area * 1e6);
     APPEND("focus distance z_o: %.9g m\n", s);
     APPEND("sensor distance z_s (= z_i of the focus plane): %.9g mm\n", zs * 1e3);
@@ -269,7 +254,7 @@ static void thinlens_metadata(const void *state, const lf_camera_attr_sink *sink
     sink->set_double(sink->ctx, "lensfield:sensor_distance_mm", c->sensor_distance * 1e3);
     double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
     sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
-    sink->set_string(sink->ctx, "lensfield:aperture", aperture_name(&c->aperture));
+    sink->set_string(sink->ctx, "lensfield:aperture", lf_aperture_name(&c->aperture));
 }
 
 const lf_camera_type lf_camera_thinlens = {

@@ -4,7 +4,11 @@
 # filter, CPU, 2 threads, fixed seed, no denoising, no adaptive sampling.
 # pbrt's (x, y, z) (y up) maps to Blender's (x, z, y) (z up): a mirror image,
 # the same work.
-#   blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- [SPP] [THREADS]
+#   blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- [SPP] [THREADS] [CASE]
+# CASE: pinhole (default), thinlens (lens radius 0.08, focus 6), motion (one
+# sphere moves 0.5 units during the shutter), rolling (panning camera, rolling
+# shutter over half the frame), fisheye (equisolid, 10 mm, 155.9 degrees) -
+# the variants of scenes/bench/plane-spheres-CASE.pbrt.
 import math
 import sys
 import time
@@ -15,6 +19,7 @@ from mathutils import Vector
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 spp = int(argv[0]) if len(argv) > 0 else 64
 threads = int(argv[1]) if len(argv) > 1 else 2
+case = argv[2] if len(argv) > 2 else "pinhole"
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
@@ -60,11 +65,20 @@ def diffuse(name, rgb):
 
 bpy.ops.mesh.primitive_plane_add(size=20, location=pbrt(0, 0, 0))
 bpy.context.object.data.materials.append(diffuse("ground", (0.8, 0.8, 0.8)))
-for pos, rgb in [((-2.1, 0.6, 0.4), (0.8, 0.2, 0.15)), ((-0.7, 0.6, 0), (0.2, 0.8, 0.15)),
-                 ((0.7, 0.6, -0.3), (0.15, 0.2, 0.8)), ((2.1, 0.6, 0.4), (0.7, 0.7, 0.2))]:
+scene.frame_start = scene.frame_current = 1
+for i, (pos, rgb) in enumerate([((-2.1, 0.6, 0.4), (0.8, 0.2, 0.15)), ((-0.7, 0.6, 0), (0.2, 0.8, 0.15)),
+                                ((0.7, 0.6, -0.3), (0.15, 0.2, 0.8)), ((2.1, 0.6, 0.4), (0.7, 0.7, 0.2))]):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, segments=64, ring_count=32, location=pbrt(*pos))
     bpy.ops.object.shade_smooth()
     bpy.context.object.data.materials.append(diffuse("sphere", rgb))
+    if case == "motion" and i == 1:
+        ob = bpy.context.object
+        ob.keyframe_insert("location", frame=1)
+        ob.location = pbrt(pos[0] + 0.5, pos[1], pos[2])
+        ob.keyframe_insert("location", frame=2)
+        for fc in ob.animation_data.action.fcurves:
+            for kp in fc.keyframe_points:
+                kp.interpolation = "LINEAR"
 
 sun = bpy.data.lights.new("sun", "SUN")
 sun.energy = 3.0
@@ -87,6 +101,34 @@ scene.collection.objects.link(cam_obj)
 cam_obj.location = pbrt(0, 1.2, -6)
 cam_obj.rotation_euler = (pbrt(0, 0.6, 0) - pbrt(0, 1.2, -6)).to_track_quat("-Z", "Y").to_euler()
 scene.camera = cam_obj
+if case == "thinlens":
+    lens_mm = cam.sensor_height / 2 / math.tan(math.radians(16))
+    cam.lens = lens_mm
+    cam.dof.use_dof = True
+    cam.dof.focus_distance = 6.0
+    cam.dof.aperture_fstop = lens_mm / (2 * 80.0)  # aperture radius 0.08 m = 80 mm
+if case in ("motion", "rolling"):
+    scene.render.use_motion_blur = True
+    cy.motion_blur_position = "START"
+    scene.render.motion_blur_shutter = 1.0 if case == "motion" else 0.5
+if case == "rolling":
+    cy.rolling_shutter_type = "TOP"
+    cy.rolling_shutter_duration = 0.5
+    cam_obj.keyframe_insert("rotation_euler", frame=1)
+    cam_obj.rotation_euler.z += math.radians(3)
+    cam_obj.keyframe_insert("rotation_euler", frame=2)
+if case == "fisheye":
+    cam.type = "PANO"
+    try:
+        cam.panorama_type = "FISHEYE_EQUISOLID"
+        cam.fisheye_lens = 10.0
+        cam.fisheye_fov = math.radians(155.9)
+    except AttributeError:  # Blender < 3.x keeps these under cam.cycles
+        cam.cycles.panorama_type = "FISHEYE_EQUISOLID"
+        cam.cycles.fisheye_lens = 10.0
+        cam.cycles.fisheye_fov = math.radians(155.9)
+    cam.sensor_fit = "AUTO"
+    cam.sensor_width = 24.0
 
 scene.render.filepath = "/tmp/cycles_plane_spheres.exr"
 scene.render.image_settings.file_format = "OPEN_EXR"

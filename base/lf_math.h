@@ -124,6 +124,8 @@ int lf_transform_decompose(const lf_transform *m, lf_decomposed *out);
 /* Interpolates at f in [0,1]: lerp translation, slerp rotation (shortest
  * arc), lerp stretch. */
 lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f);
+/* The same, forward matrix only (no inverse): for per-sample camera motion. */
+void lf_decomposed_matrix(const lf_decomposed *a, const lf_decomposed *b, double f, double m[4][4]);
 
 #ifdef __cplusplus
 }

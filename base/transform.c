@@ -342,7 +342,7 @@ int lf_transform_decompose(const lf_transform *m, lf_decomposed *out)
     return 0;
 }
 
-lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f)
+void lf_decomposed_matrix(const lf_decomposed *a, const lf_decomposed *b, double f, double m[4][4])
 {
     double q[4], qb[4] = {b->q[0], b->q[1], b->q[2], b->q[3]};
     double dot = a->q[0] * qb[0] + a->q[1] * qb[1] + a->q[2] * qb[2] + a->q[3] * qb[3];
@@ -363,7 +363,8 @@ lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decompos
     double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     for (int i = 0; i < 4; i++)
         q[i] /= l;
-    double R[3][3], m[4][4] = {{0}};
+    double R[3][3];
+    memset(m, 0, sizeof(double) * 16);
     matrix_from_quat(q, R);
     for (int i = 0; i < 3; i++) {
         for (int j = 0; j < 3; j++) {
@@ -375,6 +376,12 @@ lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decompos
         m[i][3] = (1 - f) * a->t[i] + f * b->t[i];
     }
     m[3][3] = 1;
+}
+
+lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f)
+{
+    double m[4][4];
+    lf_decomposed_matrix(a, b, f, m);
     lf_transform t;
     if (lf_transform_from_matrix(m, &t))
         t = lf_transform_identity();

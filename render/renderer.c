@@ -797,7 +797,8 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
                 lf_transform moving;
                 const lf_transform *c2w = &r->camera_to_world;
                 if (r->camera_moving) {
-                    moving = lf_decomposed_interpolate(&r->camera_keys[0], &r->camera_keys[1], tau);
+                    /* forward matrix only: the ray needs no inverse */
+                    lf_decomposed_matrix(&r->camera_keys[0], &r->camera_keys[1], tau, moving.m);
                     c2w = &moving;
                 }
                 lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr.origin[0], cr.origin[1], cr.origin[2]});

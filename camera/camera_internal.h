@@ -36,6 +36,16 @@ static inline void lf_cam_concentric_disk(double u, double v, double *x, double 
 int lf_cam_read_sensor(const lf_camera_params *p, double *w_mm, double *h_mm, char *name, size_t name_size,
                        char *err, size_t err_size);
 
+/* For describe(): appends to buf (size bytes) with snprintf semantics; the
+ * caller's int n stays the would-be length. */
+#define LF_CAM_APPEND(...)                                           \
+    do {                                                             \
+        size_t off_ = (size_t)n < size ? (size_t)n : size;           \
+        int k_ = snprintf(buf + off_, size - off_, __VA_ARGS__);     \
+        if (k_ > 0)                                                  \
+            n += k_;                                                 \
+    } while (0)
+
 extern const lf_camera_type lf_camera_perspective;
 extern const lf_camera_type lf_camera_orthographic;
 extern const lf_camera_type lf_camera_thinlens;

@@ -571,14 +571,6 @@ static void plenoptic_destroy(void *state)
     free(c);
 }
 
-#define APPEND(...)                                                \
-    do {                                                           \
-        size_t off_ = (size_t)n < size ? (size_t)n : size;         \
-        int k_ = snprintf(buf + off_, size - off_, __VA_ARGS__);   \
-        if (k_ > 0)                                                \
-            n += k_;                                               \
-    } while (0)
-
 static int plenoptic_describe(const void *state, char *buf, size_t size)
 {
     const plenoptic *c = state;
@@ -589,40 +581,40 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
     double D = 2.0 * c->aperture_radius, zi = c->mla_distance;
     if (c->compound) {
         const lf_lens *L = &c->lens;
-        APPEND("model: plenoptic camera (Ng 2005): compound main lens %s (%d surfaces, traced exactly), microlens "
+        LF_CAM_APPEND("model: plenoptic camera (Ng 2005): compound main lens %s (%d surfaces, traced exactly), microlens "
                "array at its image plane, sensor behind\n",
                L->path, L->n);
-        APPEND("main lens: EFL %.6g mm (paraxial), stop %.4g mm, working f/%.4g; focused at %.6g m from the microlens "
+        LF_CAM_APPEND("main lens: EFL %.6g mm (paraxial), stop %.4g mm, working f/%.4g; focused at %.6g m from the microlens "
                "array (%.6g m from the front principal point, the camera origin)\n",
                c->px.efl_mm, L->stop >= 0 ? 2.0 * L->s[L->stop].aperture_radius_mm : 0.0, c->working_fnumber,
                c->focus_from_mla_m, c->focus_distance);
-        APPEND("rear vertex to microlens array: %.6g mm; exit pupil %.6g mm wide, %.6g mm in front of the array "
+        LF_CAM_APPEND("rear vertex to microlens array: %.6g mm; exit pupil %.6g mm wide, %.6g mm in front of the array "
                "(candidate search radius there %.6g mm)\n",
                L->film_distance_mm, 2e3 * c->pupil_radius, c->pupil_distance * 1e3, c->search_radius * 1e3);
-        APPEND("equivalent thin lens (metadata): f %.6g mm, f/%.6g, H' to microlens array z_i %.6g mm\n",
+        LF_CAM_APPEND("equivalent thin lens (metadata): f %.6g mm, f/%.6g, H' to microlens array z_i %.6g mm\n",
                c->focal_length * 1e3, c->fstop, zi * 1e3);
     } else {
-        APPEND("model: plenoptic camera (Ng 2005): thin main lens, microlens array at its image plane, sensor behind\n");
-        APPEND("main lens: f %g mm, f/%g (aperture %.6g mm), focused at %.6g m\n", c->focal_length * 1e3, c->fstop,
+        LF_CAM_APPEND("model: plenoptic camera (Ng 2005): thin main lens, microlens array at its image plane, sensor behind\n");
+        LF_CAM_APPEND("main lens: f %g mm, f/%g (aperture %.6g mm), focused at %.6g m\n", c->focal_length * 1e3, c->fstop,
                D * 1e3, c->focus_distance);
-        APPEND("main lens to microlens array z_i: %.6g mm (image-side f-number z_i/D = %.4g)\n", zi * 1e3, zi / D);
+        LF_CAM_APPEND("main lens to microlens array z_i: %.6g mm (image-side f-number z_i/D = %.4g)\n", zi * 1e3, zi / D);
     }
-    APPEND("microlenses: %s grid, pitch %.6g um, focal length %.6g mm (f/%.4g), rotation %g deg\n",
+    LF_CAM_APPEND("microlenses: %s grid, pitch %.6g um, focal length %.6g mm (f/%.4g), rotation %g deg\n",
            c->hex ? "hex" : "square", c->pitch * 1e6, c->mla_focal * 1e3, c->mla_focal / c->pitch,
            c->rotation_rad * 180.0 / M_PI);
-    APPEND("microlens images: %.6g px apart, %d x %d lenses (partial border lenses included), lens (0,0) at (%.6g, "
+    LF_CAM_APPEND("microlens images: %.6g px apart, %d x %d lenses (partial border lenses included), lens (0,0) at (%.6g, "
            "%.6g) px\n",
            c->image_pitch_px, c->nx, c->ny, c->origin_px[0], c->origin_px[1]);
-    APPEND("aperture image / image spacing: %.4g (%s)\n", c->overlap_ratio,
+    LF_CAM_APPEND("aperture image / image spacing: %.4g (%s)\n", c->overlap_ratio,
            c->overlap_ratio > 1.01   ? "overlap: crosstalk"
            : c->overlap_ratio < 0.99 ? "gaps between images"
                                      : "matched");
-    APPEND("sensor: %s %g x %g mm as %g x %.6g mm, %.6g um pixels, %.6g mm behind the microlenses (offset %g mm%s)\n",
+    LF_CAM_APPEND("sensor: %s %g x %g mm as %g x %.6g mm, %.6g um pixels, %.6g mm behind the microlenses (offset %g mm%s)\n",
            c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->sensor_w * 1e3, c->sensor_h * 1e3, c->pixel * 1e6,
            c->mla_sensor * 1e3, c->sensor_offset * 1e3, c->sensor_offset == 0.0 ? ": plenoptic 1.0" : ": focused plenoptic 2.0");
-    APPEND("sub-aperture views: %d x %d pixels, %.4g x %.4g views\n", c->nx, c->ny, c->image_pitch_px,
+    LF_CAM_APPEND("sub-aperture views: %d x %d pixels, %.4g x %.4g views\n", c->nx, c->ny, c->image_pitch_px,
            c->image_pitch_px);
-    APPEND("pixel values are exposure: (1/d^2) int L cos^4 dA over the microlenses x shutter x ISO/100\n");
+    LF_CAM_APPEND("pixel values are exposure: (1/d^2) int L cos^4 dA over the microlenses x shutter x ISO/100\n");
     return n;
 }
 

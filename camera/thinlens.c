@@ -182,15 +182,6 @@ static void thinlens_destroy(void *state)
     free(c);
 }
 
-/* Appends with snprintf semantics; n stays the would-be length. */
-#define APPEND(...)                                                                     \
-    do {                                                                                \
-        size_t off_ = (size_t)n < size ? (size_t)n : size;                              \
-        int k_ = snprintf(buf + off_, size - off_, __VA_ARGS__);                         \
-        if (k_ > 0)                                                                     \
-            n += k_;                                                                    \
-    } while (0)
-
 static int thinlens_describe(const void *state, char *buf, size_t size)
 {
     const thinlens *c = state;
@@ -205,40 +196,40 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
     double coc = c->coc_mm * 1e-3;
     double H = f * f / (N * coc) + f;
     double near = s * (H - f) / (H + s - 2.0 * f);
-    APPEND("model: physical thin lens (lens at the origin, sensor at z = -z_s; pixel values are exposure)\n");
-    APPEND("focal length f: %g mm\n", f * 1e3);
-    APPEND("f-number N: %g\n", N);
-    APPEND("aperture diameter A = f/N: %.6g mm\n", A * 1e3);
-    APPEND("aperture: %s, %d blades, rotation %g deg, anamorphic %g, open area %.6g mm^2\n",
+    LF_CAM_APPEND("model: physical thin lens (lens at the origin, sensor at z = -z_s; pixel values are exposure)\n");
+    LF_CAM_APPEND("focal length f: %g mm\n", f * 1e3);
+    LF_CAM_APPEND("f-number N: %g\n", N);
+    LF_CAM_APPEND("aperture diameter A = f/N: %.6g mm\n", A * 1e3);
+    LF_CAM_APPEND("aperture: %s, %d blades, rotation %g deg, anamorphic %g, open area %.6g mm^2\n",
            lf_aperture_name(&c->aperture), c->aperture.kind == LF_APERTURE_CIRCLE ? 0 : c->aperture.blades,
            c->aperture.rotation_rad * 180.0 / M_PI, c->aperture.anamorphic, c->open_area * 1e6);
-    APPEND("focus distance z_o: %.9g m\n", s);
-    APPEND("sensor distance z_s (= z_i of the focus plane): %.9g mm\n", zs * 1e3);
-    APPEND("magnification m = z_s/z_o: %.6g\n", m);
-    APPEND("sensor: %s %g x %g mm, imaged as %g x %.6g mm, pixel pitch %.6g um, crop factor %.4g\n", c->sensor_name,
+    LF_CAM_APPEND("focus distance z_o: %.9g m\n", s);
+    LF_CAM_APPEND("sensor distance z_s (= z_i of the focus plane): %.9g mm\n", zs * 1e3);
+    LF_CAM_APPEND("magnification m = z_s/z_o: %.6g\n", m);
+    LF_CAM_APPEND("sensor: %s %g x %g mm, imaged as %g x %.6g mm, pixel pitch %.6g um, crop factor %.4g\n", c->sensor_name,
            c->nominal_w_mm, c->nominal_h_mm, c->sensor_w * 1e3, c->sensor_h * 1e3, pitch * 1e6,
            43.27 / hypot(c->nominal_w_mm, c->nominal_h_mm));
-    APPEND("horizontal FOV: %.6g deg\n", 2.0 * atan(c->sensor_w / (2.0 * zs)) * 180.0 / M_PI);
-    APPEND("vertical FOV: %.6g deg\n", 2.0 * atan(c->sensor_h / (2.0 * zs)) * 180.0 / M_PI);
-    APPEND("diagonal FOV: %.6g deg\n", 2.0 * atan(hypot(c->sensor_w, c->sensor_h) / (2.0 * zs)) * 180.0 / M_PI);
-    APPEND("circle of confusion c: %.6g mm\n", c->coc_mm);
-    APPEND("hyperfocal distance H = f^2/(N c) + f: %.6g m\n", H);
-    APPEND("near limit of acceptable sharpness: %.6g m\n", near);
+    LF_CAM_APPEND("horizontal FOV: %.6g deg\n", 2.0 * atan(c->sensor_w / (2.0 * zs)) * 180.0 / M_PI);
+    LF_CAM_APPEND("vertical FOV: %.6g deg\n", 2.0 * atan(c->sensor_h / (2.0 * zs)) * 180.0 / M_PI);
+    LF_CAM_APPEND("diagonal FOV: %.6g deg\n", 2.0 * atan(hypot(c->sensor_w, c->sensor_h) / (2.0 * zs)) * 180.0 / M_PI);
+    LF_CAM_APPEND("circle of confusion c: %.6g mm\n", c->coc_mm);
+    LF_CAM_APPEND("hyperfocal distance H = f^2/(N c) + f: %.6g m\n", H);
+    LF_CAM_APPEND("near limit of acceptable sharpness: %.6g m\n", near);
     if (s >= H)
-        APPEND("far limit of acceptable sharpness: infinity\n");
+        LF_CAM_APPEND("far limit of acceptable sharpness: infinity\n");
     else
-        APPEND("far limit of acceptable sharpness: %.6g m\n", s * (H - f) / (H - s));
+        LF_CAM_APPEND("far limit of acceptable sharpness: %.6g m\n", s * (H - f) / (H - s));
     /* C = A z_s |1/d - 1/z| (PHYSICS.md), in pixels of the sensor pitch */
     static const double factors[] = {0.5, 0.8, 2.0, 10.0};
     for (int i = 0; i < 4; i++) {
         double z = factors[i] * s;
         double C = A * zs * fabs(1.0 / s - 1.0 / z);
-        APPEND("blur diameter at %.6g m (%gx focus): %.6g px (%.6g mm)%s\n", z, factors[i], C / pitch, C * 1e3,
+        LF_CAM_APPEND("blur diameter at %.6g m (%gx focus): %.6g px (%.6g mm)%s\n", z, factors[i], C / pitch, C * 1e3,
                z <= f ? " [closer than f: no real image]" : "");
     }
     double Cinf = A * zs / s;
-    APPEND("blur diameter at infinity: %.6g px (%.6g mm)\n", Cinf / pitch, Cinf * 1e3);
-    APPEND("exposure: pixel = (1/z_s^2) int L cos^4 dA x shutter x ISO/100; on axis ~ pi/(4 N^2) L = %.6g L per "
+    LF_CAM_APPEND("blur diameter at infinity: %.6g px (%.6g mm)\n", Cinf / pitch, Cinf * 1e3);
+    LF_CAM_APPEND("exposure: pixel = (1/z_s^2) int L cos^4 dA x shutter x ISO/100; on axis ~ pi/(4 N^2) L = %.6g L per "
            "imaging ratio\n",
            M_PI / (4.0 * N * N));
     return n;

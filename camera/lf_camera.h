@@ -32,7 +32,9 @@
 extern "C" {
 #endif
 
-#define LF_CAMERA_ABI_VERSION 1u
+/* Version 2 appended the optional batch entry `generate_rays`; plugins built
+ * against version 1 (whose type struct ends at `metadata`) still load. */
+#define LF_CAMERA_ABI_VERSION 2u
 
 enum lf_camera_needs {
     LF_CAMERA_NEEDS_LENS = 1u,       /* lens_u, lens_v are used */
@@ -119,6 +121,16 @@ typedef struct lf_camera_type {
     int (*describe)(const void *state, char *buf, size_t size);
     /* Optional (may be NULL): attributes describing the image layout. */
     void (*metadata)(const void *state, const lf_camera_attr_sink *sink);
+    /* ---- ABI version 2 ---- */
+    /* Optional (may be NULL): n rays at once.  For every i it must give
+     * exactly what weights[i] = generate_ray(state, &samples[i], &rays[i])
+     * gives (the host presets rays[i].time and rays[i].wavelength_nm = 0).
+     * n is any positive number; a camera chunks internally.  Cameras
+     * implement it to generate independent rays side by side (structure of
+     * arrays, SIMD), which hides the latency of each ray's serial chain of
+     * square roots and divisions. */
+    void (*generate_rays)(const void *state, int n, const lf_camera_sample *samples, lf_camera_ray *rays,
+                          double *weights);
 } lf_camera_type;
 
 /* ---- registry (camera/registry.c) ---- */
@@ -128,8 +140,14 @@ const lf_camera_type *lf_camera_find(const char *name);
 /* Number of registered types and the i-th one (for tests that loop over all). */
 int lf_camera_count(void);
 const lf_camera_type *lf_camera_at(int i);
+/* n rays through t's generate_rays, or generate_ray in a loop when the
+ * camera has no batch entry (the host's one way to call a camera). */
+void lf_camera_generate_rays(const lf_camera_type *t, const void *state, int n, const lf_camera_sample *samples,
+                             lf_camera_ray *rays, double *weights);
 /* Loads a plugin shared object and registers its types.  Returns 0, or -1
- * with a message in err (wrong ABI version, missing symbol, name clash). */
+ * with a message in err (wrong ABI version, missing symbol, name clash).
+ * Types of ABI version 1 are accepted (copied into a version-2 record
+ * without the batch entry). */
 int lf_camera_load_plugin(const char *path, char *err, size_t err_size);
 
 #ifdef __cplusplus

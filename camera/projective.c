@@ -110,38 +110,114 @@ static uint32_t projective_needs(const void *state)
     return c->lens_radius > 0.0 ? LF_CAMERA_NEEDS_LENS : 0u;
 }
 
+/* The steps of one ray, shared by the single-ray and the batch paths so
+ * that both agree to the bit (ISO C: no contraction into FMA).  Branch-free
+ * within a camera mode, so loops over them vectorise. */
+static inline void pinhole_dir(const projective *c, double fx, double fy, double *d)
+{
+    /* raster -> screen: x grows right, y grows up from the bottom edge. */
+    double x = (c->screen[0] + fx * c->sx) * c->tan_half_fov;
+    double y = (c->screen[3] - fy * c->sy) * c->tan_half_fov;
+    double inv = 1.0 / sqrt(x * x + y * y + 1.0);
+    d[0] = x * inv, d[1] = y * inv, d[2] = inv;
+}
+static inline void ortho_origin(const projective *c, double fx, double fy, double *o)
+{
+    o[0] = c->screen[0] + fx * c->sx;
+    o[1] = c->screen[3] - fy * c->sy;
+    o[2] = 0.0;
+}
+/* The lens: the ray leaves lens point (lx, ly) (lens-radius units, weight
+ * aw) towards the point the pinhole ray (o, d) meets on the plane of focus. */
+static inline double lens_ray(const projective *c, double lx, double ly, double aw, double *o, double *d)
+{
+    double ft = c->focal_distance / d[2];
+    double f0 = o[0] + d[0] * ft, f1 = o[1] + d[1] * ft, f2 = o[2] + d[2] * ft;
+    o[0] += lx * c->lens_radius, o[1] += ly * c->lens_radius;
+    double e0 = f0 - o[0], e1 = f1 - o[1], e2 = f2 - o[2];
+    double inv = 1.0 / sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+    int ok = aw > 0.0;
+    d[0] = ok ? e0 * inv : 0.0, d[1] = ok ? e1 * inv : 0.0, d[2] = ok ? e2 * inv : 1.0;
+    return ok ? 1.0 : 0.0;
+}
+
+/* Up to LF_CAM_CHUNK rays, each step a loop over the whole padded chunk
+ * (structure of arrays) so that the compiler vectorises it. */
+LF_CAM_SIMD_CLONES
+static void projective_chunk(const projective *c, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
+{
+    enum { N = LF_CAM_CHUNK };
+    double fx[N], fy[N], lu[N], lv[N], lx[N], ly[N], aw[N], w[N], o[3][N], d[3][N];
+    for (int i = 0; i < N; i++) {
+        int k = i < n ? i : 0; /* padding repeats the first sample */
+        fx[i] = s[k].film_x, fy[i] = s[k].film_y, lu[i] = s[k].lens_u, lv[i] = s[k].lens_v;
+        w[i] = 1.0;
+    }
+    if (c->orthographic) {
+        for (int i = 0; i < N; i++) {
+            double oi[3];
+            ortho_origin(c, fx[i], fy[i], oi);
+            o[0][i] = oi[0], o[1][i] = oi[1], o[2][i] = oi[2];
+            d[0][i] = 0.0, d[1][i] = 0.0, d[2][i] = 1.0;
+        }
+    } else {
+        for (int i = 0; i < N; i++) {
+            double di[3];
+            pinhole_dir(c, fx[i], fy[i], di);
+            o[0][i] = o[1][i] = o[2][i] = 0.0;
+            d[0][i] = di[0], d[1][i] = di[1], d[2][i] = di[2];
+        }
+    }
+    if (c->lens_radius > 0.0) {
+        if (c->aperture.kind == LF_APERTURE_CIRCLE) {
+            const double ana = c->aperture.anamorphic;
+            for (int i = 0; i < N; i++) {
+                lf_cam_concentric_disk(lu[i], lv[i], &lx[i], &ly[i]);
+                lx[i] *= ana;
+                aw[i] = 1.0;
+            }
+        } else {
+            for (int i = 0; i < n; i++)
+                aw[i] = lf_aperture_sample(&c->aperture, lu[i], lv[i], &lx[i], &ly[i]);
+            for (int i = n; i < N; i++)
+                aw[i] = 0.0, lx[i] = ly[i] = 0.0;
+        }
+        for (int i = 0; i < N; i++) {
+            double oi[3] = {o[0][i], o[1][i], o[2][i]}, di[3] = {d[0][i], d[1][i], d[2][i]};
+            w[i] = lens_ray(c, lx[i], ly[i], aw[i], oi, di);
+            o[0][i] = oi[0], o[1][i] = oi[1], o[2][i] = oi[2];
+            d[0][i] = di[0], d[1][i] = di[1], d[2][i] = di[2];
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        r[i].origin[0] = o[0][i], r[i].origin[1] = o[1][i], r[i].origin[2] = o[2][i];
+        r[i].dir[0] = d[0][i], r[i].dir[1] = d[1][i], r[i].dir[2] = d[2][i];
+        wt[i] = w[i];
+    }
+}
+
+static void projective_generate_rays(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r,
+                                     double *w)
+{
+    for (int i = 0; i < n; i += LF_CAM_CHUNK)
+        projective_chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+}
+
 static double projective_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
 {
     const projective *c = state;
-    /* raster -> screen: x grows right, y grows up from the bottom edge. */
-    double px = c->screen[0] + s->film_x * c->sx;
-    double py = c->screen[3] - s->film_y * c->sy;
-    double o[3], d[3];
     if (c->orthographic) {
-        o[0] = px, o[1] = py, o[2] = 0.0;
-        d[0] = 0.0, d[1] = 0.0, d[2] = 1.0;
+        ortho_origin(c, s->film_x, s->film_y, r->origin);
+        r->dir[0] = 0.0, r->dir[1] = 0.0, r->dir[2] = 1.0;
     } else {
-        o[0] = o[1] = o[2] = 0.0;
-        d[0] = px * c->tan_half_fov, d[1] = py * c->tan_half_fov, d[2] = 1.0;
-        double inv = 1.0 / sqrt(d[0] * d[0] + d[1] * d[1] + 1.0);
-        d[0] *= inv, d[1] *= inv, d[2] *= inv;
+        r->origin[0] = r->origin[1] = r->origin[2] = 0.0;
+        pinhole_dir(c, s->film_x, s->film_y, r->dir);
     }
-    if (c->lens_radius > 0.0) {
-        double lx, ly;
-        double w = lf_aperture_sample(&c->aperture, s->lens_u, s->lens_v, &lx, &ly);
-        if (!(w > 0.0))
-            return 0.0;
-        lx *= c->lens_radius, ly *= c->lens_radius;
-        double ft = c->focal_distance / d[2];
-        double f[3] = {o[0] + d[0] * ft, o[1] + d[1] * ft, o[2] + d[2] * ft};
-        o[0] += lx, o[1] += ly;
-        d[0] = f[0] - o[0], d[1] = f[1] - o[1], d[2] = f[2] - o[2];
-        double inv = 1.0 / sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        d[0] *= inv, d[1] *= inv, d[2] *= inv;
-    }
-    memcpy(r->origin, o, sizeof o);
-    memcpy(r->dir, d, sizeof d);
-    return 1.0;
+    if (!(c->lens_radius > 0.0))
+        return 1.0;
+    double lx, ly;
+    double aw = lf_aperture_sample(&c->aperture, s->lens_u, s->lens_v, &lx, &ly);
+    return lens_ray(c, lx, ly, aw, r->origin, r->dir);
 }
 
 static void projective_destroy(void *state)
@@ -187,6 +263,7 @@ const lf_camera_type lf_camera_perspective = {
     .create = perspective_create,
     .needs = projective_needs,
     .generate_ray = projective_generate_ray,
+    .generate_rays = projective_generate_rays,
     .destroy = projective_destroy,
     .describe = projective_describe,
     .metadata = NULL,
@@ -198,6 +275,7 @@ const lf_camera_type lf_camera_orthographic = {
     .create = orthographic_create,
     .needs = projective_needs,
     .generate_ray = projective_generate_ray,
+    .generate_rays = projective_generate_rays,
     .destroy = projective_destroy,
     .describe = projective_describe,
     .metadata = NULL,

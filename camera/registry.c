@@ -18,6 +18,13 @@ static const lf_camera_type *const builtin[] = {
 
 enum { MAX_PLUGIN_TYPES = 64 };
 static const lf_camera_type *plugin_types[MAX_PLUGIN_TYPES];
+/* Version-1 types, copied into full version-2 records (batch entry NULL):
+ * their own struct ends before generate_rays and must not be read past. */
+static lf_camera_type legacy_types[MAX_PLUGIN_TYPES];
+
+/* The size of a version-1 type record: everything up to and including
+ * `metadata`. */
+#define LF_CAMERA_TYPE_V1_SIZE (offsetof(lf_camera_type, metadata) + sizeof(((lf_camera_type *)0)->metadata))
 static int n_plugin_types;
 
 int lf_camera_count(void)
@@ -38,6 +45,17 @@ const lf_camera_type *lf_camera_find(const char *name)
         if (strcmp(lf_camera_at(i)->name, name) == 0)
             return lf_camera_at(i);
     return NULL;
+}
+
+void lf_camera_generate_rays(const lf_camera_type *t, const void *state, int n, const lf_camera_sample *samples,
+                             lf_camera_ray *rays, double *weights)
+{
+    if (t->generate_rays) {
+        t->generate_rays(state, n, samples, rays, weights);
+        return;
+    }
+    for (int i = 0; i < n; i++)
+        weights[i] = t->generate_ray(state, &samples[i], &rays[i]);
 }
 
 typedef const lf_camera_type *const *(*plugin_entry_fn)(int *count);
@@ -65,8 +83,8 @@ int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
     }
     for (int i = 0; i < count; i++) {
         const lf_camera_type *t = types[i];
-        if (!t || t->abi_version != LF_CAMERA_ABI_VERSION) {
-            snprintf(err, err_size, "camera plugin %s: type %d has ABI version %u, this lfrender needs %u", path, i,
+        if (!t || t->abi_version < 1u || t->abi_version > LF_CAMERA_ABI_VERSION) {
+            snprintf(err, err_size, "camera plugin %s: type %d has ABI version %u, this lfrender reads 1..%u", path, i,
                      t ? t->abi_version : 0u, LF_CAMERA_ABI_VERSION);
             dlclose(h);
             return -1;
@@ -87,8 +105,16 @@ int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
         dlclose(h);
         return -1;
     }
-    for (int i = 0; i < count; i++)
-        plugin_types[n_plugin_types++] = types[i];
+    for (int i = 0; i < count; i++) {
+        const lf_camera_type *t = types[i];
+        if (t->abi_version == 1u) {
+            lf_camera_type *c = &legacy_types[n_plugin_types];
+            memset(c, 0, sizeof *c);
+            memcpy(c, t, LF_CAMERA_TYPE_V1_SIZE);
+            t = c;
+        }
+        plugin_types[n_plugin_types++] = t;
+    }
     /* The handle stays open for the life of the process: the types live in it. */
     return 0;
 }

@@ -148,29 +148,84 @@ static uint32_t thinlens_needs(const void *state)
     return c->aperture_radius > 0.0 ? LF_CAMERA_NEEDS_LENS : 0u;
 }
 
+/* One ray from its film point (fx, fy) and its aperture point (ax, ay) in
+ * radius units with the aperture weight aw.  Shared by the single-ray and
+ * the batch paths: with ISO C's default -ffp-contract=off the vectorised
+ * loop performs the same correctly rounded operations, so both paths agree
+ * to the bit. */
+static inline double thinlens_ray(const thinlens *c, double fx, double fy, double apx, double apy, double aw,
+                                  double *o, double *d)
+{
+    /* upright sensor coordinates, metres */
+    double sx = (fx / c->width - 0.5) * c->sensor_w;
+    double sy = (0.5 - fy / c->height) * c->sensor_h;
+    double X = apx * c->aperture_radius, Y = apy * c->aperture_radius;
+    /* towards the conjugate point P = (sx/m, sy/m, z_o) on the focus plane */
+    double ex = sx * c->inv_m - X, ey = sy * c->inv_m - Y, zo = c->focus_distance;
+    double len2 = ex * ex + ey * ey + zo * zo;
+    double il = 1.0 / sqrt(len2);
+    /* cos(theta) of the ray p_s -> p_l, with p_s = (-sx, -sy, -z_s) */
+    double ax = X + sx, ay = Y + sy, zs2 = c->sensor_distance * c->sensor_distance;
+    double cos2 = zs2 / (ax * ax + ay * ay + zs2);
+    double w = c->weight_scale * cos2 * cos2 * aw;
+    int ok = aw > 0.0 && len2 > 0.0 && len2 <= 1.79e308 && il <= 1.79e308 && w <= 1.79e308;
+    o[0] = X, o[1] = Y;
+    d[0] = ok ? ex * il : 0.0, d[1] = ok ? ey * il : 0.0, d[2] = ok ? zo * il : 1.0;
+    return ok ? w : 0.0;
+}
+
+/* Up to LF_CAM_CHUNK rays, each step a loop over the whole padded chunk
+ * (structure of arrays), so the compiler vectorises it and the square roots
+ * and divisions of different rays overlap. */
+LF_CAM_SIMD_CLONES
+static void thinlens_chunk(const thinlens *c, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
+{
+    enum { N = LF_CAM_CHUNK };
+    double fx[N], fy[N], lu[N], lv[N], lx[N], ly[N], aw[N];
+    double ox[N], oy[N], dx[N], dy[N], dz[N], w[N];
+    for (int i = 0; i < N; i++) {
+        int k = i < n ? i : 0; /* padding repeats the first sample */
+        fx[i] = s[k].film_x, fy[i] = s[k].film_y, lu[i] = s[k].lens_u, lv[i] = s[k].lens_v;
+    }
+    const double ana = c->aperture.anamorphic;
+    if (c->aperture.kind == LF_APERTURE_CIRCLE) {
+        for (int i = 0; i < N; i++) {
+            lf_cam_concentric_disk(lu[i], lv[i], &lx[i], &ly[i]);
+            lx[i] *= ana;
+            aw[i] = 1.0;
+        }
+    } else {
+        for (int i = 0; i < n; i++)
+            aw[i] = lf_aperture_sample(&c->aperture, lu[i], lv[i], &lx[i], &ly[i]);
+        for (int i = n; i < N; i++)
+            aw[i] = 0.0, lx[i] = ly[i] = 0.0;
+    }
+    for (int i = 0; i < N; i++) {
+        double o[2], d[3];
+        w[i] = thinlens_ray(c, fx[i], fy[i], lx[i], ly[i], aw[i], o, d);
+        ox[i] = o[0], oy[i] = o[1], dx[i] = d[0], dy[i] = d[1], dz[i] = d[2];
+    }
+    for (int i = 0; i < n; i++) {
+        r[i].origin[0] = ox[i], r[i].origin[1] = oy[i], r[i].origin[2] = 0.0;
+        r[i].dir[0] = dx[i], r[i].dir[1] = dy[i], r[i].dir[2] = dz[i];
+        wt[i] = w[i];
+    }
+}
+
+static void thinlens_generate_rays(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r,
+                                   double *w)
+{
+    for (int i = 0; i < n; i += LF_CAM_CHUNK)
+        thinlens_chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+}
+
 static double thinlens_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
 {
     const thinlens *c = state;
-    /* upright sensor coordinates, metres */
-    double sx = (s->film_x / c->width - 0.5) * c->sensor_w;
-    double sy = (0.5 - s->film_y / c->height) * c->sensor_h;
-    double lx, ly;
+    double lx, ly, o[2];
     double aw = lf_aperture_sample(&c->aperture, s->lens_u, s->lens_v, &lx, &ly);
-    if (!(aw > 0.0))
-        return 0.0;
-    lx *= c->aperture_radius, ly *= c->aperture_radius;
-    /* conjugate point on the focus plane */
-    double P[3] = {sx * c->inv_m, sy * c->inv_m, c->focus_distance};
-    double d[3] = {P[0] - lx, P[1] - ly, P[2]};
-    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    /* cos(theta) of the ray p_s -> p_l, with p_s = (-sx, -sy, -z_s) */
-    double ax = lx + sx, ay = ly + sy, zs = c->sensor_distance;
-    double cos2 = zs * zs / (ax * ax + ay * ay + zs * zs);
-    double w = c->weight_scale * cos2 * cos2 * aw;
-    if (!(len > 0.0) || !isfinite(len) || !isfinite(w))
-        return 0.0;
-    r->origin[0] = lx, r->origin[1] = ly, r->origin[2] = 0.0;
-    r->dir[0] = d[0] / len, r->dir[1] = d[1] / len, r->dir[2] = d[2] / len;
+    double w = thinlens_ray(c, s->film_x, s->film_y, lx, ly, aw, o, r->dir);
+    r->origin[0] = o[0], r->origin[1] = o[1], r->origin[2] = 0.0;
     return w;
 }
 
@@ -257,4 +312,5 @@ const lf_camera_type lf_camera_thinlens = {
     .destroy = thinlens_destroy,
     .describe = thinlens_describe,
     .metadata = thinlens_metadata,
+    .generate_rays = thinlens_generate_rays,
 };

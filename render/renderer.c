@@ -744,6 +744,61 @@ static double shutter_time(const lf_renderer *r, double u, double film_x, double
     return start + x * (r->shutter_close - r->shutter_open);
 }
 
+/* One camera sample waiting for its ray: the pixel it belongs to, its
+ * sample stream (positioned after the camera's dimensions, so the path goes
+ * on drawing from it), filter weight and motion parameter. */
+typedef struct pending {
+    lf_sample_stream st;
+    int pixel; /* index within the tile */
+    double fw, tau;
+} pending;
+
+enum { BATCH = 32 }; /* camera rays generated together (lf_camera_type.generate_rays) */
+
+/* Traces one camera ray and adds its contribution to the pixel's exact
+ * fixed-point sums (integer sums: the order of samples does not matter, so
+ * batching and splitting renders never change a bit). */
+static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_ray *cr, double w, lf_pixel_acc *acc,
+                             long long *rays, long long *nonfinite, long long *zero_weight)
+{
+    acc->v[3] += lf_acc_quantize(p->fw);
+    if (!(w > 0) || !isfinite(w)) {
+        (*zero_weight)++;
+        return;
+    }
+    lf_transform moving;
+    const lf_transform *c2w = &r->camera_to_world;
+    if (r->camera_moving) {
+        /* forward matrix only: the ray needs no inverse */
+        lf_decomposed_matrix(&r->camera_keys[0], &r->camera_keys[1], p->tau, moving.m);
+        c2w = &moving;
+    }
+    lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
+    lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr->dir[0], cr->dir[1], cr->dir[2]});
+    double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
+    lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
+    lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
+    L = lf_scale(L, (float)w * (float)r->imaging_ratio);
+    if ((r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) && cr->wavelength_nm > 0)
+        L = lf_mul(L, lf_wavelength_rgb_weight(cr->wavelength_nm));
+    if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
+        (*nonfinite)++;
+        return;
+    }
+    if (isfinite(r->max_component)) {
+        float m = lf_maxc(L);
+        if (m > r->max_component)
+            L = lf_scale(L, (float)(r->max_component / m));
+    }
+    acc->v[0] += lf_acc_quantize(p->fw * L.x);
+    acc->v[1] += lf_acc_quantize(p->fw * L.y);
+    acc->v[2] += lf_acc_quantize(p->fw * L.z);
+}
+
+/* A tile: its camera samples are drawn pixel by pixel and sample by sample,
+ * their rays generated BATCH at a time (so a camera can trace them side by
+ * side), then each path is traced. */
 static void render_tile(job *jb, int tile, long long *rays, long long *paths, long long *nonfinite,
                         long long *zero_weight)
 {
@@ -751,84 +806,65 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
     int tx = tile % jb->tiles_x, ty = tile / jb->tiles_x;
     int x0 = r->px0 + tx * TILE, y0 = r->py0 + ty * TILE;
     int x1 = x0 + TILE < r->px1 ? x0 + TILE : r->px1, y1 = y0 + TILE < r->py1 ? y0 + TILE : r->py1;
-    const lf_camera_type *ct = r->camera_type;
+    int tw = x1 - x0, th = y1 - y0;
     int need_lens = (r->camera_needs & LF_CAMERA_NEEDS_LENS) != 0;
     int need_wl = (r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) != 0;
-    float scale = (float)r->imaging_ratio;
+    lf_pixel_acc acc[TILE * TILE];
+    memset(acc, 0, sizeof acc);
+    pending pend[BATCH];
+    lf_camera_sample cs[BATCH];
+    lf_camera_ray cr[BATCH];
+    double w[BATCH];
+    int nb = 0;
+    int spp = r->spp_end - r->spp_begin;
+    long long total = (long long)tw * th * spp;
+    for (long long k = 0; k < total; k++) {
+        int pixel = (int)(k / spp), i = r->spp_begin + (int)(k % spp);
+        int x = x0 + pixel % tw, y = y0 + pixel / tw;
+        pending *p = &pend[nb];
+        lf_camera_sample *c = &cs[nb];
+        p->pixel = pixel;
+        lf_sample_start(&p->st, &r->sampler, x, y, (uint32_t)i);
+        double fu, fv, dx, dy;
+        lf_sample_2d_d(&p->st, &fu, &fv);
+        p->fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);
+        c->film_x = x + 0.5 + dx;
+        c->film_y = y + 0.5 + dy;
+        c->lens_u = c->lens_v = 0.5;
+        if (need_lens)
+            lf_sample_2d_d(&p->st, &c->lens_u, &c->lens_v);
+        p->tau = 0;
+        c->time = r->shutter_open;
+        if (r->time_needed) {
+            double ut, unused;
+            lf_sample_2d_d(&p->st, &ut, &unused);
+            c->time = shutter_time(r, ut, c->film_x, c->film_y);
+            double tau = r->time1 > r->time0 ? (c->time - r->time0) / (r->time1 - r->time0) : 0;
+            p->tau = tau < 0 ? 0 : (tau > 1 ? 1 : tau); /* Embree asserts 0 <= time <= 1 */
+        }
+        c->wavelength_u = 0.5;
+        if (need_wl) {
+            double unused;
+            lf_sample_2d_d(&p->st, &c->wavelength_u, &unused);
+        }
+        cr[nb].time = c->time;
+        cr[nb].wavelength_nm = 0;
+        if (++nb < BATCH && k + 1 < total)
+            continue;
+        lf_camera_generate_rays(r->camera_type, r->camera, nb, cs, cr, w);
+        *paths += nb;
+        for (int j = 0; j < nb; j++)
+            trace_camera_ray(r, &pend[j], &cr[j], w[j], &acc[pend[j].pixel], rays, nonfinite, zero_weight);
+        nb = 0;
+    }
     for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
-            lf_pixel_acc acc = {{0, 0, 0, 0}};
-            for (int i = r->spp_begin; i < r->spp_end; i++) {
-                lf_sample_stream st;
-                lf_sample_start(&st, &r->sampler, x, y, (uint32_t)i);
-                double fu, fv, dx, dy;
-                lf_sample_2d_d(&st, &fu, &fv);
-                double fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);
-                lf_camera_sample cs;
-                cs.film_x = x + 0.5 + dx;
-                cs.film_y = y + 0.5 + dy;
-                cs.lens_u = cs.lens_v = 0.5;
-                if (need_lens)
-                    lf_sample_2d_d(&st, &cs.lens_u, &cs.lens_v);
-                double tau = 0;
-                cs.time = r->shutter_open;
-                if (r->time_needed) {
-                    double ut, unused;
-                    lf_sample_2d_d(&st, &ut, &unused);
-                    cs.time = shutter_time(r, ut, cs.film_x, cs.film_y);
-                    tau = r->time1 > r->time0 ? (cs.time - r->time0) / (r->time1 - r->time0) : 0;
-                    tau = tau < 0 ? 0 : (tau > 1 ? 1 : tau); /* Embree asserts 0 <= time <= 1 */
-                }
-                cs.wavelength_u = 0.5;
-                if (need_wl) {
-                    double unused;
-                    lf_sample_2d_d(&st, &cs.wavelength_u, &unused);
-                }
-                lf_camera_ray cr;
-                cr.time = cs.time;
-                cr.wavelength_nm = 0;
-                double w = ct->generate_ray(r->camera, &cs, &cr);
-                (*paths)++;
-                acc.v[3] += lf_acc_quantize(fw);
-                if (!(w > 0) || !isfinite(w)) {
-                    (*zero_weight)++;
-                    continue;
-                }
-                lf_transform moving;
-                const lf_transform *c2w = &r->camera_to_world;
-                if (r->camera_moving) {
-                    /* forward matrix only: the ray needs no inverse */
-                    lf_decomposed_matrix(&r->camera_keys[0], &r->camera_keys[1], tau, moving.m);
-                    c2w = &moving;
-                }
-                lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr.origin[0], cr.origin[1], cr.origin[2]});
-                lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr.dir[0], cr.dir[1], cr.dir[2]});
-                double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-                lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
-                lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
-                lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, (float)tau, &st, rays);
-                L = lf_scale(L, (float)w * scale);
-                if (need_wl && cr.wavelength_nm > 0)
-                    L = lf_mul(L, lf_wavelength_rgb_weight(cr.wavelength_nm));
-                if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
-                    (*nonfinite)++;
-                    continue;
-                }
-                if (isfinite(r->max_component)) {
-                    float m = lf_maxc(L);
-                    if (m > r->max_component)
-                        L = lf_scale(L, (float)(r->max_component / m));
-                }
-                /* exact fixed-point sums: split renders merge bit-identically */
-                acc.v[0] += lf_acc_quantize(fw * L.x);
-                acc.v[1] += lf_acc_quantize(fw * L.y);
-                acc.v[2] += lf_acc_quantize(fw * L.z);
-            }
+            const lf_pixel_acc *a = &acc[(y - y0) * tw + (x - x0)];
             float *px = lf_image_px(jb->img, x - r->px0, y - r->py0);
             for (int c = 0; c < 3; c++)
-                px[c] = lf_acc_value(&acc, c);
+                px[c] = lf_acc_value(a, c);
             if (jb->acc)
-                jb->acc[(size_t)(y - r->py0) * jb->img->width + (x - r->px0)] = acc;
+                jb->acc[(size_t)(y - r->py0) * jb->img->width + (x - r->px0)] = *a;
         }
 }
 

@@ -1,4 +1,5 @@
 /* Loading a user's camera from a shared object into the registry. */
+#include <math.h>
 #include <string.h>
 
 #include "camera/lf_camera.h"
@@ -19,5 +20,29 @@ int main(void)
     CHECK(lf_camera_load_plugin(LF_PLUGIN_PATH, err, sizeof err) != 0);
     CHECK(strstr(err, "already registered") != NULL);
     CHECK(lf_camera_count() == before + 1);
+
+    /* A version-1 plugin (its type record ends before generate_rays) loads,
+     * has no batch entry, and the host's batch call falls back to single
+     * rays: the pinhole's rays for pixel centres, from projection. */
+    CHECK_MSG(lf_camera_load_plugin(LF_LEGACY_PLUGIN_PATH, err, sizeof err) == 0, "%s", err);
+    const lf_camera_type *lt = lf_camera_find("legacy_pinhole");
+    CHECK(lt != NULL);
+    if (lt) {
+        CHECK(lt->abi_version == 1u && lt->generate_rays == NULL && lt->describe == NULL && lt->metadata == NULL);
+        lf_camera_create_args a = {sizeof a, NULL, 64, 32, 35.0, 0, 1, ".", err, sizeof err, NULL, 0};
+        void *state = NULL;
+        CHECK(lt->create(&a, &state) == 0);
+        lf_camera_sample s[3] = {{32, 16, .5, .5, 0, .5}, {0, 0, .5, .5, 0, .5}, {64, 32, .5, .5, 0, .5}};
+        lf_camera_ray r[3];
+        double w[3];
+        lf_camera_generate_rays(lt, state, 3, s, r, w);
+        /* film (x, y) -> direction (2x/W - 1, (1 - 2y/H) H/W, 1), normalised */
+        CHECK(w[0] == 1 && w[1] == 1 && w[2] == 1);
+        CHECK_NEAR(r[0].dir[2], 1.0, 1e-15);
+        CHECK_NEAR(r[1].dir[0], -1.0 / sqrt(2.25), 1e-15);
+        CHECK_NEAR(r[1].dir[1], 0.5 / sqrt(2.25), 1e-15);
+        CHECK_NEAR(r[2].dir[0], 1.0 / sqrt(2.25), 1e-15);
+        lt->destroy(state);
+    }
     return lf_test_end();
 }

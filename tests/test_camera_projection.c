@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "camera/camera_internal.h"
 #include "camera/lf_camera.h"
 #include "lf_test.h"
 
@@ -44,11 +45,14 @@ static int g_bool(void *c, const char *name, int def)
  * Gauss (relative to scenes/).  Other cameras (plenoptic takes an optional
  * lensfile) keep their defaults. */
 static const char *current_camera = "";
+static const char *current_aperture = NULL; /* "string aperture", when set */
 static const char *g_string(void *c, const char *name, const char *def)
 {
     (void)c;
     if (!strcmp(name, "lensfile") && !strcmp(current_camera, "realistic"))
         return "lenses/dgauss.50mm.dat";
+    if (!strcmp(name, "aperture") && current_aperture)
+        return current_aperture;
     return def;
 }
 static int g_floats(void *c, const char *name, double *out, int max)
@@ -215,8 +219,109 @@ static void test_all_cameras_properties(void)
     }
 }
 
+/* The branch-free concentric mapping with its polynomial sine and cosine
+ * gives pbrt's points: r (cos phi, sin phi) with phi = pi/4 b/a (|a| > |b|)
+ * or pi/2 - pi/4 a/b, computed here with libm. */
+static void test_concentric_disk(void)
+{
+    double worst = 0;
+    unsigned st = 99;
+    for (int k = 0; k < 100000; k++) {
+        double u, v;
+        st = st * 1664525u + 1013904223u;
+        u = (st >> 8) * 0x1p-24;
+        st = st * 1664525u + 1013904223u;
+        v = (st >> 8) * 0x1p-24;
+        if (k < 9)
+            u = (k % 3) * 0.5, v = (k / 3) * 0.5; /* centre, edges, corners, diagonals */
+        double a = 2 * u - 1, b = 2 * v - 1, x, y, ex, ey;
+        if (a == 0 && b == 0)
+            ex = ey = 0;
+        else if (fabs(a) > fabs(b))
+            ex = a * cos(M_PI / 4 * (b / a)), ey = a * sin(M_PI / 4 * (b / a));
+        else
+            ex = b * cos(M_PI / 2 - M_PI / 4 * (a / b)), ey = b * sin(M_PI / 2 - M_PI / 4 * (a / b));
+        lf_cam_concentric_disk(u, v, &x, &y);
+        double e = fmax(fabs(x - ex), fabs(y - ey));
+        worst = e > worst ? e : worst;
+    }
+    CHECK_MSG(worst < 1e-15, "concentric disk differs from libm's by %g", worst);
+}
+
+/* generate_rays (what lfrender calls) gives exactly the rays and weights
+ * of generate_ray, for every built-in camera and every aperture path,
+ * including batches that end mid-chunk. */
+static void test_batch_equals_single(void)
+{
+    struct {
+        const char *camera, *aperture;
+        store s;
+    } cfg[] = {
+        {"perspective", NULL, {{{"fov", {40}, 1}}, 1}},
+        {"perspective", NULL, {{{"fov", {40}, 1}, {"lensradius", {0.05}, 1}, {"focaldistance", {3}, 1}}, 3}},
+        {"perspective", "polygon", {{{"lensradius", {0.05}, 1}, {"anamorphic", {1.5}, 1}}, 2}},
+        {"orthographic", NULL, {{{"lensradius", {0.05}, 1}, {"focaldistance", {2}, 1}}, 2}},
+        {"orthographic", NULL, {{{"screenwindow", {-2, 2, -1, 1}, 4}}, 1}},
+        {"thinlens", NULL, {{{"fstop", {2}, 1}, {"focusdistance", {3}, 1}}, 2}},
+        {"thinlens", NULL, {{{"fstop", {1.4}, 1}, {"anamorphic", {1.33}, 1}}, 2}},
+        {"thinlens", "polygon", {{{"blades", {7}, 1}, {"aperturerotation", {10}, 1}}, 2}},
+        {"thinlens", "star", {{{"fstop", {4}, 1}}, 1}},
+        {"realistic", NULL, {{{"aperturediameter", {20}, 1}}, 1}},
+        {"lightfield", NULL, {{{"lensradius", {0.05}, 1}}, 1}},
+        {"plenoptic", NULL, {{{"fstop", {2}, 1}}, 1}},
+    };
+    enum { N = 1237 }; /* not a multiple of any chunk size */
+    lf_camera_sample *cs = malloc(sizeof *cs * N);
+    lf_camera_ray *r1 = malloc(sizeof *r1 * N), *r2 = malloc(sizeof *r2 * N);
+    double *w1 = malloc(sizeof *w1 * N), *w2 = malloc(sizeof *w2 * N);
+    unsigned st = 7;
+    for (int i = 0; i < N; i++) {
+        double u[4];
+        for (int j = 0; j < 4; j++) {
+            st = st * 1664525u + 1013904223u;
+            u[j] = (st >> 8) * 0x1p-24;
+        }
+        if (i < 4)
+            u[2] = i & 1 ? 0.5 : 0x1.fffffep-1, u[3] = i & 2 ? 0.5 : 0; /* lens centre and edges */
+        lf_camera_sample s = {u[0] * 64, u[1] * 48, u[2], u[3], 0.25, 0.5};
+        cs[i] = s;
+    }
+    for (size_t c = 0; c < sizeof cfg / sizeof cfg[0]; c++) {
+        const lf_camera_type *t = lf_camera_find(cfg[c].camera);
+        current_camera = cfg[c].camera;
+        current_aperture = cfg[c].aperture;
+        char err[512] = "";
+        void *state = make(cfg[c].camera, &cfg[c].s, 64, 48, err);
+        current_aperture = NULL;
+        CHECK_MSG(state != NULL, "%s: %s", cfg[c].camera, err);
+        if (!state)
+            continue;
+        for (int i = 0; i < N; i++) {
+            r1[i].time = r2[i].time = 0.25, r1[i].wavelength_nm = r2[i].wavelength_nm = 0;
+            w1[i] = t->generate_ray(state, &cs[i], &r1[i]);
+        }
+        /* uneven batch sizes: 1, 2, 3, ... */
+        for (int i = 0, n = 1; i < N; i += n, n++)
+            lf_camera_generate_rays(t, state, i + n <= N ? n : N - i, cs + i, r2 + i, w2 + i);
+        int differ = 0, lit = 0;
+        for (int i = 0; i < N; i++) {
+            lit += w1[i] > 0;
+            if (w1[i] != w2[i] || (w1[i] > 0 && (memcmp(r1[i].origin, r2[i].origin, sizeof r1[i].origin) ||
+                                                  memcmp(r1[i].dir, r2[i].dir, sizeof r1[i].dir))))
+                differ++;
+        }
+        CHECK_MSG(differ == 0, "%s (config %zu): %d of %d batch rays differ from single rays", cfg[c].camera, c,
+                  differ, N);
+        CHECK_MSG(lit > N / 2, "%s (config %zu): only %d of %d rays carry weight", cfg[c].camera, c, lit, N);
+        t->destroy(state);
+    }
+    free(cs), free(r1), free(r2), free(w1), free(w2);
+}
+
 int main(void)
 {
+    test_concentric_disk();
+    test_batch_equals_single();
     test_perspective_projection();
     test_thin_lens_focus();
     test_orthographic();

@@ -84,7 +84,13 @@ static double generate_ray(const void *state, const lf_camera_sample *s, lf_came
 static void destroy(void *state) { free(state); }
 
 static const lf_camera_type mythinlens_type = {
-    LF_CAMERA_ABI_VERSION, "mythinlens", create, needs, generate_ray, destroy, NULL, NULL,
+    .abi_version = LF_CAMERA_ABI_VERSION,
+    .name = "mythinlens",
+    .create = create,
+    .needs = needs,
+    .generate_ray = generate_ray,
+    .destroy = destroy,
+    /* optional: .describe, .metadata, and .generate_rays (many rays at once) */
 };
 
 const lf_camera_type *const *lf_camera_plugin_types(int *count)

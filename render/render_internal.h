@@ -3,6 +3,7 @@
 #define LF_RENDER_INTERNAL_H
 
 #include <embree3/rtcore.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "../base/lf_distrib.h"
@@ -13,14 +14,17 @@
 #include "lf_render.h"
 #include "lf_shading.h"
 
-/* A world-space triangle mesh (trianglemesh, plymesh, bilinearmesh, disk,
- * and spheres that Embree's sphere primitive cannot represent). */
+/* A triangle mesh (trianglemesh, plymesh, bilinearmesh, disk, and spheres
+ * that Embree's sphere primitive cannot represent): world space, or the
+ * space of a prototype that rigidly moving Embree instances place in the
+ * world (proto >= 0; docs/motion.md). */
 typedef struct lf_mesh {
     int n_tris, n_verts;
     int n_keys;    /* keyframes of its motion (1: static), evenly spaced in Embree time 0..1 */
+    int proto;     /* -1: world space; else the lf_proto whose space P and N are in (n_keys 1) */
     int *idx;      /* 3 per triangle */
-    float *P;      /* world space, 3 per vertex, n_keys blocks of 3 * n_verts */
-    float *N;      /* world space shading normals (same layout), or NULL */
+    float *P;      /* world (or prototype) space, 3 per vertex, n_keys blocks of 3 * n_verts */
+    float *N;      /* shading normals in the same space and layout, or NULL */
     float *uv;     /* 2 per vertex, or NULL (pbrt defaults per triangle) */
     int material;
     int light_first;   /* index of the first triangle's light, -1 if not emissive */
@@ -83,6 +87,35 @@ static inline lf_vec3 lf_mesh_normal_at(const lf_mesh *m, int i, float tau)
     return lf_v3(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]));
 }
 
+/* A static Embree scene of meshes in their own space, placed in the world
+ * by lf_instance geometries.  Its meshes are s->meshes[mesh_first ..
+ * mesh_first + n_meshes), attached with geomID = mesh index - mesh_first. */
+typedef struct lf_proto {
+    RTCScene rtc;
+    int mesh_first, n_meshes;
+    lf_vec3 bmin, bmax; /* bounds in its own space */
+} lf_proto;
+
+/* A rigidly moving placement of a prototype: an Embree instance with two
+ * time steps given as quaternion decompositions, so Embree slerps the
+ * rotation (pbrt's decomposed interpolation) instead of moving vertices
+ * along chords.  Hits go to the world by the same interpolation at the
+ * ray's time, evaluated from the fields below (render/scene.c,
+ * instance_motion_at; rtcGetGeometryTransform agrees to ~2e-6 but costs
+ * ~470 instructions a hit). */
+typedef struct lf_instance {
+    RTCGeometry geom;  /* owned by the top-level scene */
+    int proto;
+    lf_decomposed key[2]; /* its motion at Embree time 0 and 1 */
+    /* The same motion for hits, precomputed: rotation q(tau) = cos(tau
+     * theta) q0 + sin(tau theta) qperp (nlerp of q0, q1 when they are within
+     * Embree's and pbrt's lerp threshold), axis scales and translation lerped. */
+    float q0[4], q1[4], qperp[4], theta;
+    int nlerp;
+    int uniform_scale; /* the same scale on all axes at both keys */
+    lf_vec3 scale0, scale1, trans0, trans1;
+} lf_instance;
+
 typedef enum lf_light_kind {
     LF_LIGHT_POINT,
     LF_LIGHT_SPOT,
@@ -122,10 +155,17 @@ typedef struct lf_scene {
     lf_sphere *spheres;
     int n_spheres;
     unsigned sphere_geom_id; /* the static spheres' geometry; RTC_INVALID_GEOMETRY_ID if none */
-    int *geom_index;         /* geomID -> mesh index (>= 0) or -1 - sphere index (moving sphere) */
+    int *geom_index;         /* top-level geomID -> mesh index (>= 0) or -1 - sphere index (moving
+                                sphere); for an instance, the lf_instance index (hit.instID[0]) */
     int n_geom;
-    int moving_shapes;       /* meshes or spheres with more than one keyframe */
-    int max_keys;
+    lf_proto *protos;
+    int n_protos;
+    lf_instance *instances;
+    int n_instances;
+    int moving_shapes;       /* meshes or spheres with more than one keyframe, plus moving instances */
+    int max_keys;            /* of the keyframed meshes and spheres */
+    int motion_rigid_shapes; /* Shape directives (per ObjectInstance) moved as rigid Embree instances */
+    int motion_keyframed_shapes; /* ... moved by keyframed vertices or sphere centres */
     double time0, time1;     /* TransformTimes: scene time of Embree time 0 and 1 */
     lf_light *lights;
     int n_lights;
@@ -144,6 +184,8 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err);
 /* A scene with no geometry and a uniform environment of radiance 1. */
 int lf_scene_build_white(lf_scene *s, lf_error *err);
 void lf_scene_free(lf_scene *s);
+/* How the moving shapes move, for --explain (one clause, no newline). */
+void lf_scene_motion_summary(const lf_scene *s, char *buf, size_t n);
 /* Appends a warning line to a malloc'ed buffer. */
 void lf_warn_append(char **buf, const char *fmt, ...)
 #if defined(__GNUC__)

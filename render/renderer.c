@@ -660,11 +660,11 @@ char *lf_renderer_explain(const lf_renderer *r)
             r->camera_needs & LF_CAMERA_NEEDS_LENS ? "on (the camera samples its lens)"
                                                    : "off (pinhole: no lens samples drawn)");
     if (r->time_needed) {
-        appendf(&b, &len, &cap,
-                "  motion blur: on (%d moving shapes, up to %d keyframes = %d segments, on Embree motion-BVH nodes; "
-                "camera %s); one time sample per camera ray in [%g, %g]\n",
-                s->moving_shapes, s->max_keys, s->max_keys - 1, r->camera_moving ? "moving" : "static",
-                r->shutter_open, r->shutter_close + (r->rolling ? r->readout : 0));
+        char shapes[512];
+        lf_scene_motion_summary(s, shapes, sizeof shapes);
+        appendf(&b, &len, &cap, "  motion blur: on (%s; camera %s); one time sample per camera ray in [%g, %g]\n",
+                shapes, r->camera_moving ? "moving" : "static", r->shutter_open,
+                r->shutter_close + (r->rolling ? r->readout : 0));
     } else {
         appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
                 r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");

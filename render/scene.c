@@ -4,7 +4,15 @@
  * similarity transform go to one Embree sphere-point geometry (exact
  * intersections, no tessellation); partial spheres, disks and bilinear
  * patches are tessellated finely enough that their area differs from the
- * analytic one by well under 0.1%.  Object instances are flattened. */
+ * analytic one by well under 0.1%.  Static object instances are flattened.
+ *
+ * Motion (docs/motion.md): a shape that moves rigidly (rotation, axis
+ * scales, translation) is built once in its own space into a static child
+ * scene (lf_proto) and placed by an Embree instance whose two time steps are
+ * quaternion decompositions, so the rotation is slerped exactly as pbrt's
+ * decomposed interpolation and rays traverse a static BVH.  Shapes that ask
+ * for "motionsegments", emitters, full spheres and motions Embree's
+ * decomposition cannot represent get keyframed vertices (or centres). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -40,8 +48,10 @@ typedef struct motion {
 typedef struct builder {
     lf_scene *s;
     lf_scene_desc *d;
-    int cap_meshes, cap_spheres, cap_lights;
+    int cap_meshes, cap_spheres, cap_lights, cap_protos, cap_instances;
     lf_error *err;
+    int proto;         /* the lf_proto being built (meshes go to its space), or -1: world */
+    int *object_proto; /* per ObjectBegin: its shared lf_proto, -1 none, -2 not built yet */
 } builder;
 
 static int push_mesh(builder *b, lf_mesh *m)
@@ -210,8 +220,13 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, fl
     m.P = P;
     m.N = N;
     m.uv = uv;
+    m.proto = b->proto;
     m.material = sh->material;
     m.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
+    if (b->proto >= 0 && sh->area_light >= 0) { /* never routed here: emitters keep keyframes */
+        free(P), free(N), free(uv), free(idx);
+        return lf_error_set(b->err, LF_ERR_INTERNAL, "internal: an emissive shape in an instance prototype");
+    }
     if (add_mesh_lights(b, &m, sh->area_light) || push_mesh(b, &m)) {
         free(P), free(N), free(uv), free(idx);
         return b->err->code;
@@ -399,7 +414,7 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
     for (int k = 1; k < mo->n && scale > 0; k++)
         if (similarity_scale(&mo->keys[k]) <= 0)
             scale = 0; /* sheared somewhere along the motion: tessellate */
-    if (full && scale > 0) {
+    if (full && scale > 0 && b->proto < 0) {
         if (b->s->n_spheres == b->cap_spheres) {
             int nc = b->cap_spheres ? 2 * b->cap_spheres : 8;
             lf_sphere *n = realloc(b->s->spheres, sizeof *n * nc);
@@ -665,6 +680,9 @@ static void rtc_error_cb(void *user, enum RTCError code, const char *str)
     (void)str;
 }
 
+/* Embree takes at most RTC_MAX_TIME_STEP_COUNT (129) time steps per geometry. */
+#define MAX_MOTION_SEGMENTS (RTC_MAX_TIME_STEP_COUNT - 1)
+
 /* Keyframes for a (possibly animated) object-to-world transform, optionally
  * composed with an animated instance transform.  pbrt interpolates the
  * decomposed transform (rigid rotation); Embree interpolates vertices
@@ -678,8 +696,10 @@ static int motion_keys(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst,
     int requested = lf_params_int(&sh->e.params, "motionsegments", 0);
     char where[512];
     loc_prefix(where, sizeof where, &sh->e.loc);
-    if (requested < 0 || requested > 1024)
-        return lf_error_set(b->err, LF_ERR_PARAM, "%s: \"motionsegments\" must be in 1..1024, got %d", where, requested);
+    if (requested < 0 || requested > MAX_MOTION_SEGMENTS)
+        return lf_error_set(b->err, LF_ERR_PARAM,
+                            "%s: \"motionsegments\" must be in 1..%d (Embree's limit of %d time steps), got %d", where,
+                            MAX_MOTION_SEGMENTS, RTC_MAX_TIME_STEP_COUNT, requested);
     if (!animated) {
         *keys = malloc(sizeof(lf_transform));
         if (!*keys)
@@ -707,8 +727,8 @@ static int motion_keys(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst,
     int segs = requested > 0 ? requested : (int)ceil(angle / 5.0);
     if (segs < 1)
         segs = 1;
-    if (segs > 1024)
-        segs = 1024;
+    if (segs > MAX_MOTION_SEGMENTS)
+        segs = MAX_MOTION_SEGMENTS;
     *keys = malloc(sizeof(lf_transform) * (size_t)(segs + 1));
     if (!*keys)
         return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
@@ -733,16 +753,335 @@ static int motion_keys(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst,
     return 0;
 }
 
+/* ---- rigid motion as Embree instances ---- */
+
+static double peek_num(const lf_paramset *ps, const char *name, double def)
+{
+    const lf_param *p = lf_params_peek(ps, name);
+    return p && p->n_nums >= 1 ? p->nums[0] : def;
+}
+
+/* May this shape's motion be a rigid Embree instance (docs/motion.md)?  Not
+ * when it asks for piecewise-linear keyframes ("motionsegments": the course
+ * notes' segment figures depend on them), not an emitter (light sampling
+ * reads its world-space keyframed vertices), not a full sphere (analytic
+ * spheres move their centre, already cheap), not an unknown shape. */
+static int shape_can_instance(const lf_shape_desc *sh)
+{
+    const lf_paramset *ps = &sh->e.params;
+    if (sh->area_light >= 0 || lf_params_peek(ps, "motionsegments"))
+        return 0;
+    int known = 0;
+    for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
+        known |= strcmp(shape_table[i].name, sh->e.type) == 0;
+    if (!known)
+        return 0;
+    if (strcmp(sh->e.type, "sphere") == 0) {
+        double r = peek_num(ps, "radius", 1.0), z0 = peek_num(ps, "zmin", -r), z1 = peek_num(ps, "zmax", r);
+        return !(fmin(z0, z1) <= -r && fmax(z0, z1) >= r && peek_num(ps, "phimax", 360.0) >= 360.0);
+    }
+    return 1;
+}
+
+/* pbrt's decomposition M = T R S (polar: S symmetric) is Embree's
+ * RTCQuaternionDecomposition T R S (S upper triangular scale/skew/shift)
+ * when S is diagonal: a rotation with scales along the object's axes.
+ * Embree then lerps S and T and slerps R (shortest arc, plain lerp above a
+ * quaternion dot of 0.9995) exactly as lf_decomposed_matrix does. */
+static int stretch_is_diagonal(const lf_decomposed *d)
+{
+    double diag = fmax(fabs(d->s[0][0]), fmax(fabs(d->s[1][1]), fabs(d->s[2][2])));
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (i != j && !(fabs(d->s[i][j]) <= 1e-7 * diag))
+                return 0;
+    return diag > 0 && isfinite(diag);
+}
+
+/* Decomposes a two-key motion for an Embree instance; -1 if singular or not
+ * representable.  Key 1's quaternion is put on key 0's hemisphere so the
+ * float copy Embree gets takes the same (shortest) arc as ours. */
+static int rigid_motion(const lf_transform *x0, const lf_transform *x1, lf_decomposed d[2])
+{
+    if (lf_transform_decompose(x0, &d[0]) || lf_transform_decompose(x1, &d[1]))
+        return -1;
+    if (!stretch_is_diagonal(&d[0]) || !stretch_is_diagonal(&d[1]))
+        return -1;
+    for (int i = 0; i < 3; i++) /* a scale lerping through 0 would make Embree's transform singular */
+        if (!(d[0].s[i][i] * d[1].s[i][i] > 0))
+            return -1;
+    double dot = 0;
+    for (int i = 0; i < 4; i++)
+        dot += d[0].q[i] * d[1].q[i];
+    if (dot < 0)
+        for (int i = 0; i < 4; i++)
+            d[1].q[i] = -d[1].q[i];
+    return 0;
+}
+
+/* pbrt's motion of a shape at fraction f: its own decomposed interpolation,
+ * composed with an instance's (as motion_keys). */
+static void reference_motion(const lf_anim_xform *ax, const lf_anim_xform *inst, double f, double m[4][4])
+{
+    lf_decomposed a[2], i[2];
+    lf_transform t = ax->xf[0];
+    if (ax->animated && !lf_transform_decompose(&ax->xf[0], &a[0]) && !lf_transform_decompose(&ax->xf[1], &a[1]))
+        t = lf_decomposed_interpolate(&a[0], &a[1], f);
+    if (inst) {
+        lf_transform ti = inst->xf[0];
+        if (inst->animated && !lf_transform_decompose(&inst->xf[0], &i[0]) &&
+            !lf_transform_decompose(&inst->xf[1], &i[1]))
+            ti = lf_decomposed_interpolate(&i[0], &i[1], f);
+        t = lf_transform_compose(&ti, &t);
+    }
+    memcpy(m, t.m, sizeof t.m);
+}
+
+/* The whole world motion of a shape (its own animated transform composed
+ * with an instance's) as one two-key decomposed motion: -1 unless that
+ * reproduces pbrt's composed interpolation (checked at interior times; a
+ * rotating instance around a shape that itself rotates about another
+ * point, or a non-uniform static instance scale, does not). */
+static int shape_rigid_motion(const lf_shape_desc *sh, const lf_anim_xform *inst, lf_decomposed w[2])
+{
+    const lf_anim_xform *ax = &sh->object_to_world;
+    lf_transform x[2];
+    for (int k = 0; k < 2; k++)
+        x[k] = inst ? lf_transform_compose(&inst->xf[k], &ax->xf[k]) : ax->xf[k];
+    if (rigid_motion(&x[0], &x[1], w))
+        return -1;
+    if (!inst)
+        return 0; /* exactly pbrt's interpolation of the shape's own keys */
+    for (int k = 1; k < 8; k++) {
+        double ref[4][4], got[4][4], scale = 1, err = 0;
+        reference_motion(ax, inst, k / 8.0, ref);
+        lf_decomposed_matrix(&w[0], &w[1], k / 8.0, got);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++) {
+                scale = fmax(scale, fabs(ref[i][j]));
+                err = fmax(err, fabs(ref[i][j] - got[i][j]));
+            }
+        if (!(err <= 1e-6 * scale))
+            return -1;
+    }
+    return 0;
+}
+
+static int begin_proto(builder *b)
+{
+    lf_scene *s = b->s;
+    if (s->n_protos == b->cap_protos) {
+        int nc = b->cap_protos ? 2 * b->cap_protos : 8;
+        lf_proto *n = realloc(s->protos, sizeof *n * (size_t)nc);
+        if (!n)
+            return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+        s->protos = n;
+        b->cap_protos = nc;
+    }
+    lf_proto *p = &s->protos[s->n_protos];
+    memset(p, 0, sizeof *p);
+    p->mesh_first = s->n_meshes;
+    b->proto = s->n_protos++;
+    return 0;
+}
+
+/* Closes the prototype being built; *index is -1 if it got no geometry
+ * (unsupported shapes), and the prototype is dropped. */
+static void end_proto(builder *b, int *index)
+{
+    lf_scene *s = b->s;
+    lf_proto *p = &s->protos[b->proto];
+    p->n_meshes = s->n_meshes - p->mesh_first;
+    lf_vec3 lo = lf_v3(INFINITY, INFINITY, INFINITY), hi = lf_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (int m = p->mesh_first; m < s->n_meshes; m++)
+        for (int v = 0; v < s->meshes[m].n_verts; v++) {
+            const float *q = s->meshes[m].P + 3 * (size_t)v;
+            lo = lf_v3(fminf(lo.x, q[0]), fminf(lo.y, q[1]), fminf(lo.z, q[2]));
+            hi = lf_v3(fmaxf(hi.x, q[0]), fmaxf(hi.y, q[1]), fmaxf(hi.z, q[2]));
+        }
+    p->bmin = lo;
+    p->bmax = hi;
+    *index = b->proto;
+    if (p->n_meshes == 0) { /* prototypes are built one after another: this is the last */
+        *index = -1;
+        s->n_protos--;
+    }
+    b->proto = -1;
+}
+
+static int push_instance(builder *b, int proto, const lf_decomposed w[2])
+{
+    lf_scene *s = b->s;
+    if (s->n_instances == b->cap_instances) {
+        int nc = b->cap_instances ? 2 * b->cap_instances : 8;
+        lf_instance *n = realloc(s->instances, sizeof *n * (size_t)nc);
+        if (!n)
+            return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+        s->instances = n;
+        b->cap_instances = nc;
+    }
+    lf_instance *in = &s->instances[s->n_instances++];
+    memset(in, 0, sizeof *in);
+    in->proto = proto;
+    in->key[0] = w[0];
+    in->key[1] = w[1];
+    /* q1 is on q0's hemisphere (rigid_motion) */
+    double dot = 0, perp[4], len = 0;
+    for (int i = 0; i < 4; i++)
+        dot += w[0].q[i] * w[1].q[i];
+    for (int i = 0; i < 4; i++) {
+        perp[i] = w[1].q[i] - dot * w[0].q[i];
+        len += perp[i] * perp[i];
+    }
+    in->nlerp = dot > 0.9995 || !(len > 0);
+    in->theta = (float)acos(dot < 1 ? dot : 1);
+    for (int i = 0; i < 4; i++) {
+        in->q0[i] = (float)w[0].q[i];
+        in->q1[i] = (float)w[1].q[i];
+        in->qperp[i] = in->nlerp ? 0.f : (float)(perp[i] / sqrt(len));
+    }
+    in->scale0 = lf_v3((float)w[0].s[0][0], (float)w[0].s[1][1], (float)w[0].s[2][2]);
+    in->scale1 = lf_v3((float)w[1].s[0][0], (float)w[1].s[1][1], (float)w[1].s[2][2]);
+    in->trans0 = lf_v3((float)w[0].t[0], (float)w[0].t[1], (float)w[0].t[2]);
+    in->trans1 = lf_v3((float)w[1].t[0], (float)w[1].t[1], (float)w[1].t[2]);
+    in->uniform_scale = 1;
+    for (int k = 0; k < 2; k++)
+        for (int i = 1; i < 3; i++)
+            if (fabs(w[k].s[i][i] - w[k].s[0][0]) > 1e-6 * fabs(w[k].s[0][0]))
+                in->uniform_scale = 0;
+    return 0;
+}
+
+/* Builds shapes into a new prototype: one shape in its object space
+ * (sh != NULL), or every instanceable static shape of ObjectBegin `object`
+ * in the object's space, shared by all its moving instances. */
+static int build_proto(builder *b, lf_shape_desc *sh, int object, int *index)
+{
+    if (begin_proto(b))
+        return b->err->code;
+    if (sh) {
+        lf_transform id = lf_transform_identity();
+        motion mo = {&id, 1};
+        if (build_shape(b, sh, &mo)) {
+            b->proto = -1;
+            return b->err->code;
+        }
+    } else {
+        for (size_t i = 0; i < b->d->n_shapes; i++) {
+            lf_shape_desc *o = &b->d->shapes[i];
+            if (o->object != object || o->object_to_world.animated || !shape_can_instance(o))
+                continue;
+            motion mo = {&o->object_to_world.xf[0], 1};
+            if (build_shape(b, o, &mo)) {
+                b->proto = -1;
+                return b->err->code;
+            }
+        }
+    }
+    end_proto(b, index);
+    return 0;
+}
+
 static int build_shape_moving(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst)
 {
     lf_transform *keys = NULL;
     int n = 0;
     if (motion_keys(b, sh, inst, &keys, &n))
         return b->err->code;
+    lf_decomposed w[2];
+    if (n > 1 && shape_can_instance(sh) && !shape_rigid_motion(sh, inst, w)) {
+        free(keys);
+        int proto;
+        if (build_proto(b, sh, -1, &proto) || (proto >= 0 && push_instance(b, proto, w)))
+            return b->err->code;
+        b->s->motion_rigid_shapes += proto >= 0; /* else it made no geometry */
+        return 0;
+    }
     motion mo = {keys, n};
     int rc = build_shape(b, sh, &mo);
     free(keys);
+    if (n > 1)
+        b->s->motion_keyframed_shapes++;
     return rc;
+}
+
+/* An ObjectInstance: a moving rigid instance transform places the object's
+ * shared prototype (its static, instanceable shapes) as one Embree
+ * instance; its other shapes, and everything of a static instance, are
+ * flattened as before. */
+static int build_object_instance(builder *b, const lf_instance_desc *in)
+{
+    const lf_anim_xform *ix = &in->instance_to_world;
+    lf_decomposed w[2];
+    int proto = -1;
+    if (ix->animated && !rigid_motion(&ix->xf[0], &ix->xf[1], w)) {
+        if (b->object_proto[in->object] == -2 && build_proto(b, NULL, in->object, &b->object_proto[in->object]))
+            return b->err->code;
+        proto = b->object_proto[in->object];
+        if (proto >= 0 && push_instance(b, proto, w))
+            return b->err->code;
+    }
+    for (size_t i = 0; i < b->d->n_shapes; i++) {
+        lf_shape_desc *sh = &b->d->shapes[i];
+        if (sh->object != in->object)
+            continue;
+        if (proto >= 0 && !sh->object_to_world.animated && shape_can_instance(sh)) {
+            b->s->motion_rigid_shapes++;
+            continue;
+        }
+        if (build_shape_moving(b, sh, ix))
+            return b->err->code;
+    }
+    return 0;
+}
+
+/* A triangle geometry for a mesh (one vertex buffer per keyframe over
+ * Embree time 0..1 when it moves), attached with geomID id (or the next
+ * free one for RTC_INVALID_GEOMETRY_ID). */
+static unsigned attach_mesh(RTCDevice device, RTCScene scene, const lf_mesh *me, unsigned id)
+{
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (me->n_keys > 1)
+        rtcSetGeometryTimeStepCount(g, (unsigned)me->n_keys);
+    for (int k = 0; k < me->n_keys; k++)
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, (unsigned)k, RTC_FORMAT_FLOAT3,
+                                   me->P + (size_t)k * 3 * me->n_verts, 0, 3 * sizeof(float), (size_t)me->n_verts);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, me->idx, 0, 3 * sizeof(int),
+                               (size_t)me->n_tris);
+    rtcCommitGeometry(g);
+    if (id == RTC_INVALID_GEOMETRY_ID)
+        id = rtcAttachGeometry(scene, g);
+    else
+        rtcAttachGeometryByID(scene, g, id);
+    rtcReleaseGeometry(g);
+    return id;
+}
+
+/* Our decomposition (diagonal stretch, checked by rigid_motion) in Embree's
+ * terms: scale = the stretch's diagonal, no skew or shift, quaternion
+ * (r, i, j, k) = (w, x, y, z). */
+static void embree_decomposition(const lf_decomposed *d, struct RTCQuaternionDecomposition *qd)
+{
+    rtcInitQuaternionDecomposition(qd);
+    rtcQuaternionDecompositionSetScale(qd, (float)d->s[0][0], (float)d->s[1][1], (float)d->s[2][2]);
+    rtcQuaternionDecompositionSetQuaternion(qd, (float)d->q[3], (float)d->q[0], (float)d->q[1], (float)d->q[2]);
+    rtcQuaternionDecompositionSetTranslation(qd, (float)d->t[0], (float)d->t[1], (float)d->t[2]);
+}
+
+void lf_scene_motion_summary(const lf_scene *s, char *buf, size_t n)
+{
+    int rigid = s->motion_rigid_shapes, keyed = s->motion_keyframed_shapes;
+    char a[256] = "", k[256] = "";
+    if (rigid)
+        snprintf(a, sizeof a,
+                 "%d as rigid Embree instance%s (%d instance%s of %d prototype%s: quaternion motion, static BVHs)",
+                 rigid, rigid == 1 ? "" : "s", s->n_instances, s->n_instances == 1 ? "" : "s", s->n_protos,
+                 s->n_protos == 1 ? "" : "s");
+    if (keyed)
+        snprintf(k, sizeof k, "%d with keyframed vertices or centres (up to %d keyframes = %d segments, on Embree "
+                 "motion-BVH nodes)", keyed, s->max_keys, s->max_keys - 1);
+    snprintf(buf, n, "%d moving shape%s: %s%s%s", rigid + keyed, rigid + keyed == 1 ? "" : "s", a,
+             rigid && keyed ? ", " : "", k);
 }
 
 int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
@@ -751,7 +1090,14 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
     s->time0 = d->transform_start_time;
     s->time1 = d->transform_end_time;
-    builder b = {s, d, 0, 0, 0, err};
+    builder b = {s, d, 0, 0, 0, 0, 0, err, -1, NULL};
+    b.object_proto = malloc(sizeof(int) * (d->n_objects ? d->n_objects : 1));
+    if (!b.object_proto) {
+        lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < d->n_objects; i++)
+        b.object_proto[i] = -2;
     if (lf_materials_build(d, &s->materials, err))
         goto fail;
     if (lf_materials_warnings(s->materials))
@@ -763,16 +1109,11 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         if (build_shape_moving(&b, sh, NULL))
             goto fail;
     }
-    for (size_t k = 0; k < d->n_instances; k++) {
-        lf_instance_desc *in = &d->instances[k];
-        for (size_t i = 0; i < d->n_shapes; i++) {
-            lf_shape_desc *sh = &d->shapes[i];
-            if (sh->object != in->object)
-                continue;
-            if (build_shape_moving(&b, sh, &in->instance_to_world))
-                goto fail;
-        }
-    }
+    for (size_t k = 0; k < d->n_instances; k++)
+        if (build_object_instance(&b, &d->instances[k]))
+            goto fail;
+    free(b.object_proto);
+    b.object_proto = NULL;
     if (lf_scene_build_lights(d, s, err))
         goto fail;
 
@@ -788,7 +1129,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     int n_moving_spheres = 0;
     for (int i = 0; i < s->n_spheres; i++)
         n_moving_spheres += s->spheres[i].n_keys > 1;
-    s->n_geom = s->n_meshes + 1 + n_moving_spheres;
+    s->n_geom = s->n_meshes + 1 + n_moving_spheres + s->n_instances;
     s->geom_index = malloc(sizeof(int) * (size_t)s->n_geom);
     if (!s->geom_index) {
         lf_error_set(err, LF_ERR_NOMEM, "out of memory");
@@ -798,21 +1139,12 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     lf_vec3 bmin = lf_v3(INFINITY, INFINITY, INFINITY), bmax = lf_v3(-INFINITY, -INFINITY, -INFINITY);
     for (int m = 0; m < s->n_meshes; m++) {
         lf_mesh *me = &s->meshes[m];
-        RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        if (me->n_keys > 1) {
-            /* Motion: one vertex buffer per keyframe over Embree time 0..1. */
-            rtcSetGeometryTimeStepCount(g, (unsigned)me->n_keys);
-            s->moving_shapes++;
-        }
-        for (int k = 0; k < me->n_keys; k++)
-            rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, (unsigned)k, RTC_FORMAT_FLOAT3,
-                                       me->P + (size_t)k * 3 * me->n_verts, 0, 3 * sizeof(float), (size_t)me->n_verts);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, me->idx, 0, 3 * sizeof(int),
-                                   (size_t)me->n_tris);
-        rtcCommitGeometry(g);
-        unsigned id = rtcAttachGeometry(s->rtc, g);
-        rtcReleaseGeometry(g);
+        if (me->proto >= 0)
+            continue; /* in its prototype's scene, below */
+        unsigned id = attach_mesh(s->device, s->rtc, me, RTC_INVALID_GEOMETRY_ID);
         s->geom_index[id] = m;
+        if (me->n_keys > 1)
+            s->moving_shapes++;
         if (me->n_keys > s->max_keys)
             s->max_keys = me->n_keys;
         for (size_t v = 0; v < (size_t)me->n_verts * me->n_keys; v++) {
@@ -860,7 +1192,57 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
             }
         }
     }
+    /* Rigidly moving shapes: static prototype scenes placed by instances. */
+    for (int p = 0; p < s->n_protos; p++) {
+        lf_proto *pr = &s->protos[p];
+        pr->rtc = rtcNewScene(s->device);
+        rtcSetSceneBuildQuality(pr->rtc, RTC_BUILD_QUALITY_HIGH);
+        for (int m = 0; m < pr->n_meshes; m++)
+            attach_mesh(s->device, pr->rtc, &s->meshes[pr->mesh_first + m], (unsigned)m);
+        rtcCommitScene(pr->rtc);
+    }
+    for (int i = 0; i < s->n_instances; i++) {
+        lf_instance *in = &s->instances[i];
+        const lf_proto *pr = &s->protos[in->proto];
+        RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, pr->rtc);
+        rtcSetGeometryTimeStepCount(g, 2);
+        for (unsigned k = 0; k < 2; k++) {
+            struct RTCQuaternionDecomposition qd;
+            embree_decomposition(&in->key[k], &qd);
+            rtcSetGeometryTransformQuaternion(g, k, &qd);
+        }
+        rtcCommitGeometry(g);
+        unsigned id = rtcAttachGeometry(s->rtc, g);
+        rtcReleaseGeometry(g); /* the scene keeps it alive; in->geom is valid as long as s->rtc */
+        in->geom = g;
+        s->geom_index[id] = i;
+        s->moving_shapes++;
+        /* World bounds over the motion: the prototype's box at 17 times. */
+        for (int k = 0; k <= 16; k++) {
+            double m4[4][4];
+            lf_decomposed_matrix(&in->key[0], &in->key[1], k / 16.0, m4);
+            for (int c = 0; c < 8; c++) {
+                double q[3] = {c & 1 ? pr->bmax.x : pr->bmin.x, c & 2 ? pr->bmax.y : pr->bmin.y,
+                               c & 4 ? pr->bmax.z : pr->bmin.z};
+                float w[3];
+                for (int r = 0; r < 3; r++)
+                    w[r] = (float)(m4[r][0] * q[0] + m4[r][1] * q[1] + m4[r][2] * q[2] + m4[r][3]);
+                bmin = lf_v3(fminf(bmin.x, w[0]), fminf(bmin.y, w[1]), fminf(bmin.z, w[2]));
+                bmax = lf_v3(fmaxf(bmax.x, w[0]), fmaxf(bmax.y, w[1]), fmaxf(bmax.z, w[2]));
+            }
+        }
+    }
     rtcCommitScene(s->rtc);
+    {
+        /* The error callback stays quiet (it may run on render threads);
+         * what went wrong while building is an error here. */
+        enum RTCError e = rtcGetDeviceError(s->device);
+        if (e != RTC_ERROR_NONE) {
+            lf_error_set(err, LF_ERR_INTERNAL, "Embree could not build the scene (error %d)", (int)e);
+            goto fail;
+        }
+    }
     if (bmin.x > bmax.x)
         bmin = bmax = lf_v3(0, 0, 0);
     s->bounds_min = bmin;
@@ -883,6 +1265,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     }
     return 0;
 fail:
+    free(b.object_proto);
     lf_scene_free(s);
     return err && err->code ? err->code : LF_ERR_INTERNAL;
 }
@@ -915,6 +1298,11 @@ void lf_scene_free(lf_scene *s)
 {
     if (s->rtc)
         rtcReleaseScene(s->rtc);
+    for (int p = 0; p < s->n_protos; p++)
+        if (s->protos[p].rtc)
+            rtcReleaseScene(s->protos[p].rtc);
+    free(s->protos);
+    free(s->instances);
     if (s->device)
         rtcReleaseDevice(s->device);
     for (int i = 0; i < s->n_meshes; i++) {
@@ -968,6 +1356,128 @@ static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax, flo
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
+static inline lf_vec3 rotate(const float R[3][3], lf_vec3 v)
+{
+    return lf_v3(R[0][0] * v.x + R[0][1] * v.y + R[0][2] * v.z, R[1][0] * v.x + R[1][1] * v.y + R[1][2] * v.z,
+                 R[2][0] * v.x + R[2][1] * v.y + R[2][2] * v.z);
+}
+
+/* An instance's placement at a ray's time: x -> R (scale * x) + trans. */
+typedef struct instance_xf {
+    float R[3][3];
+    lf_vec3 scale, cof, trans; /* cof: the cofactors of the scale, for normals (see mesh_hit) */
+    int uniform_scale;
+} instance_xf;
+
+/* pbrt's decomposed interpolation (lf_decomposed_matrix) of an instance's
+ * motion at Embree time tau, in float. */
+static void instance_motion_at(const lf_instance *in, float tau, instance_xf *xf)
+{
+    float q[4];
+    if (in->nlerp) {
+        float l = 0;
+        for (int i = 0; i < 4; i++) {
+            q[i] = (1 - tau) * in->q0[i] + tau * in->q1[i];
+            l += q[i] * q[i];
+        }
+        l = 1.f / sqrtf(l);
+        for (int i = 0; i < 4; i++)
+            q[i] *= l;
+    } else {
+        float phi = tau * in->theta, c = cosf(phi), sn = sinf(phi);
+        for (int i = 0; i < 4; i++)
+            q[i] = c * in->q0[i] + sn * in->qperp[i];
+    }
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    float(*R)[3] = xf->R;
+    R[0][0] = 1 - 2 * (y * y + z * z), R[0][1] = 2 * (x * y - z * w), R[0][2] = 2 * (x * z + y * w);
+    R[1][0] = 2 * (x * y + z * w), R[1][1] = 1 - 2 * (x * x + z * z), R[1][2] = 2 * (y * z - x * w);
+    R[2][0] = 2 * (x * z - y * w), R[2][1] = 2 * (y * z + x * w), R[2][2] = 1 - 2 * (x * x + y * y);
+    lf_vec3 sc = lf_add(lf_scale(in->scale0, 1 - tau), lf_scale(in->scale1, tau));
+    xf->scale = sc;
+    xf->cof = lf_v3(sc.y * sc.z, sc.x * sc.z, sc.x * sc.y);
+    xf->trans = lf_add(lf_scale(in->trans0, 1 - tau), lf_scale(in->trans1, tau));
+    xf->uniform_scale = in->uniform_scale;
+}
+
+/* A normal to the world by (R S)^-T = R S^-1, up to the positive factor
+ * |det S| (cof(S) = det(S) S^-1). */
+static inline lf_vec3 instance_normal(const instance_xf *xf, lf_vec3 n)
+{
+    return rotate(xf->R, lf_scale(lf_mul(n, xf->cof), xf->cof.x * xf->scale.x < 0 ? -1.f : 1.f));
+}
+
+/* The shading context of a hit on triangle t of a mesh whose vertices (and
+ * shading normals, or NULL) are p and nsv at the ray's time; b1, b2:
+ * Embree's barycentrics; flip: reverse orientation XOR the world
+ * transform's handedness swap.  Without xf, p and nsv are in world space.
+ * With xf, p is in an instance's prototype space, and so is nsv when the
+ * instance scales uniformly (else the caller has taken each vertex normal
+ * to the world and normalised it, as the keyframed path does); the frame
+ * goes to the world by M = R S: dp/du by M, shading normals by the inverse
+ * transpose R S^-1, and the geometric normal, a cross product of edges, by
+ * cross(M a, M b) = det(M) M^-T cross(a, b) = R (cof(S) cross(a, b)), which
+ * keeps pbrt's orientation.  sc->p is then the caller's to set. */
+static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 *nsv, float b1, float b2, int flip,
+                     const instance_xf *xf, lf_hit *hit)
+{
+    lf_shading_ctx *sc = &hit->sc;
+    int i0 = m->idx[3 * t], i1 = m->idx[3 * t + 1], i2 = m->idx[3 * t + 2];
+    lf_vec3 p0 = p[0], p1 = p[1], p2 = p[2];
+    float b0 = 1.f - b1 - b2;
+    sc->p = lf_add(lf_add(lf_scale(p0, b0), lf_scale(p1, b1)), lf_scale(p2, b2));
+    /* pbrt-v4 Triangle: n = normalize(cross(p0 - p2, p1 - p2)). */
+    lf_vec3 n = lf_cross(lf_sub(p0, p2), lf_sub(p1, p2));
+    if (xf)
+        n = rotate(xf->R, lf_mul(n, xf->cof));
+    n = lf_normalize(n);
+    lf_vec2 uv0 = {0, 0}, uv1 = {1, 0}, uv2 = {1, 1};
+    if (m->uv) {
+        uv0 = (lf_vec2){m->uv[2 * i0], m->uv[2 * i0 + 1]};
+        uv1 = (lf_vec2){m->uv[2 * i1], m->uv[2 * i1 + 1]};
+        uv2 = (lf_vec2){m->uv[2 * i2], m->uv[2 * i2 + 1]};
+    }
+    sc->uv = (lf_vec2){b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
+    /* dp/du from the uv parameterisation (pbrt's triangle derivatives). */
+    float du02 = uv0.x - uv2.x, du12 = uv1.x - uv2.x, dv02 = uv0.y - uv2.y, dv12 = uv1.y - uv2.y;
+    float det = du02 * dv12 - dv02 * du12;
+    lf_vec3 dp02 = lf_sub(p0, p2), dp12 = lf_sub(p1, p2);
+    lf_vec3 dpdu;
+    if (fabsf(det) < 1e-9f) {
+        lf_vec3 tt;
+        lf_basis(n, &dpdu, &tt);
+    } else {
+        float inv = 1.f / det;
+        dpdu = lf_scale(lf_sub(lf_scale(dp02, dv12), lf_scale(dp12, dv02)), inv);
+        if (!(lf_dot(dpdu, dpdu) > 0) || !isfinite(dpdu.x)) {
+            lf_vec3 tt;
+            lf_basis(n, &dpdu, &tt);
+        } else if (xf) {
+            dpdu = rotate(xf->R, lf_mul(dpdu, xf->scale));
+        }
+    }
+    sc->dpdu = lf_normalize(dpdu);
+    if (nsv) {
+        lf_vec3 ns = lf_add(lf_add(lf_scale(nsv[0], b0), lf_scale(nsv[1], b1)), lf_scale(nsv[2], b2));
+        if (xf && xf->uniform_scale) /* the vertex normals' lengths all scale alike: blend, then transform */
+            ns = instance_normal(xf, ns);
+        ns = lf_normalize(ns);
+        if (!(lf_dot(ns, ns) > 0))
+            ns = n;
+        /* pbrt: the geometric normal follows the shading normal's side. */
+        if (lf_dot(n, ns) < 0)
+            n = lf_neg(n);
+        sc->ns = ns;
+    } else {
+        if (flip)
+            n = lf_neg(n);
+        sc->ns = n;
+    }
+    sc->ng = n;
+    hit->material = m->material;
+    hit->light = m->light_first >= 0 ? m->light_first + t : -1;
+}
+
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit)
 {
     struct RTCRayHit rh;
@@ -979,7 +1489,7 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
         return 0;
     hit->t = rh.ray.tfar;
     lf_shading_ctx *sc = &hit->sc;
-    int gi = s->geom_index[rh.hit.geomID];
+    int gi = rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? s->geom_index[rh.hit.geomID] : 0;
     if (gi < 0) {
         int si = gi == INT32_MIN ? (int)rh.hit.primID : -1 - gi;
         const lf_sphere *sp = &s->spheres[si];
@@ -1011,55 +1521,46 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
     }
     hit->sphere = -1;
     hit->tau = tau;
-    const lf_mesh *m = &s->meshes[gi];
     int t = (int)rh.hit.primID;
-    int i0 = m->idx[3 * t], i1 = m->idx[3 * t + 1], i2 = m->idx[3 * t + 2];
-    lf_vec3 p0 = lf_mesh_vertex_at(m, i0, tau), p1 = lf_mesh_vertex_at(m, i1, tau), p2 = lf_mesh_vertex_at(m, i2, tau);
-    float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.f - b1 - b2;
-    sc->p = lf_add(lf_add(lf_scale(p0, b0), lf_scale(p1, b1)), lf_scale(p2, b2));
-    /* pbrt-v4 Triangle: n = normalize(cross(p0 - p2, p1 - p2)). */
-    lf_vec3 n = lf_normalize(lf_cross(lf_sub(p0, p2), lf_sub(p1, p2)));
-    lf_vec2 uv0 = {0, 0}, uv1 = {1, 0}, uv2 = {1, 1};
-    if (m->uv) {
-        uv0 = (lf_vec2){m->uv[2 * i0], m->uv[2 * i0 + 1]};
-        uv1 = (lf_vec2){m->uv[2 * i1], m->uv[2 * i1 + 1]};
-        uv2 = (lf_vec2){m->uv[2 * i2], m->uv[2 * i2 + 1]};
-    }
-    sc->uv = (lf_vec2){b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
-    /* dp/du from the uv parameterisation (pbrt's triangle derivatives). */
-    float du02 = uv0.x - uv2.x, du12 = uv1.x - uv2.x, dv02 = uv0.y - uv2.y, dv12 = uv1.y - uv2.y;
-    float det = du02 * dv12 - dv02 * du12;
-    lf_vec3 dp02 = lf_sub(p0, p2), dp12 = lf_sub(p1, p2);
-    lf_vec3 dpdu;
-    if (fabsf(det) < 1e-9f) {
-        lf_vec3 tt;
-        lf_basis(n, &dpdu, &tt);
-    } else {
-        float inv = 1.f / det;
-        dpdu = lf_scale(lf_sub(lf_scale(dp02, dv12), lf_scale(dp12, dv02)), inv);
-        if (!(lf_dot(dpdu, dpdu) > 0) || !isfinite(dpdu.x)) {
-            lf_vec3 tt;
-            lf_basis(n, &dpdu, &tt);
+    if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+        /* A rigidly moving instance: the hit is in its prototype's space.
+         * The world point is where Embree found it on the ray; normals,
+         * tangent and uv are computed in the prototype's space and go to the
+         * world by pbrt's decomposed motion at the ray's time
+         * (instance_motion_at: ~100 instructions where rtcGetGeometryTransform
+         * takes ~470; Embree's slerp, with its fast acos, agrees with it to
+         * ~2e-6 per matrix element). */
+        const lf_instance *in = &s->instances[s->geom_index[rh.hit.instID[0]]];
+        const lf_mesh *m = &s->meshes[s->protos[in->proto].mesh_first + (int)rh.hit.geomID];
+        instance_xf xf;
+        instance_motion_at(in, tau, &xf);
+        lf_vec3 p[3], nv[3];
+        for (int k = 0; k < 3; k++) {
+            const float *q = m->P + 3 * (size_t)m->idx[3 * t + k];
+            p[k] = lf_v3(q[0], q[1], q[2]);
+            if (m->N) {
+                q = m->N + 3 * (size_t)m->idx[3 * t + k];
+                nv[k] = lf_v3(q[0], q[1], q[2]);
+            }
         }
+        if (m->N && !xf.uniform_scale) /* as the keyframed path: each vertex normal to the world, normalised */
+            for (int k = 0; k < 3; k++)
+                nv[k] = lf_normalize(instance_normal(&xf, nv[k]));
+        int swap = xf.cof.x * xf.scale.x < 0; /* det S < 0 */
+        mesh_hit(m, t, p, m->N ? nv : NULL, rh.hit.u, rh.hit.v, m->flip_normal ^ swap, &xf, hit);
+        sc->p = lf_madd(o, d, rh.ray.tfar);
+        return 1;
     }
-    sc->dpdu = lf_normalize(dpdu);
+    const lf_mesh *m = &s->meshes[gi];
+    int i0 = m->idx[3 * t], i1 = m->idx[3 * t + 1], i2 = m->idx[3 * t + 2];
+    lf_vec3 p[3] = {lf_mesh_vertex_at(m, i0, tau), lf_mesh_vertex_at(m, i1, tau), lf_mesh_vertex_at(m, i2, tau)};
+    lf_vec3 nw[3];
     if (m->N) {
-        lf_vec3 n0 = lf_mesh_normal_at(m, i0, tau), n1 = lf_mesh_normal_at(m, i1, tau), n2 = lf_mesh_normal_at(m, i2, tau);
-        lf_vec3 ns = lf_normalize(lf_add(lf_add(lf_scale(n0, b0), lf_scale(n1, b1)), lf_scale(n2, b2)));
-        if (!(lf_dot(ns, ns) > 0))
-            ns = n;
-        /* pbrt: the geometric normal follows the shading normal's side. */
-        if (lf_dot(n, ns) < 0)
-            n = lf_neg(n);
-        sc->ns = ns;
-    } else {
-        if (m->flip_normal)
-            n = lf_neg(n);
-        sc->ns = n;
+        nw[0] = lf_mesh_normal_at(m, i0, tau);
+        nw[1] = lf_mesh_normal_at(m, i1, tau);
+        nw[2] = lf_mesh_normal_at(m, i2, tau);
     }
-    sc->ng = n;
-    hit->material = m->material;
-    hit->light = m->light_first >= 0 ? m->light_first + t : -1;
+    mesh_hit(m, t, p, m->N ? nw : NULL, rh.hit.u, rh.hit.v, m->flip_normal, NULL, hit);
     return 1;
 }
 

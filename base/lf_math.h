@@ -124,8 +124,21 @@ int lf_transform_decompose(const lf_transform *m, lf_decomposed *out);
 /* Interpolates at f in [0,1]: lerp translation, slerp rotation (shortest
  * arc), lerp stretch. */
 lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f);
-/* The same, forward matrix only (no inverse): for per-sample camera motion. */
+/* The same, forward matrix only (no inverse). */
 void lf_decomposed_matrix(const lf_decomposed *a, const lf_decomposed *b, double f, double m[4][4]);
+
+/* A keyframe pair prepared for many evaluations (per-sample camera motion):
+ * the slerp's angle and the shortest-arc sign are found once, so each
+ * evaluation costs one sine/cosine pair and a 3x3 product. */
+typedef struct lf_motion_pair {
+    double qa[4], qb[4];   /* qb on qa's hemisphere */
+    double theta, cos_theta, sin_theta;
+    int lerp;              /* nearly parallel: normalised lerp, as lf_decomposed_matrix */
+    double sa[3][3], sb[3][3], ta[3], tb[3];
+} lf_motion_pair;
+void lf_motion_pair_prepare(const lf_decomposed *a, const lf_decomposed *b, lf_motion_pair *p);
+/* Equals lf_decomposed_matrix(a, b, f, m) up to rounding (1e-15). */
+void lf_motion_pair_matrix(const lf_motion_pair *p, double f, double m[4][4]);
 
 #ifdef __cplusplus
 }

@@ -378,6 +378,53 @@ void lf_decomposed_matrix(const lf_decomposed *a, const lf_decomposed *b, double
     m[3][3] = 1;
 }
 
+void lf_motion_pair_prepare(const lf_decomposed *a, const lf_decomposed *b, lf_motion_pair *p)
+{
+    double dot = 0;
+    for (int i = 0; i < 4; i++)
+        dot += a->q[i] * b->q[i];
+    double sign = dot < 0 ? -1.0 : 1.0; /* shortest arc */
+    for (int i = 0; i < 4; i++)
+        p->qa[i] = a->q[i], p->qb[i] = sign * b->q[i];
+    dot *= sign;
+    p->lerp = dot > 0.9995;
+    p->theta = acos(dot < 1 ? dot : 1);
+    p->cos_theta = cos(p->theta);
+    p->sin_theta = sin(p->theta);
+    memcpy(p->sa, a->s, sizeof p->sa);
+    memcpy(p->sb, b->s, sizeof p->sb);
+    memcpy(p->ta, a->t, sizeof p->ta);
+    memcpy(p->tb, b->t, sizeof p->tb);
+}
+
+void lf_motion_pair_matrix(const lf_motion_pair *p, double f, double m[4][4])
+{
+    double wa = 1 - f, wb = f;
+    if (!p->lerp) {
+        /* sin((1-f) th) = sin th cos(f th) - cos th sin(f th) */
+        double sf = sin(f * p->theta), cf = cos(f * p->theta);
+        wa = (p->sin_theta * cf - p->cos_theta * sf) / p->sin_theta;
+        wb = sf / p->sin_theta;
+    }
+    double q[4];
+    for (int i = 0; i < 4; i++)
+        q[i] = wa * p->qa[i] + wb * p->qb[i];
+    double il = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; i++)
+        q[i] *= il;
+    double R[3][3], S[3][3];
+    matrix_from_quat(q, R);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            S[i][j] = (1 - f) * p->sa[i][j] + f * p->sb[i][j];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            m[i][j] = R[i][0] * S[0][j] + R[i][1] * S[1][j] + R[i][2] * S[2][j];
+        m[i][3] = (1 - f) * p->ta[i] + f * p->tb[i];
+    }
+    m[3][0] = m[3][1] = m[3][2] = 0, m[3][3] = 1;
+}
+
 lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f)
 {
     double m[4][4];

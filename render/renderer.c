@@ -54,6 +54,7 @@ struct lf_renderer {
     int time_needed;          /* something moves: draw a time sample per camera ray */
     int camera_moving;
     lf_decomposed camera_keys[2];
+    lf_motion_pair camera_motion; /* camera_keys prepared for per-sample evaluation */
     double time0, time1;      /* TransformTimes */
     int rolling;              /* rolling shutter */
     double readout;           /* seconds from the first to the last row (column) starting */
@@ -462,6 +463,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                 return lf_error_set(err, LF_ERR_NUMERIC, "%s: the camera's %s motion keyframe is degenerate (singular)",
                                     where, k ? "end" : "start");
         }
+        lf_motion_pair_prepare(&r->camera_keys[0], &r->camera_keys[1], &r->camera_motion);
         r->camera_moving = 1;
     }
     char ctx[128];
@@ -770,7 +772,7 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
     const lf_transform *c2w = &r->camera_to_world;
     if (r->camera_moving) {
         /* forward matrix only: the ray needs no inverse */
-        lf_decomposed_matrix(&r->camera_keys[0], &r->camera_keys[1], p->tau, moving.m);
+        lf_motion_pair_matrix(&r->camera_motion, p->tau, moving.m);
         c2w = &moving;
     }
     lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});

@@ -696,8 +696,58 @@ static void test_object_instance_streaks(void)
     lf_image_free(&img);
 }
 
+/* The per-sample camera interpolation (lf_motion_pair, prepared once) gives
+ * lf_decomposed_matrix's matrices; and for a turn about one axis, pbrt's
+ * slerp is the rotation by the same fraction of the angle. */
+static void test_motion_pair(void)
+{
+    const double angles[] = {0.01, 3, 30, 120, 179.9, 250};
+    double worst = 0, worst_rot = 0;
+    for (int a = 0; a < 6; a++) {
+        for (int variant = 0; variant < 3; variant++) {
+            lf_transform x0 = lf_transform_translate(1, -2, 3), x1;
+            lf_transform r = lf_transform_rotate(angles[a], 0.3, 1, -0.2);
+            lf_transform t = lf_transform_translate(-4, 0.5, 2);
+            x1 = lf_transform_compose(&t, &r);
+            if (variant == 1) { /* non-uniform scale at both keys */
+                lf_transform sc = lf_transform_scale(2, 0.5, 1.5);
+                x0 = lf_transform_compose(&x0, &sc);
+                x1 = lf_transform_compose(&x1, &sc);
+            } else if (variant == 2) { /* mirrored */
+                lf_transform sc = lf_transform_scale(-1, 1, 1);
+                x0 = lf_transform_compose(&x0, &sc);
+                x1 = lf_transform_compose(&x1, &sc);
+            }
+            lf_decomposed da, db;
+            CHECK(lf_transform_decompose(&x0, &da) == 0 && lf_transform_decompose(&x1, &db) == 0);
+            lf_motion_pair mp;
+            lf_motion_pair_prepare(&da, &db, &mp);
+            const double fs[] = {0, 1e-9, 0.1, 0.37, 0.5, 0.999, 1};
+            for (int k = 0; k < 7; k++) {
+                double m1[4][4], m2[4][4];
+                lf_decomposed_matrix(&da, &db, fs[k], m1);
+                lf_motion_pair_matrix(&mp, fs[k], m2);
+                for (int i = 0; i < 4; i++)
+                    for (int j = 0; j < 4; j++)
+                        worst = fmax(worst, fabs(m1[i][j] - m2[i][j]));
+                if (variant == 0 && angles[a] < 180 && !mp.lerp) {
+                    /* the rotation part is Rotate(f angle) about the same axis
+                     * (below ~3.6 degrees pbrt switches to a normalised lerp) */
+                    lf_transform rf = lf_transform_rotate(fs[k] * angles[a], 0.3, 1, -0.2);
+                    for (int i = 0; i < 3; i++)
+                        for (int j = 0; j < 3; j++)
+                            worst_rot = fmax(worst_rot, fabs(m2[i][j] - rf.m[i][j]));
+                }
+            }
+        }
+    }
+    CHECK_MSG(worst < 1e-13, "prepared interpolation differs from lf_decomposed_matrix by %g", worst);
+    CHECK_MSG(worst_rot < 1e-12, "slerp differs from the rotation by the same fraction by %g", worst_rot);
+}
+
 int main(void)
 {
+    test_motion_pair();
     test_streaks();
     test_camera_motion();
     test_rolling_shutter();

@@ -3,7 +3,9 @@
  * following pbrt-v4's PathIntegrator so that scenes converge to the same
  * images.  Per bounce the sampler uses four dimension pairs, in this order:
  *   (light choice, BSDF lobe choice), light position, BSDF direction,
- *   (roulette, unused).
+ *   (roulette, unused);
+ * when every light is sampled at every vertex ("lightsampler" "all", and
+ * "bvh" with few lights), the light position takes one pair per light.
  * A pair nobody needs (one light and a one-lobe BSDF; no roulette yet) is
  * skipped without computing it: samples are the most expensive part of a
  * path after ray casting. */
@@ -19,23 +21,33 @@ static float power_heuristic(float a, float b)
     return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
 }
 
-static double light_pmf(const lf_scene *s, int light)
+lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s)
 {
-    return lf_distrib1d_pmf(&s->light_distrib, light);
+    if (in->light_sampler == LF_LIGHTS_AUTO)
+        return s->n_lights <= LF_LIGHTS_ALL_MAX ? LF_LIGHTS_ALL : LF_LIGHTS_POWER;
+    return in->light_sampler;
+}
+
+/* Probability that NEE samples this light at a vertex (1 when all are). */
+static double light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
+{
+    switch (ls) {
+    case LF_LIGHTS_ALL:
+        return 1.0;
+    case LF_LIGHTS_UNIFORM:
+        return 1.0 / s->n_lights;
+    default:
+        return lf_distrib1d_pmf(&s->light_distrib, light);
+    }
 }
 
 /* Direct lighting at a non-specular surface: one light sample, MIS-weighted.
  * ul chooses the light; the light position pair comes from st. */
-static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo, float ul,
-                             lf_sample_stream *st, long long *rays)
+/* Light li's direct contribution at a non-specular surface, sampled with
+ * (u0, u1) and chosen with probability pmf; MIS-weighted. */
+static lf_vec3 light_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo, int li, double pmf,
+                            float u0, float u1, long long *rays)
 {
-    float u0, u1;
-    lf_sample_2d(st, &u0, &u1);
-    double pmf, ur;
-    int li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
-    (void)ur;
-    if (!(pmf > 0))
-        return lf_v3(0, 0, 0);
     const lf_light *l = &s->lights[li];
     lf_light_sample ls;
     if (!lf_light_sample_li(s, l, h->sc.p, h->tau, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
@@ -56,11 +68,43 @@ static lf_vec3 sample_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *
     return lf_scale(lf_mul(f, ls.Li), cosi * w / p_l);
 }
 
+/* Direct lighting at a non-specular surface: every light once (ALL), or
+ * one light chosen with ul. */
+static lf_vec3 sample_direct(const lf_scene *s, lf_light_sampler lsm, const lf_hit *h, const lf_bsdf *bsdf,
+                             lf_vec3 wo, float ul, lf_sample_stream *st, long long *rays)
+{
+    float u0, u1;
+    if (lsm == LF_LIGHTS_ALL) {
+        lf_vec3 L = lf_v3(0, 0, 0);
+        for (int li = 0; li < s->n_lights; li++) {
+            lf_sample_2d(st, &u0, &u1);
+            L = lf_add(L, light_direct(s, h, bsdf, wo, li, 1.0, u0, u1, rays));
+        }
+        return L;
+    }
+    lf_sample_2d(st, &u0, &u1);
+    double pmf;
+    int li;
+    if (lsm == LF_LIGHTS_UNIFORM) {
+        li = (int)(ul * s->n_lights);
+        li = li < s->n_lights ? li : s->n_lights - 1;
+        pmf = 1.0 / s->n_lights;
+    } else {
+        double ur;
+        li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
+        (void)ur;
+    }
+    if (!(pmf > 0))
+        return lf_v3(0, 0, 0);
+    return light_direct(s, h, bsdf, wo, li, pmf, u0, u1, rays);
+}
+
 lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
                    long long *rays)
 {
     lf_vec3 L = lf_v3(0, 0, 0), beta = lf_v3(1, 1, 1);
     int depth = 0, specular_bounce = 0;
+    const lf_light_sampler lsm = lf_light_sampler_for(in, s);
     float p_b = 1.f, eta_scale = 1.f;
     lf_vec3 prev_p = o;
     int passes = 0;
@@ -76,7 +120,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                 if (depth == 0 || specular_bounce) {
                     L = lf_add(L, lf_mul(beta, Le));
                 } else {
-                    float p_l = (float)light_pmf(s, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
+                    float p_l = (float)light_pmf(s, lsm, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
                     L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
                 }
             }
@@ -90,7 +134,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                 if (depth == 0 || specular_bounce) {
                     L = lf_add(L, lf_mul(beta, Le));
                 } else {
-                    float p_l = (float)light_pmf(s, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
+                    float p_l = (float)light_pmf(s, lsm, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
                     L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
                 }
             }
@@ -110,7 +154,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         lf_bsdf bsdf;
         lf_material_bsdf(mat, &h.sc, &bsdf);
         int specular = lf_bsdf_is_specular(&bsdf);
-        int need_light_choice = !specular && s->n_lights > 1;
+        int need_light_choice = !specular && s->n_lights > 1 && lsm != LF_LIGHTS_ALL;
         int need_lobe_choice = bsdf.kind != LF_LOBE_DIFFUSE;
         float ul = 0.5f, uc = 0.5f;
         if (need_light_choice || need_lobe_choice)
@@ -118,7 +162,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         else
             lf_sample_skip(st);
         if (!specular && s->n_lights > 0)
-            L = lf_add(L, lf_mul(beta, sample_direct(s, &h, &bsdf, wo, ul, st, rays)));
+            L = lf_add(L, lf_mul(beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
         else
             lf_sample_skip(st);
         float u0, u1;

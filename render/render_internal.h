@@ -238,10 +238,23 @@ void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit);
 lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w);
 
 /* ---- integrator (render/integrator.c) ---- */
+/* How next-event estimation picks lights ("string lightsampler"). */
+typedef enum lf_light_sampler {
+    LF_LIGHTS_AUTO,    /* "bvh" (pbrt-v4's default name): ALL up to LF_LIGHTS_ALL_MAX lights, else POWER */
+    LF_LIGHTS_POWER,   /* one light per vertex, chosen by power */
+    LF_LIGHTS_UNIFORM, /* one light per vertex, chosen uniformly */
+    LF_LIGHTS_ALL      /* every light at every vertex (lensfield extension "all") */
+} lf_light_sampler;
+enum { LF_LIGHTS_ALL_MAX = 8 };
+
 typedef struct lf_integrator {
     int max_depth;
     int regularize;
+    lf_light_sampler light_sampler;
 } lf_integrator;
+
+/* The strategy in effect for a scene (AUTO resolved by its light count). */
+lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s);
 
 /* Radiance along a world-space camera ray. rays counts traced rays. */
 lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,

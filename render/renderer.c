@@ -326,8 +326,21 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                        where, type);
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
+    /* pbrt-v4's names; "bvh" (its default) is our automatic choice: every
+     * light at every vertex for a few lights, otherwise one by power. */
     const char *ls = lf_params_string(ps, "lightsampler", "bvh");
-    (void)ls;
+    if (!strcmp(ls, "bvh"))
+        r->integrator.light_sampler = LF_LIGHTS_AUTO;
+    else if (!strcmp(ls, "power"))
+        r->integrator.light_sampler = LF_LIGHTS_POWER;
+    else if (!strcmp(ls, "uniform"))
+        r->integrator.light_sampler = LF_LIGHTS_UNIFORM;
+    else if (!strcmp(ls, "all"))
+        r->integrator.light_sampler = LF_LIGHTS_ALL;
+    else
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: \"lightsampler\" must be \"bvh\", \"power\", \"uniform\" or \"all\", got \"%s\"", where,
+                            ls);
     lf_params_find(ps, "strategy");
     lf_params_find(ps, "bidirectional");
     lf_params_find(ps, "visualizestrategies");
@@ -698,10 +711,14 @@ char *lf_renderer_explain(const lf_renderer *r)
     int counts[7] = {0};
     for (int i = 0; i < s->n_lights; i++)
         counts[s->lights[i].kind]++;
+    lf_light_sampler lsm = lf_light_sampler_for(&r->integrator, s);
     appendf(&b, &len, &cap,
             "lights: %d (point %d, spot %d, distant %d, infinite %d, image infinite %d, area triangles %d, area "
-            "spheres %d), chosen by power\n",
-            s->n_lights, counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6]);
+            "spheres %d), %s\n",
+            s->n_lights, counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6],
+            lsm == LF_LIGHTS_ALL       ? "every light sampled at every vertex (one shadow ray each)"
+            : lsm == LF_LIGHTS_UNIFORM ? "one light per vertex, chosen uniformly"
+                                       : "one light per vertex, chosen by power");
     appendf(&b, &len, &cap, "threads: %d\n", r->threads);
     return b;
 }

@@ -1,25 +1,51 @@
-# Blender Cycles version of scenes/bench/plane-spheres.pbrt, for
-# bench/peers/cycles_vs_lensfield.sh: 640x426, a 20x20 plane, 4 diffuse
-# spheres (radius 0.6), a sun and a uniform sky, 8 bounces, 64 spp, box
-# filter, CPU, 2 threads, fixed seed, no denoising, no adaptive sampling.
-# pbrt's (x, y, z) (y up) maps to Blender's (x, z, y) (z up): a mirror image,
-# the same work.
-#   blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- [SPP] [THREADS] [CASE]
+# Blender Cycles version of scenes/bench/plane-spheres[-CASE].pbrt, for
+# bench/peers/cycles_vs_lensfield.sh and bench/peers/equal_quality.sh: by
+# default 640x426, a 20x20 plane, 4 diffuse spheres (radius 0.6), a sun and a
+# uniform sky, 8 bounces, 64 spp, box filter 1 px, CPU, 2 threads, fixed seed,
+# no denoising, no adaptive sampling, no clamping.  pbrt's (x, y, z) (y up)
+# maps to Blender's (x, z, y) (z up); with pbrt's left-handed and Blender's
+# right-handed frames the image comes out the same way round.
+#   blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- \
+#       [SPP] [THREADS] [CASE] [--res W H] [--seed N] [--out FILE.exr]
+#       [--fisheye-model equisolid|polynomial]
 # CASE: pinhole (default), thinlens (lens radius 0.08, focus 6), motion (one
 # sphere moves 0.5 units during the shutter), rolling (panning camera, rolling
-# shutter over half the frame), fisheye (equisolid, 10 mm, 155.9 degrees) -
-# the variants of scenes/bench/plane-spheres-CASE.pbrt.
+# shutter over half the frame), fisheye (equisolid, fitted to the traced 10 mm
+# fisheye prescription, or with --fisheye-model polynomial Cycles' polynomial
+# fisheye fitted to its whole mapping: see the fisheye block below) - the variants of
+# scenes/bench/plane-spheres-CASE.pbrt.  There is no "realistic" case: Cycles
+# has no traced lens.
+# --out writes the render as a linear float RGB OpenEXR (scene-referred, no
+# view transform); the time printed is that of bpy.ops.render.render alone
+# (scene sync, BVH build and the samples), not of writing the file.
 import math
 import sys
 import time
 
 import bpy
-from mathutils import Vector
+from mathutils import Matrix, Vector
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-spp = int(argv[0]) if len(argv) > 0 else 64
-threads = int(argv[1]) if len(argv) > 1 else 2
-case = argv[2] if len(argv) > 2 else "pinhole"
+opts = {"--res": None, "--seed": "1", "--out": None, "--fisheye-model": "equisolid"}
+pos = []
+i = 0
+while i < len(argv):
+    a = argv[i]
+    if a == "--res":
+        opts[a] = (int(argv[i + 1]), int(argv[i + 2]))
+        i += 3
+    elif a in opts:
+        opts[a] = argv[i + 1]
+        i += 2
+    else:
+        pos.append(a)
+        i += 1
+spp = int(pos[0]) if len(pos) > 0 else 64
+threads = int(pos[1]) if len(pos) > 1 else 2
+case = pos[2] if len(pos) > 2 else "pinhole"
+width, height = opts["--res"] or (640, 426)
+if case not in ("pinhole", "thinlens", "motion", "rolling", "fisheye"):
+    sys.exit(f"cycles_plane_spheres.py: no Cycles equivalent of case '{case}'")
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
@@ -29,7 +55,8 @@ cy.device = "CPU"
 cy.samples = spp
 cy.use_adaptive_sampling = False
 cy.use_denoising = False
-cy.seed = 1
+cy.seed = int(opts["--seed"])
+cy.use_animated_seed = False
 cy.max_bounces = 8
 cy.diffuse_bounces = 8
 cy.glossy_bounces = 8
@@ -41,8 +68,8 @@ cy.pixel_filter_type = "BOX"
 cy.filter_width = 1.0
 scene.render.threads_mode = "FIXED"
 scene.render.threads = threads
-scene.render.resolution_x = 640
-scene.render.resolution_y = 426
+scene.render.resolution_x = width
+scene.render.resolution_y = height
 scene.render.resolution_percentage = 100
 scene.render.use_persistent_data = False
 
@@ -108,32 +135,88 @@ if case == "thinlens":
     cam.dof.focus_distance = 6.0
     cam.dof.aperture_fstop = lens_mm / (2 * 80.0)  # aperture radius 0.08 m = 80 mm
 if case in ("motion", "rolling"):
+    # Frame 1 -> 2 is pbrt's time 0 -> 1 (its default transform times), and
+    # the shutter spans it.
     scene.render.use_motion_blur = True
     cy.motion_blur_position = "START"
-    scene.render.motion_blur_shutter = 1.0 if case == "motion" else 0.5
+    scene.render.motion_blur_shutter = 1.0
 if case == "rolling":
+    # pbrt scene: shutter 0..0.5, readout 0.5 - row y of H is exposed over
+    # [0.5 y/H, 0.5 y/H + 0.5].  Cycles maps the shutter's normalised time u
+    # of row y (top first) to (u - 0.5) d + (y/H - 0.5)(1 - d) + 0.5, with
+    # d = rolling_shutter_duration; over a 1-frame shutter, d = 0.5 gives the
+    # same interval.  The pan: pbrt's "Rotate -3 0 1 0" at EndTime, applied
+    # after the LookAt, turns the camera about its own up axis (tilted 5.7 deg
+    # with the view) so the scene drifts left in the image: here -3 deg about
+    # the camera's local Y, keyed as quaternions.
     cy.rolling_shutter_type = "TOP"
     cy.rolling_shutter_duration = 0.5
-    cam_obj.keyframe_insert("rotation_euler", frame=1)
-    cam_obj.rotation_euler.z += math.radians(3)
-    cam_obj.keyframe_insert("rotation_euler", frame=2)
+    r0 = cam_obj.rotation_euler.to_matrix()
+    cam_obj.rotation_mode = "QUATERNION"
+    cam_obj.rotation_quaternion = r0.to_quaternion()
+    cam_obj.keyframe_insert("rotation_quaternion", frame=1)
+    cam_obj.rotation_quaternion = (r0 @ Matrix.Rotation(math.radians(-3), 3, "Y")).to_quaternion()
+    cam_obj.keyframe_insert("rotation_quaternion", frame=2)
+    for fc in cam_obj.animation_data.action.fcurves:
+        for kp in fc.keyframe_points:
+            kp.interpolation = "LINEAR"
 if case == "fisheye":
+    # Fitted to what lensfield's fisheye scene frames (scenes/bench/
+    # plane-spheres-fisheye.pbrt: 10 mm prescription, 2 mm stop, focus 6 m,
+    # film diagonal 28 mm).  `lflens info scenes/lenses/fisheye.10mm.dat
+    # --aperture 2 --focus 6 --diagonal D` gives the traced field and the
+    # image circle: 26.878 mm across, and 66.39 deg off axis at the film's
+    # half width (11.654 mm).  The prescription maps nearly equidistantly
+    # (r = 10.03 mm x theta, within 0.3%), which no equisolid lens
+    # (r = 2 f sin(theta/2)) matches everywhere; this one is chosen to give the
+    # same horizontal field (f from the half width) and the same image circle
+    # (the field cut-off from the circle's radius).  The vertical field comes
+    # out 85.5 deg against 88.6, and mid-field angles differ by up to 1.6 deg.
+    # With --fisheye-model polynomial, Cycles' polynomial fisheye takes the
+    # whole mapping instead: theta = k1 r + k2 r^2 + k3 r^3 + k4 r^4 (r in mm,
+    # Cycles negates the coefficients), fitted by least squares to the traced
+    # field angles at r = 0.5 .. 13.43 mm, within 0.05 deg
+    # (`python3 bench/peers/fisheye_framing.py --fit` prints them), cut off
+    # at the image circle's 76.89 deg.
+    film_w = 28.0 * width / math.hypot(width, height)
+    circle_r = 26.878 / 2
+    half_w_angle = math.radians(66.39)
+    lens_mm = (film_w / 2) / (2 * math.sin(half_w_angle / 2))
+    fov = 4 * math.asin(circle_r / (2 * lens_mm))
+    k = (0.0994777, 3.180818e-4, -6.381209e-5, 3.117570e-6)
     cam.type = "PANO"
-    try:
-        cam.panorama_type = "FISHEYE_EQUISOLID"
-        cam.fisheye_lens = 10.0
-        cam.fisheye_fov = math.radians(155.9)
-    except AttributeError:  # Blender < 3.x keeps these under cam.cycles
-        cam.cycles.panorama_type = "FISHEYE_EQUISOLID"
-        cam.cycles.fisheye_lens = 10.0
-        cam.cycles.fisheye_fov = math.radians(155.9)
-    cam.sensor_fit = "AUTO"
-    cam.sensor_width = 24.0
+    cam.sensor_fit = "HORIZONTAL"
+    cam.sensor_width = film_w
+    cam.sensor_height = film_w * height / width
+    pano = cam if hasattr(cam, "panorama_type") else cam.cycles  # cam.cycles in Blender 3.x
+    if opts["--fisheye-model"] == "polynomial":
+        pano.panorama_type = "FISHEYE_LENS_POLYNOMIAL"
+        pano.fisheye_polynomial_k0 = 0.0
+        pano.fisheye_polynomial_k1, pano.fisheye_polynomial_k2, pano.fisheye_polynomial_k3, \
+            pano.fisheye_polynomial_k4 = (-c for c in k)
+        pano.fisheye_fov = math.radians(2 * 76.89)
+        print(f"cycles: fisheye polynomial, field {2 * 76.89:.2f} deg, sensor {film_w:.3f} mm wide")
+    else:
+        pano.panorama_type = "FISHEYE_EQUISOLID"
+        pano.fisheye_lens = lens_mm
+        pano.fisheye_fov = fov
+        print(f"cycles: fisheye equisolid {lens_mm:.3f} mm, field {math.degrees(fov):.2f} deg, "
+              f"sensor {film_w:.3f} mm wide")
 
-scene.render.filepath = "/tmp/cycles_plane_spheres.exr"
-scene.render.image_settings.file_format = "OPEN_EXR"
+view = scene.view_settings
+view.view_transform = "Standard"
+view.look = "None"
+view.exposure = 0.0
+view.gamma = 1.0
 t0 = time.time()
-bpy.ops.render.render(write_still=True)
+bpy.ops.render.render(write_still=False)
 dt = time.time() - t0
-paths = 640 * 426 * spp
+if opts["--out"]:
+    img = scene.render.image_settings
+    img.file_format = "OPEN_EXR"
+    img.color_mode = "RGB"
+    img.color_depth = "32"
+    img.exr_codec = "ZIP"
+    bpy.data.images["Render Result"].save_render(opts["--out"], scene=scene)
+paths = width * height * spp
 print(f"cycles: {paths} camera paths in {dt:.3f} s: {paths / dt / 1e6:.3f} M paths/s")

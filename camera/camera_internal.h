@@ -11,14 +11,16 @@
 #endif
 
 /* Batch kernels (generate_rays) are compiled twice on x86-64 with GCC: for
- * Haswell-class CPUs (AVX2 + FMA: four doubles per instruction) and for the
- * baseline; the loader picks one at start-up (GNU ifunc).  Kernels copy the
+ * CPUs with AVX2 (four doubles per instruction; FMA is not needed, as ISO C
+ * does not contract) and for the baseline; the loader picks one at start-up
+ * (GNU ifunc, by CPU feature: "arch=haswell" would dispatch by CPU model
+ * and leave AMD processors on the baseline).  Kernels copy the
  * samples of a chunk into padded structure-of-arrays buffers and loop over
  * the whole fixed-size chunk, so the compiler vectorises the loops even at
  * -O2's cheap cost model. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
     !defined(__SANITIZE_ADDRESS__)
-#define LF_CAM_SIMD_CLONES __attribute__((target_clones("arch=haswell", "default")))
+#define LF_CAM_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define LF_CAM_SIMD_CLONES
 #endif

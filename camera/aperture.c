@@ -84,11 +84,25 @@ int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, char *err, size
         a->area = M_PI;
         break;
     case LF_APERTURE_POLYGON:
-        a->area = polygon_area(a->blades);
+    case LF_APERTURE_STAR: {
+        int n = a->blades, star = a->kind == LF_APERTURE_STAR, m = star ? 2 * n : n;
+        a->area = star ? star_area(n) : polygon_area(n);
+        a->corners = malloc(sizeof *a->corners * (size_t)(m + 1));
+        if (!a->corners) {
+            snprintf(err, err_size, "out of memory");
+            return -1;
+        }
+        /* polygons: corners on the unit circle; stars alternate outer and
+         * inner vertices */
+        double ri = star_inner_radius(n);
+        for (int k = 0; k <= m; k++) {
+            double t = M_PI / 2.0 + a->rotation_rad + (star ? M_PI : 2.0 * M_PI) * (k % m) / n;
+            double r = star && (k & 1) ? ri : 1.0;
+            a->corners[k][0] = r * cos(t);
+            a->corners[k][1] = r * sin(t);
+        }
         break;
-    case LF_APERTURE_STAR:
-        a->area = star_area(a->blades);
-        break;
+    }
     case LF_APERTURE_IMAGE: {
         char msg[512] = "";
         int w = 0, h = 0;
@@ -178,23 +192,18 @@ double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, d
         *y = py;
         return 1.0;
     case LF_APERTURE_POLYGON: {
-        int n = a->blades;
         double ur;
-        int k = pick(u, n, &ur);
-        /* the rotation goes into the corner angles: no rotation step */
-        double t0 = M_PI / 2.0 + a->rotation_rad + 2.0 * M_PI * k / n, t1 = t0 + 2.0 * M_PI / n;
-        fan_triangle(ur, v, cos(t0), sin(t0), cos(t1), sin(t1), x, y);
+        int k = pick(u, a->blades, &ur);
+        /* the rotation is in the corners: no rotation step */
+        fan_triangle(ur, v, a->corners[k][0], a->corners[k][1], a->corners[k + 1][0], a->corners[k + 1][1], x, y);
         *x *= a->anamorphic;
         return 1.0;
     }
     case LF_APERTURE_STAR: {
-        int n = a->blades;
-        double ur, ri = star_inner_radius(n);
-        int k = pick(u, 2 * n, &ur);
+        double ur;
+        int k = pick(u, 2 * a->blades, &ur);
         /* triangles alternate outer -> inner and inner -> next outer vertex */
-        double t0 = M_PI / 2.0 + a->rotation_rad + M_PI * k / n, t1 = t0 + M_PI / n;
-        double r0 = (k & 1) ? ri : 1.0, r1 = (k & 1) ? 1.0 : ri;
-        fan_triangle(ur, v, r0 * cos(t0), r0 * sin(t0), r1 * cos(t1), r1 * sin(t1), x, y);
+        fan_triangle(ur, v, a->corners[k][0], a->corners[k][1], a->corners[k + 1][0], a->corners[k + 1][1], x, y);
         *x *= a->anamorphic;
         return 1.0;
     }
@@ -293,6 +302,8 @@ void lf_aperture_free(lf_aperture *a)
         lf_distrib2d_free(&a->distrib);
         free(a->img);
     }
+    free(a->corners);
+    a->corners = NULL;
     a->img = NULL;
 }
 

@@ -42,6 +42,9 @@ typedef struct lf_aperture {
     float *img;
     lf_distrib2d distrib;
     double area; /* open area in radius^2 units, including anamorphic and transmission */
+    /* polygons and stars: the outline's vertices (x, y), closed (the first
+     * repeated at the end), so sampling needs no trigonometry */
+    double (*corners)[2];
 } lf_aperture;
 
 /* Reads the parameters above; 0 or -1 with a message (e.g. an all-black image). */

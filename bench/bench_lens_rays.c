@@ -5,10 +5,15 @@
  * exit-pupil bounds and with plain rear-disk sampling (camera/lens.c), the
  * useful-ray fraction of each, the exit-pupil precomputation time, and the
  * whole "realistic" camera through the registry against a pinhole
- * ("perspective") and, if registered, "thinlens".  Medians of 5 repeats.
+ * ("perspective") and, if registered, "thinlens".  Each both one ray per call
+ * (lf_lens_sample_ray, generate_ray) and in batches of 64
+ * (lf_lens_sample_rays, generate_rays).  Medians of 5 repeats.
  *
- * usage: bench_lens_rays [rays-per-repeat (default 400000)]
+ * usage: bench_lens_rays [rays-per-repeat (default 400000)] [lens-name-filter]
+ *   (the filter, a substring such as "dgauss.50", keeps only matching lenses
+ *   and skips the pinhole and thinlens rows: for callgrind runs)
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,8 +99,13 @@ static int g_image(void *c, const char *p, int *w, int *h, float **px, char *e, 
     return -1;
 }
 
-/* ns per generate_ray for a registered camera; also its setup time. */
-static double camera_ns(const char *type, const char *lensfile, long n, double *setup_s, double *through)
+enum { BATCH = 64 };
+
+/* ns per generate_ray for a registered camera, and per ray through
+ * generate_rays in batches of BATCH (*batch_ns; -1 without a batch entry);
+ * also its setup time. */
+static double camera_ns(const char *type, const char *lensfile, long n, double *setup_s, double *through,
+                        double *batch_ns)
 {
     store s = {lensfile};
     lf_camera_params p = {&s, g_float, g_int, g_int, g_string, g_floats, g_image};
@@ -131,8 +141,35 @@ static double camera_ns(const char *type, const char *lensfile, long n, double *
             printf("?");
     }
     *through = (double)ok / n;
+    double scalar_ns = median(ns, REPEATS);
+    *batch_ns = -1;
+    if (t->generate_rays) {
+        lf_camera_sample cs[BATCH];
+        lf_camera_ray rays[BATCH];
+        double w[BATCH];
+        for (int r = 0; r < REPEATS; r++) {
+            double sink = 0;
+            t0 = now();
+            for (long i0 = 0; i0 < n; i0 += BATCH) {
+                int m = n - i0 < BATCH ? (int)(n - i0) : BATCH;
+                for (int j = 0; j < m; j++) {
+                    long i = i0 + j;
+                    cs[j] = (lf_camera_sample){halton(i, 2) * 1440, halton(i, 3) * 960, halton(i, 5), halton(i, 7),
+                                               0, 0.5};
+                    rays[j].time = 0, rays[j].wavelength_nm = 0;
+                }
+                t->generate_rays(st, m, cs, rays, w);
+                for (int j = 0; j < m; j++)
+                    sink += w[j];
+            }
+            ns[r] = (now() - t0) / n * 1e9;
+            if (sink < 0)
+                printf("?");
+        }
+        *batch_ns = median(ns, REPEATS);
+    }
     t->destroy(st);
-    return median(ns, REPEATS);
+    return scalar_ns;
 }
 
 int main(int argc, char **argv)
@@ -140,6 +177,7 @@ int main(int argc, char **argv)
     long n = argc > 1 ? atol(argv[1]) : 400000;
     if (n <= 0)
         n = 400000;
+    const char *filter = argc > 2 ? argv[2] : NULL;
     samples = malloc(sizeof(double) * 4 * (size_t)n);
     if (!samples)
         return 1;
@@ -150,16 +188,19 @@ int main(int argc, char **argv)
     static const char *const lenses[] = {"dgauss.50mm.dat", "dgauss.100mm.dat", "wide.22mm.dat",
                                          "telephoto.250mm.dat", "fisheye.10mm.dat"};
     const double film_w = 36, film_h = 24, film_r = 0.5 * 43.2666;
-    double setup, thr;
-    double pin = camera_ns("perspective", NULL, n, &setup, &thr);
-    double thin = lf_camera_find("thinlens") ? camera_ns("thinlens", NULL, n, &setup, &thr) : -1;
+    double setup, thr, pin_b = -1, thin_b = -1;
+    double pin = filter ? -1 : camera_ns("perspective", NULL, n, &setup, &thr, &pin_b);
+    double thin = !filter && lf_camera_find("thinlens") ? camera_ns("thinlens", NULL, n, &setup, &thr, &thin_b) : -1;
     printf("bench_lens_rays: %ld rays per repeat, median of %d; full-frame film, wide open, focus 3 m\n", n, REPEATS);
-    printf("pinhole (perspective) camera: %.1f ns/ray\n", pin);
+    if (pin > 0)
+        printf("pinhole (perspective) camera: %.1f ns/ray, %.1f ns/ray in batches of %d\n", pin, pin_b, BATCH);
     if (thin > 0)
-        printf("thinlens camera:              %.1f ns/ray\n", thin);
-    printf("\n%-20s %9s %9s %9s %9s %9s %10s %10s %8s\n", "lens", "pupil s", "ns bound", "useful", "ns disk",
-           "useful", "camera ns", "x pinhole", "setup s");
+        printf("thinlens camera:              %.1f ns/ray, %.1f ns/ray in batches of %d\n", thin, thin_b, BATCH);
+    printf("\n%-20s %8s %9s %9s %8s %9s %8s %10s %10s %9s %8s\n", "lens", "pupil s", "ns bound", "batch", "useful",
+           "ns disk", "useful", "camera ns", "cam batch", "x pinhole", "setup s");
     for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
+        if (filter && !strstr(lenses[k], filter))
+            continue;
         char path[1024], err[1024];
         snprintf(path, sizeof path, LF_SOURCE_DIR "/scenes/lenses/%s", lenses[k]);
         lf_lens L;
@@ -200,14 +241,42 @@ int main(int argc, char **argv)
             ns[mode] = median(t, REPEATS);
             useful[mode] = traced ? (double)passed / traced : 0;
         }
-        double cam = camera_ns("realistic", path, n, &setup, &thr);
-        printf("%-20s %9.3f %9.1f %8.1f%% %9.1f %8.1f%% %10.1f %10.1f %8.3f\n", lenses[k], median(build, REPEATS),
-               ns[0], 100 * useful[0], ns[1], 100 * useful[1], cam, cam / pin, setup);
+        /* The same film samples with the bounds through lf_lens_sample_rays,
+         * BATCH at a time (film points without light included: the batch
+         * call skips them itself). */
+        double tb[REPEATS];
+        for (int r = 0; r < REPEATS; r++) {
+            double fx[BATCH], fy[BATCH], u[BATCH], v[BATCH], w[BATCH], sink = 0;
+            lf_lens_ray out[BATCH];
+            double t0 = now();
+            for (long i0 = 0; i0 < n; i0 += BATCH) {
+                int m = n - i0 < BATCH ? (int)(n - i0) : BATCH;
+                for (int j = 0; j < m; j++) {
+                    long i = i0 + j;
+                    fx[j] = (halton(i, 2) - 0.5) * film_w, fy[j] = (halton(i, 3) - 0.5) * film_h;
+                    u[j] = halton(i, 5), v[j] = halton(i, 7);
+                }
+                lf_lens_sample_rays(&L, &P, 1, m, fx, fy, u, v, NULL, NULL, NULL, out, w);
+                for (int j = 0; j < m; j++)
+                    sink += w[j];
+            }
+            tb[r] = (now() - t0) / n * 1e9;
+            if (sink < 0)
+                printf("?");
+        }
+        double cam_b;
+        double cam = camera_ns("realistic", path, n, &setup, &thr, &cam_b);
+        printf("%-20s %8.3f %9.1f %9.1f %7.1f%% %9.1f %7.1f%% %10.1f %10.1f %9.1f %8.3f\n", lenses[k],
+               median(build, REPEATS), ns[0], median(tb, REPEATS), 100 * useful[0], ns[1], 100 * useful[1], cam, cam_b,
+               pin > 0 ? cam / pin : NAN, setup);
         lf_lens_free(&L);
     }
     printf("\npupil s: exit-pupil bound precomputation (64 bins x 16 strips); ns bound / ns disk: lens.c sampling\n"
-           "+ tracing per film sample with the bounds / over the whole rear disk; useful: rays that get through\n"
-           "among those traced; camera ns: the registered \"realistic\" camera's generate_ray (raster -> camera\n"
-           "space); setup s: its create() (parse, focus, bounds, useful-fraction estimate)\n");
+           "+ tracing per film sample with the bounds / over the whole rear disk (lf_lens_sample_ray); batch: ns\n"
+           "bound through lf_lens_sample_rays, %d rays per call; useful: rays that get through among those\n"
+           "traced; camera ns: the registered \"realistic\" camera's generate_ray (raster -> camera space);\n"
+           "cam batch: its generate_rays, %d rays per call; x pinhole: camera ns / the pinhole's; setup s: its\n"
+           "create() (parse, focus, bounds, useful-fraction estimate)\n",
+           BATCH, BATCH);
     return 0;
 }

@@ -8,7 +8,9 @@
 #include "lens.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -502,7 +504,118 @@ int lf_lens_focus_search(const lf_lens *L, double D, double *film_distance_mm, c
     return 0;
 }
 
-/* ---------------------------------------------------------- exact tracing */
+/* ---------------------------------------------------------- exact tracing
+ *
+ * A unit ray o + t d meets the sphere of centre c and radius R where
+ * t = -b -+ sqrt(R^2 - q), with b = (o - c).d and q = |(o - c) x d|^2 the
+ * squared distance of the centre from the ray's line; at the hit point the
+ * angle of incidence has sin^2 = q / R^2 and cos = sqrt(R^2 - q) / |R|.
+ * So Snell's law's cos(theta_t) = sqrt(1 - eta^2 q / R^2) needs only q, and
+ * the two square roots of a surface run side by side instead of one after
+ * the other (a trace is one serial chain through the surfaces: latency is
+ * its cost).  The root and the normal's orientation are fixed per surface
+ * and direction (the ray's d.z has a known sign, checked after every
+ * surface): from the film the nearer root is taken where R < 0 (pbrt:
+ * (d.z > 0) xor (R < 0)) and the normal (p - c) / R is flipped to face the
+ * ray; from the scene the nearer root where R > 0, the normal as it is. */
+
+typedef struct surf_k {
+    int stop;              /* radius 0 */
+    double zv;             /* vertex z (lens space) */
+    double zc, R, R2, inv_R2, abs_inv_r; /* sphere: centre z, radius, R^2, 1/R^2, 1/|R| */
+    double k, sgn;         /* normal facing the ray = (p - c) k; t = -b + sgn sqrt(R^2 - q) */
+    double ap, ap2;        /* clear radius, squared */
+    double eta, eta2;      /* n_i / n_t at n_d, squared */
+    double na, nb;         /* n_d after / before the surface */
+    double ca_a, cb_a, ca_b, cb_b; /* their Cauchy A, B (B = 0: not dispersive) */
+} surf_k;
+
+/* Surface i's constants for a ray going toward the scene (from_film) or
+ * the film: those the intersection needs, then those only refraction needs
+ * (the scalar trace computes the second part only for rays that hit). */
+static inline void surf_hit_constants(const lf_lens *L, int i, int from_film, surf_k *c)
+{
+    const lf_lens_surface *s = &L->s[i];
+    c->stop = s->radius_mm == 0.0;
+    c->zv = s->z_mm - L->film_distance_mm;
+    c->ap = s->aperture_radius_mm;
+    c->ap2 = c->ap * c->ap;
+    double R = s->radius_mm; /* (unused for the stop) */
+    c->R = R;
+    c->zc = c->zv + R;
+    c->R2 = R * R;
+    c->sgn = from_film ? copysign(1.0, R) : -copysign(1.0, R);
+}
+
+static inline void surf_refract_constants(const lf_lens *L, int i, int from_film, surf_k *c)
+{
+    const lf_lens_surface *s = &L->s[i];
+    double inv_r = 1.0 / c->R;
+    c->inv_R2 = inv_r * inv_r;
+    c->abs_inv_r = fabs(inv_r);
+    c->k = from_film ? -inv_r : inv_r;
+    c->na = s->ior, c->nb = i > 0 ? L->s[i - 1].ior : 1.0;
+    c->eta = from_film ? c->na / c->nb : c->nb / c->na;
+    c->eta2 = c->eta * c->eta;
+    c->ca_a = s->cauchy_a, c->cb_a = s->cauchy_b;
+    c->ca_b = i > 0 ? L->s[i - 1].cauchy_a : 1.0, c->cb_b = i > 0 ? L->s[i - 1].cauchy_b : 0.0;
+}
+
+static inline void surf_constants(const lf_lens *L, int i, int from_film, surf_k *c)
+{
+    memset(c, 0, sizeof *c);
+    surf_hit_constants(L, i, from_film, c);
+    if (!c->stop)
+        surf_refract_constants(L, i, from_film, c);
+}
+
+/* The sphere step, shared by the scalar and the batch paths (the same
+ * operations in the same order, so both give the same bits), in two parts.
+ * sphere_hit: o moves to the hit point; valid if disc >= 0, t >= 0,
+ * side <= 0 (not the sphere's far side) and r2 <= ap^2.  q and sq are kept
+ * for sphere_refract. */
+static inline __attribute__((always_inline)) void sphere_hit(const surf_k *s, double *ox, double *oy, double *oz,
+                                                            double dx, double dy, double dz, double *q_out,
+                                                            double *sq_out, double *disc_out, double *t_out,
+                                                            double *side_out, double *r2_out)
+{
+    const double x = *ox, y = *oy, zo = *oz - s->zc;
+    double cx = y * dz - zo * dy, cy = zo * dx - x * dz, cz = x * dy - y * dx;
+    double q = cx * cx + cy * cy + cz * cz;
+    double b = x * dx + y * dy + zo * dz;
+    double disc = s->R2 - q;
+    double sq = sqrt(disc);
+    double t = -b + s->sgn * sq;
+    double px = x + t * dx, py = y + t * dy, pz = *oz + t * dz;
+    *ox = px, *oy = py, *oz = pz;
+    *q_out = q, *sq_out = sq, *disc_out = disc, *t_out = t, *side_out = (pz - s->zc) * s->R;
+    *r2_out = px * px + py * py;
+}
+
+/* sphere_refract: d becomes the refracted direction at the hit point p;
+ * valid if sin2_t < 1 (no total internal reflection). */
+static inline __attribute__((always_inline)) void sphere_refract(const surf_k *s, double eta, double eta2, double q,
+                                                                double sq, double px, double py, double pz,
+                                                                double *dx, double *dy, double *dz,
+                                                                double *sin2_t_out)
+{
+    double sin2_t = eta2 * (q * s->inv_R2);
+    double cos_t = sqrt(1.0 - sin2_t);
+    double g = eta * (sq * s->abs_inv_r) - cos_t; /* eta cos(theta_i) - cos(theta_t) */
+    double k = s->k;
+    *dx = eta * *dx + g * (px * k);
+    *dy = eta * *dy + g * (py * k);
+    *dz = eta * *dz + g * ((pz - s->zc) * k);
+    *sin2_t_out = sin2_t;
+}
+
+/* eta at wavelength 1 / sqrt(inv_l2) um (ior_at() of both media). */
+static inline double surf_eta(const surf_k *s, double inv_l2, int from_film)
+{
+    double na = inv_l2 > 0.0 && s->cb_a != 0.0 ? s->ca_a + s->cb_a * inv_l2 : s->na;
+    double nb = inv_l2 > 0.0 && s->cb_b != 0.0 ? s->ca_b + s->cb_b * inv_l2 : s->nb;
+    return from_film ? na / nb : nb / na;
+}
 
 static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray *out, lf_lens_trace_opts *opts,
                             int from_film)
@@ -516,82 +629,56 @@ static lf_lens_status trace(const lf_lens *L, const lf_lens_ray *in, lf_lens_ray
     }
     if (!(dl > 0.0) || !isfinite(dl))
         return LF_LENS_BACKWARDS;
-    d[0] /= dl, d[1] /= dl, d[2] /= dl;
+    double inv_dl = 1.0 / dl;
+    d[0] *= inv_dl, d[1] *= inv_dl, d[2] *= inv_dl;
     const double dir = from_film ? -1.0 : 1.0; /* sign of d.z the system needs */
     if (!(d[2] * dir > 0.0))
         return LF_LENS_BACKWARDS;
     int n = L->n;
     for (int k = 0; k < n; k++) {
         int i = from_film ? n - 1 - k : k;
-        const lf_lens_surface *s = &L->s[i];
-        double zv = s->z_mm - L->film_distance_mm;
-        double p[3];
-        if (s->radius_mm == 0.0) {
-            double t = (zv - o[2]) / d[2];
+        surf_k c;
+        surf_hit_constants(L, i, from_film, &c);
+        if (c.stop) {
+            double t = (c.zv - o[2]) / d[2];
             if (!(t >= 0.0))
                 return LF_LENS_MISSED;
-            p[0] = o[0] + t * d[0], p[1] = o[1] + t * d[1], p[2] = zv;
-            double r2 = p[0] * p[0] + p[1] * p[1], ap = s->aperture_radius_mm;
-            if (r2 > ap * ap)
+            o[0] = o[0] + t * d[0], o[1] = o[1] + t * d[1], o[2] = c.zv;
+            double r2 = o[0] * o[0] + o[1] * o[1];
+            if (r2 > c.ap2)
                 return LF_LENS_STOPPED;
             if (opts && opts->stop_shape) {
-                double tr = opts->stop_shape(opts->stop_ctx, p[0] / ap, p[1] / ap);
+                double tr = opts->stop_shape(opts->stop_ctx, o[0] / c.ap, o[1] / c.ap);
                 if (!(tr > 0.0))
                     return LF_LENS_STOPPED;
                 opts->transmission = tr;
             }
         } else {
-            double R = s->radius_mm, zc = zv + R;
-            double oc[3] = {o[0], o[1], o[2] - zc};
-            double b = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
-            double c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - R * R;
-            double disc = b * b - c;
-            if (!(disc >= 0.0))
+            double q, sq, disc, t, side, r2, sin2_t;
+            sphere_hit(&c, &o[0], &o[1], &o[2], d[0], d[1], d[2], &q, &sq, &disc, &t, &side, &r2);
+            if (!(disc >= 0.0) || !(t >= 0.0) || side > 0.0)
                 return LF_LENS_MISSED;
-            double sq = sqrt(disc);
-            /* The vertex cap: the nearer root when the ray meets the sphere's
-             * convex side first (pbrt: (d.z > 0) xor (R < 0)). */
-            int closer = (d[2] > 0.0) ^ (R < 0.0);
-            double t = closer ? -b - sq : -b + sq;
-            if (!(t >= 0.0))
-                return LF_LENS_MISSED;
-            p[0] = o[0] + t * d[0], p[1] = o[1] + t * d[1], p[2] = o[2] + t * d[2];
-            if ((p[2] - zc) * R > 0.0) /* on the far side of the sphere */
-                return LF_LENS_MISSED;
-            double ap = s->aperture_radius_mm;
-            if (p[0] * p[0] + p[1] * p[1] > ap * ap)
+            if (r2 > c.ap2)
                 return LF_LENS_CLIPPED;
-            /* Snell's law: n_i sin(theta_i) = n_t sin(theta_t). */
-            double inv_r = 1.0 / R; /* p lies on the sphere: (p - c) / R is the unit normal */
-            double nrm[3] = {p[0] * inv_r, p[1] * inv_r, (p[2] - zc) * inv_r};
-            double cos_i = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
-            if (cos_i < 0.0) {
-                nrm[0] = -nrm[0], nrm[1] = -nrm[1], nrm[2] = -nrm[2];
-                cos_i = -cos_i;
-            }
-            /* Incident medium: after surface i going toward the scene,
-             * before it going toward the film. */
-            double n_before_i = i > 0 ? ior_at(&L->s[i - 1], inv_l2) : 1.0, n_after_i = ior_at(s, inv_l2);
-            double eta_i = from_film ? n_after_i : n_before_i, eta_t = from_film ? n_before_i : n_after_i;
-            double eta = eta_i / eta_t;
-            double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+            surf_refract_constants(L, i, from_film, &c);
+            double eta = c.eta, eta2 = c.eta2;
+            if (inv_l2 > 0.0)
+                eta = surf_eta(&c, inv_l2, from_film), eta2 = eta * eta;
+            sphere_refract(&c, eta, eta2, q, sq, o[0], o[1], o[2], &d[0], &d[1], &d[2], &sin2_t);
             if (sin2_t >= 1.0)
                 return LF_LENS_TIR;
-            double cos_t = sqrt(1.0 - sin2_t);
-            for (int j = 0; j < 3; j++) /* unit length by construction; renormalised at the end */
-                d[j] = eta * d[j] + (eta * cos_i - cos_t) * nrm[j];
+            /* d is unit length by construction; renormalised at the end */
             if (!(d[2] * dir > 0.0))
                 return LF_LENS_BACKWARDS;
         }
-        o[0] = p[0], o[1] = p[1], o[2] = p[2];
         if (opts && opts->path) {
-            memcpy(opts->path[opts->path_count], p, sizeof p);
+            memcpy(opts->path[opts->path_count], o, sizeof o);
             opts->path_count++;
         }
     }
     if (out) {
-        dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        d[0] /= dl, d[1] /= dl, d[2] /= dl;
+        inv_dl = 1.0 / sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        d[0] *= inv_dl, d[1] *= inv_dl, d[2] *= inv_dl;
         memcpy(out->o, o, sizeof o);
         memcpy(out->d, d, sizeof d);
     }
@@ -835,6 +922,7 @@ int lf_lens_pupil_build(const lf_lens *L, double film_radius_mm, int lambda_spre
     memset(P, 0, sizeof *P);
     P->film_radius_mm = film_radius_mm;
     P->n_bins = LF_LENS_PUPIL_BINS;
+    P->bins_per_mm = P->n_bins / film_radius_mm;
     P->rear_disk_radius_mm = lf_lens_rear_disk_radius(L, film_radius_mm);
     if (lambda_spread && L->dispersive) {
         P->lambda_nm[0] = 360.0, P->lambda_nm[1] = 0.0, P->lambda_nm[2] = 830.0;
@@ -931,59 +1019,83 @@ int lf_lens_pupil_build(const lf_lens *L, double film_radius_mm, int lambda_spre
             bin->cdf[j] /= area;
         bin->y_max = ymax;
         bin->area = 2.0 * area;
+        bin->pdf = 1.0 / bin->area;
         lit_bins++;
     }
     P->traces = c.traces;
     return lit_bins;
 }
 
+/* lf_lens_pupil_sample in stages, shared with lf_lens_sample_rays (which
+ * runs each stage over a chunk of rays: the first and last vectorise, the
+ * middle one reads the bins).
+ * Stage 1: the film point's bin (by its distance r from the axis; the
+ * clamp comes before the conversion, so no value of r overflows it) and the
+ * rotation (cs, sn) of (r, 0) onto the film point; v picks the half of the
+ * bound (sign: +1 for y >= 0) and is rescaled to [0, 1) within it. */
+static inline int pupil_stage1(const lf_lens_pupil *P, double fx, double fy, double v, double *cs, double *sn,
+                               double *v_half, double *sign)
+{
+    double r = sqrt(fx * fx + fy * fy), fb = r * P->bins_per_mm, top = P->n_bins - 1;
+    fb = fb >= top ? top : fb > 0.0 ? fb : 0.0;
+    double inv_r = 1.0 / r;
+    *cs = r > 0.0 ? fx * inv_r : 1.0;
+    *sn = r > 0.0 ? fy * inv_r : 0.0;
+    v *= 2.0;
+    double lower = v >= 1.0;
+    *v_half = v - lower;
+    *sign = 1.0 - 2.0 * lower;
+    return (int)fb;
+}
+
+/* Stage 2: the strip, the last j < LF_LENS_PUPIL_STRIPS with cdf[j] <= v
+ * (cdf is non-decreasing from cdf[0] = 0), by branch-free bisection. */
+static inline int pupil_stage2(const lf_lens_pupil_bin *bin, double v)
+{
+    _Static_assert(LF_LENS_PUPIL_STRIPS == 16, "the bisection below has 4 steps");
+    int j = v >= bin->cdf[8] ? 8 : 0;
+    j += v >= bin->cdf[j + 4] ? 4 : 0;
+    j += v >= bin->cdf[j + 2] ? 2 : 0;
+    j += v >= bin->cdf[j + 1] ? 1 : 0;
+    return j;
+}
+
+/* Stage 3: the point of strip j (its cdf values c0, c1 and x extent) at
+ * height v in it and u across, rotated to the film point's angle. */
+static inline void pupil_stage3(double c0, double c1, double xlo, double xhi, double y_max, double j, double u,
+                                double v, double sign, double cs, double sn, double *rx, double *ry)
+{
+    double span = c1 - c0, tq = (v - c0) / span;
+    double t = span > 0.0 ? tq : 0.5;
+    t = t < 0.0 ? 0.0 : t;
+    t = t > 1.0 ? 1.0 : t;
+    double h = y_max * (1.0 / LF_LENS_PUPIL_STRIPS);
+    double x = xlo + u * (xhi - xlo);
+    double y = sign * (j + t) * h;
+    *rx = cs * x - sn * y;
+    *ry = sn * x + cs * y;
+}
+
 double lf_lens_pupil_sample(const lf_lens_pupil *P, double film_x, double film_y, double u, double v, double *rx,
                             double *ry)
 {
-    double r = sqrt(film_x * film_x + film_y * film_y);
-    int b = (int)(r / P->film_radius_mm * P->n_bins);
-    if (b >= P->n_bins)
-        b = P->n_bins - 1;
-    if (b < 0)
-        b = 0;
-    const lf_lens_pupil_bin *bin = &P->bin[b];
+    double cs, sn, vh, sign;
+    const lf_lens_pupil_bin *bin = &P->bin[pupil_stage1(P, film_x, film_y, v, &cs, &sn, &vh, &sign)];
     if (!(bin->area > 0.0))
         return 0.0;
-    /* v picks the half, then the strip by area, then the height in it. */
-    double sign = 1.0;
-    v *= 2.0;
-    if (v >= 1.0)
-        v -= 1.0, sign = -1.0;
-    int j = 0;
-    while (j < LF_LENS_PUPIL_STRIPS - 1 && v >= bin->cdf[j + 1])
-        j++;
-    double span = bin->cdf[j + 1] - bin->cdf[j];
-    double t = span > 0.0 ? (v - bin->cdf[j]) / span : 0.5;
-    if (t < 0.0)
-        t = 0.0;
-    if (t > 1.0)
-        t = 1.0;
-    double h = bin->y_max / LF_LENS_PUPIL_STRIPS;
-    double x = bin->xlo[j] + u * (bin->xhi[j] - bin->xlo[j]);
-    double y = sign * (j + t) * h;
-    /* Rotate the bound of the film point (r, 0) to the film point's angle. */
-    double cs = r > 0.0 ? film_x / r : 1.0, sn = r > 0.0 ? film_y / r : 0.0;
-    *rx = cs * x - sn * y;
-    *ry = sn * x + cs * y;
-    return 1.0 / bin->area;
+    int j = pupil_stage2(bin, vh);
+    pupil_stage3(bin->cdf[j], bin->cdf[j + 1], bin->xlo[j], bin->xhi[j], bin->y_max, j, u, vh, sign, cs, sn, rx, ry);
+    return bin->pdf;
 }
 
 int lf_lens_pupil_contains(const lf_lens_pupil *P, double film_x, double film_y, double rx, double ry)
 {
-    double r = sqrt(film_x * film_x + film_y * film_y);
-    int b = (int)(r / P->film_radius_mm * P->n_bins);
-    b = b >= P->n_bins ? P->n_bins - 1 : b < 0 ? 0 : b;
-    const lf_lens_pupil_bin *bin = &P->bin[b];
+    double cs, sn, vh, sign;
+    const lf_lens_pupil_bin *bin = &P->bin[pupil_stage1(P, film_x, film_y, 0.0, &cs, &sn, &vh, &sign)];
     if (!(bin->area > 0.0))
         return 0;
-    double cs = r > 0.0 ? film_x / r : 1.0, sn = r > 0.0 ? film_y / r : 0.0;
     double x = cs * rx + sn * ry, y = fabs(-sn * rx + cs * ry); /* rotate back to the film point (r, 0) */
-    if (y > bin->y_max)
+    if (!(y <= bin->y_max))
         return 0;
     int j = (int)(y / (bin->y_max / LF_LENS_PUPIL_STRIPS));
     if (j >= LF_LENS_PUPIL_STRIPS)
@@ -1010,24 +1122,29 @@ static void concentric_disk(double u, double v, double *x, double *y)
     *y = r * sin(th);
 }
 
+/* The rear-plane point a camera ray is aimed at and its pdf (per mm^2); 0:
+ * the film point gets no light.  Shared by the scalar and batch paths. */
+static inline double rear_point(const lf_lens_pupil *P, int use_bounds, double fx, double fy, double u, double v,
+                                double *rx, double *ry)
+{
+    if (use_bounds)
+        return lf_lens_pupil_sample(P, fx, fy, u, v, rx, ry);
+    double R = P->rear_disk_radius_mm;
+    concentric_disk(u, v, rx, ry);
+    *rx *= R, *ry *= R;
+    return 1.0 / (M_PI * R * R);
+}
+
 double lf_lens_sample_ray(const lf_lens *L, const lf_lens_pupil *P, int use_bounds, double fx, double fy, double u,
                           double v, lf_lens_trace_opts *opts, lf_lens_ray *out)
 {
-    double rx, ry, pdf;
-    if (use_bounds) {
-        pdf = lf_lens_pupil_sample(P, fx, fy, u, v, &rx, &ry);
-        if (!(pdf > 0.0))
-            return 0.0;
-    } else {
-        double R = P->rear_disk_radius_mm;
-        concentric_disk(u, v, &rx, &ry);
-        rx *= R, ry *= R;
-        pdf = 1.0 / (M_PI * R * R);
-    }
+    double rx, ry, pdf = rear_point(P, use_bounds, fx, fy, u, v, &rx, &ry);
+    if (!(pdf > 0.0))
+        return 0.0;
     double Z = L->film_distance_mm;
     lf_lens_ray in = {{fx, fy, 0.0}, {rx - fx, ry - fy, -Z}};
     double l = sqrt(in.d[0] * in.d[0] + in.d[1] * in.d[1] + Z * Z);
-    double cos_t = Z / l;
+    double cos_t = Z * (1.0 / l);
     lf_lens_trace_opts local = {0};
     if (!opts)
         opts = &local;
@@ -1036,6 +1153,317 @@ double lf_lens_sample_ray(const lf_lens *L, const lf_lens_pupil *P, int use_boun
     double c2 = cos_t * cos_t;
     double w = opts->transmission * c2 * c2 / (pdf * Z * Z);
     return isfinite(w) && w > 0.0 ? w : 0.0;
+}
+
+/* --------------------------------------------------------- batched camera rays
+ *
+ * lf_lens_sample_rays: the computation of lf_lens_sample_ray, operation for
+ * operation, for chunks of LANES rays in structure-of-arrays form, every
+ * ray of a chunk taken through surface k before surface k + 1.  One ray's
+ * trace is a serial chain (per sphere: a cross product, a square root, the
+ * hit point, the refracted direction, on to the next sphere), so the scalar
+ * path mostly waits on latencies; the rays of a chunk are independent, the
+ * lane loops are branch-free (everything computed, then the ray's alive flag
+ * cleared where a test fails; failed rays carry garbage to the end of the
+ * chunk) and GCC vectorises them: AVX2 (4 doubles) where the CPU has it,
+ * SSE2 (2) otherwise.  No FMA contraction (ISO C mode), so the results are
+ * bit-identical to the scalar path's.  A chunk stops early once no ray is
+ * alive. */
+enum { LANES = 32 };
+
+typedef struct batch_chunk {
+    double ox[LANES], oy[LANES], oz[LANES];
+    double dx[LANES], dy[LANES], dz[LANES];
+    double il2[LANES];   /* 1 / lambda_um^2, 0 for n_d */
+    double tr[LANES];    /* stop-shape transmission */
+    union {
+        double alive[LANES];      /* 1: still traced, 0: blocked (a double: SSE2 selects it in the lane loops) */
+        uint64_t alive_bits[LANES]; /* the same, for a vectorisable "any alive?" */
+    };
+} batch_chunk;
+
+static int batch_generic_only;
+
+void lf_lens_batch_force_generic(int on)
+{
+    batch_generic_only = on;
+}
+
+/* The AVX2 kernel: x86 with GCC or Clang (function-level target attributes;
+ * the CPU is asked at run time, so the binary still runs on any x86-64). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define LF_LENS_AVX2_KERNEL 1
+#endif
+
+int lf_lens_batch_uses_avx2(void)
+{
+#ifdef LF_LENS_AVX2_KERNEL
+    return !batch_generic_only && __builtin_cpu_supports("avx2");
+#else
+    return 0;
+#endif
+}
+
+/* A chunk through sphere s: eta (n_i / n_t) per lane, or eta[0] for all. */
+static inline __attribute__((always_inline)) void sphere_lanes(const surf_k *s, const double *eta,
+                                                              const double *eta2, const int per_lane, batch_chunk *c)
+{
+    const surf_k sk = *s; /* a local copy: the lane stores below cannot alias it */
+    const double e0 = eta[0], e20 = eta2[0];
+    for (int j = 0; j < LANES; j++) {
+        double ox = c->ox[j], oy = c->oy[j], oz = c->oz[j], dx = c->dx[j], dy = c->dy[j], dz = c->dz[j];
+        double q, sq, disc, t, side, r2, sin2_t;
+        sphere_hit(&sk, &ox, &oy, &oz, dx, dy, dz, &q, &sq, &disc, &t, &side, &r2);
+        sphere_refract(&sk, per_lane ? eta[j] : e0, per_lane ? eta2[j] : e20, q, sq, ox, oy, oz, &dx, &dy, &dz,
+                       &sin2_t);
+        int ok = (disc >= 0.0) & (t >= 0.0) & !(side > 0.0) & !(r2 > sk.ap2) & !(sin2_t >= 1.0) & (dz * -1.0 > 0.0);
+        c->alive[j] = ok ? c->alive[j] : 0.0;
+        c->ox[j] = ox, c->oy[j] = oy, c->oz[j] = oz;
+        c->dx[j] = dx, c->dy[j] = dy, c->dz[j] = dz;
+    }
+}
+
+/* One chunk through all surfaces (S in trace order, rear first). */
+static inline __attribute__((always_inline)) void batch_trace_body(const surf_k *S, int ns, int dispersive,
+                                                                  lf_lens_stop_shape shape, const void *ctx,
+                                                                  batch_chunk *c)
+{
+    for (int k = 0; k < ns; k++) {
+        const surf_k *s = &S[k];
+        if (s->stop) {
+            const double zv = s->zv, ap2 = s->ap2;
+            for (int j = 0; j < LANES; j++) {
+                double t = (zv - c->oz[j]) / c->dz[j];
+                double px = c->ox[j] + t * c->dx[j], py = c->oy[j] + t * c->dy[j];
+                double r2 = px * px + py * py;
+                int ok = (t >= 0.0) & !(r2 > ap2);
+                c->alive[j] = ok ? c->alive[j] : 0.0;
+                c->ox[j] = px, c->oy[j] = py, c->oz[j] = zv;
+            }
+            if (shape)
+                for (int j = 0; j < LANES; j++)
+                    if (c->alive[j] != 0.0) {
+                        double tr = shape(ctx, c->ox[j] / s->ap, c->oy[j] / s->ap);
+                        if (!(tr > 0.0))
+                            c->alive[j] = 0.0;
+                        c->tr[j] = tr;
+                    }
+        } else if (dispersive) {
+            /* surf_eta() without branches */
+            const double ca_a = s->ca_a, cb_a = s->cb_a, na_d = s->na, ca_b = s->ca_b, cb_b = s->cb_b, nb_d = s->nb;
+            const int da = cb_a != 0.0, db = cb_b != 0.0;
+            double eta[LANES], eta2[LANES];
+            for (int j = 0; j < LANES; j++) {
+                double l2 = c->il2[j];
+                int lit = l2 > 0.0;
+                double na_l = ca_a + cb_a * l2, nb_l = ca_b + cb_b * l2;
+                double na = lit & da ? na_l : na_d;
+                double nb = lit & db ? nb_l : nb_d;
+                double e = na / nb;
+                eta[j] = e, eta2[j] = e * e;
+            }
+            sphere_lanes(s, eta, eta2, 1, c);
+        } else {
+            sphere_lanes(s, &s->eta, &s->eta2, 0, c);
+        }
+        uint64_t any = 0;
+        for (int j = 0; j < LANES; j++)
+            any |= c->alive_bits[j];
+        if (!any)
+            break;
+    }
+}
+
+typedef struct batch_args {
+    const lf_lens *L;
+    const lf_lens_pupil *P;
+    const surf_k *S; /* L's surfaces in trace order */
+    int use_bounds, n;
+    const double *film_x, *film_y, *u, *v, *lambda_nm;
+    lf_lens_stop_shape stop_shape;
+    const void *stop_ctx;
+    lf_lens_ray *out;
+    double *weights;
+    const lf_lens_ray *in; /* lf_lens_trace_rays_from_film: these rays instead of samples */
+    unsigned char *passed;
+} batch_args;
+
+/* lf_lens_sample_rays' work, chunk by chunk.  always_inline: compiled once
+ * per target, in the two callers below (so the pupil sampling and the
+ * prologue and epilogue loops vectorise with AVX2 too). */
+static inline __attribute__((always_inline)) void batch_rays_body(const batch_args *a)
+{
+    const lf_lens *L = a->L;
+    const lf_lens_pupil *P = a->P;
+    const double Z = L->film_distance_mm;
+    for (int i0 = 0; i0 < a->n; i0 += LANES) {
+        int m = a->n - i0 < LANES ? a->n - i0 : LANES;
+        batch_chunk c;
+        double pdf[LANES], rx[LANES], ry[LANES], cos_t[LANES], ul[LANES], vl[LANES];
+        int dispersive = 0;
+        if (a->in) {
+            /* lf_lens_trace_rays_from_film: trace()'s prologue for the given rays */
+            for (int j = 0; j < LANES; j++) {
+                const lf_lens_ray *r = &a->in[i0 + (j < m ? j : 0)];
+                double dx = r->d[0], dy = r->d[1], dz = r->d[2];
+                c.ox[j] = r->o[0], c.oy[j] = r->o[1], c.oz[j] = r->o[2];
+                c.dx[j] = dx, c.dy[j] = dy, c.dz[j] = dz;
+            }
+            for (int j = 0; j < LANES; j++) {
+                double dx = c.dx[j], dy = c.dy[j], dz = c.dz[j];
+                double dl = sqrt(dx * dx + dy * dy + dz * dz), inv_dl = 1.0 / dl;
+                dx *= inv_dl, dy *= inv_dl, dz *= inv_dl;
+                int ok = (j < m) & (dl > 0.0) & (dl <= DBL_MAX) & (dz * -1.0 > 0.0);
+                c.alive[j] = ok ? 1.0 : 0.0;
+                c.dx[j] = dx, c.dy[j] = dy, c.dz[j] = dz;
+                c.il2[j] = 0.0, c.tr[j] = 1.0;
+            }
+            batch_trace_body(a->S, L->n, 0, NULL, NULL, &c);
+            for (int j = 0; j < LANES; j++) {
+                double dx = c.dx[j], dy = c.dy[j], dz = c.dz[j];
+                double inv_dl = 1.0 / sqrt(dx * dx + dy * dy + dz * dz);
+                c.dx[j] = dx * inv_dl, c.dy[j] = dy * inv_dl, c.dz[j] = dz * inv_dl;
+            }
+            for (int j = 0; j < m; j++) {
+                int i = i0 + j;
+                a->passed[i] = c.alive[j] != 0.0;
+                if (c.alive[j] != 0.0) {
+                    lf_lens_ray *o = &a->out[i];
+                    o->o[0] = c.ox[j], o->o[1] = c.oy[j], o->o[2] = c.oz[j];
+                    o->d[0] = c.dx[j], o->d[1] = c.dy[j], o->d[2] = c.dz[j];
+                }
+            }
+            continue;
+        }
+        for (int j = 0; j < m; j++) {
+            int i = i0 + j;
+            c.ox[j] = a->film_x[i], c.oy[j] = a->film_y[i], ul[j] = a->u[i], vl[j] = a->v[i];
+            c.il2[j] = a->lambda_nm ? inv_lambda2(L, a->lambda_nm[i]) : 0.0;
+            dispersive |= c.il2[j] > 0.0;
+        }
+        for (int j = m; j < LANES; j++) /* padding */
+            c.ox[j] = c.oy[j] = ul[j] = vl[j] = c.il2[j] = 0.0;
+        /* The rear-plane points: rear_point(), the pupil bound in stages. */
+        if (a->use_bounds) {
+            double cs[LANES], sn[LANES], vh[LANES], sign[LANES], c0[LANES], c1[LANES], xlo[LANES], xhi[LANES],
+                y_max[LANES], jd[LANES];
+            int b[LANES];
+            for (int j = 0; j < LANES; j++)
+                b[j] = pupil_stage1(P, c.ox[j], c.oy[j], vl[j], &cs[j], &sn[j], &vh[j], &sign[j]);
+            for (int j = 0; j < LANES; j++) {
+                const lf_lens_pupil_bin *bin = &P->bin[b[j]];
+                int k = pupil_stage2(bin, vh[j]);
+                c0[j] = bin->cdf[k], c1[j] = bin->cdf[k + 1], xlo[j] = bin->xlo[k], xhi[j] = bin->xhi[k];
+                y_max[j] = bin->y_max, jd[j] = k;
+                pdf[j] = bin->area > 0.0 && j < m ? bin->pdf : 0.0;
+            }
+            for (int j = 0; j < LANES; j++)
+                pupil_stage3(c0[j], c1[j], xlo[j], xhi[j], y_max[j], jd[j], ul[j], vh[j], sign[j], cs[j], sn[j],
+                             &rx[j], &ry[j]);
+        } else {
+            for (int j = 0; j < LANES; j++) {
+                rx[j] = ry[j] = 0.0;
+                pdf[j] = j < m ? rear_point(P, 0, c.ox[j], c.oy[j], ul[j], vl[j], &rx[j], &ry[j]) : 0.0;
+            }
+        }
+        /* lf_lens_sample_ray's and trace()'s prologue */
+        for (int j = 0; j < LANES; j++) {
+            double dx = rx[j] - c.ox[j], dy = ry[j] - c.oy[j], dz = -Z;
+            double dl = sqrt(dx * dx + dy * dy + dz * dz), inv_dl = 1.0 / dl;
+            cos_t[j] = Z * inv_dl;
+            dx *= inv_dl, dy *= inv_dl, dz *= inv_dl;
+            int ok = (pdf[j] > 0.0) & (dl > 0.0) & (dl <= DBL_MAX) & (dz * -1.0 > 0.0);
+            c.alive[j] = ok ? 1.0 : 0.0;
+            c.oz[j] = 0.0;
+            c.dx[j] = dx, c.dy[j] = dy, c.dz[j] = dz;
+            c.tr[j] = 1.0;
+        }
+        batch_trace_body(a->S, L->n, dispersive, a->stop_shape, a->stop_ctx, &c);
+        /* trace()'s and lf_lens_sample_ray's epilogue */
+        double w[LANES];
+        for (int j = 0; j < LANES; j++) {
+            double dx = c.dx[j], dy = c.dy[j], dz = c.dz[j];
+            double inv_dl = 1.0 / sqrt(dx * dx + dy * dy + dz * dz);
+            c.dx[j] = dx * inv_dl, c.dy[j] = dy * inv_dl, c.dz[j] = dz * inv_dl;
+            double c2 = cos_t[j] * cos_t[j];
+            double wj = c.tr[j] * c2 * c2 / (pdf[j] * Z * Z);
+            int ok = (c.alive[j] != 0.0) & (wj > 0.0) & (wj <= DBL_MAX);
+            w[j] = ok ? wj : 0.0;
+        }
+        for (int j = 0; j < m; j++) {
+            int i = i0 + j;
+            a->weights[i] = w[j];
+            if (c.alive[j] != 0.0) {
+                lf_lens_ray *o = &a->out[i];
+                o->o[0] = c.ox[j], o->o[1] = c.oy[j], o->o[2] = c.oz[j];
+                o->d[0] = c.dx[j], o->d[1] = c.dy[j], o->d[2] = c.dz[j];
+            }
+        }
+    }
+}
+
+#ifdef LF_LENS_AVX2_KERNEL
+__attribute__((target("avx2"))) static void batch_rays_avx2(const batch_args *a)
+{
+    batch_rays_body(a);
+}
+#endif
+
+static void batch_rays_generic(const batch_args *a)
+{
+    batch_rays_body(a);
+}
+
+void lf_lens_sample_rays(const lf_lens *L, const lf_lens_pupil *P, int use_bounds, int n, const double *film_x,
+                         const double *film_y, const double *u, const double *v, const double *lambda_nm,
+                         lf_lens_stop_shape stop_shape, const void *stop_ctx, lf_lens_ray *out, double *weights)
+{
+    if (n <= 0)
+        return;
+    if (L->n > LF_LENS_MAX_SURFACES) {
+        for (int i = 0; i < n; i++) {
+            lf_lens_trace_opts o = {0};
+            o.lambda_nm = lambda_nm ? lambda_nm[i] : 0.0;
+            o.stop_shape = stop_shape, o.stop_ctx = stop_ctx;
+            weights[i] = lf_lens_sample_ray(L, P, use_bounds, film_x[i], film_y[i], u[i], v[i], &o, &out[i]);
+        }
+        return;
+    }
+    surf_k S[LF_LENS_MAX_SURFACES];
+    for (int k = 0; k < L->n; k++)
+        surf_constants(L, L->n - 1 - k, 1, &S[k]);
+    batch_args a = {L, P, S, use_bounds, n, film_x, film_y, u, v, lambda_nm, stop_shape, stop_ctx, out, weights,
+                    NULL, NULL};
+#ifdef LF_LENS_AVX2_KERNEL
+    if (lf_lens_batch_uses_avx2()) {
+        batch_rays_avx2(&a);
+        return;
+    }
+#endif
+    batch_rays_generic(&a);
+}
+
+void lf_lens_trace_rays_from_film(const lf_lens *L, int n, const lf_lens_ray *in, lf_lens_ray *out,
+                                  unsigned char *passed)
+{
+    if (n <= 0)
+        return;
+    if (L->n > LF_LENS_MAX_SURFACES) {
+        for (int i = 0; i < n; i++)
+            passed[i] = trace(L, &in[i], &out[i], NULL, 1) == LF_LENS_PASSED;
+        return;
+    }
+    surf_k S[LF_LENS_MAX_SURFACES];
+    for (int k = 0; k < L->n; k++)
+        surf_constants(L, L->n - 1 - k, 1, &S[k]);
+    batch_args a = {L, NULL, S, 0, n, NULL, NULL, NULL, NULL, NULL, NULL, NULL, out, NULL, in, passed};
+#ifdef LF_LENS_AVX2_KERNEL
+    if (lf_lens_batch_uses_avx2()) {
+        batch_rays_avx2(&a);
+        return;
+    }
+#endif
+    batch_rays_generic(&a);
 }
 
 /* ------------------------------------------------------------------ field */

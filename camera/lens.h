@@ -10,8 +10,9 @@
  *   lf_lens_set_stop_diameter(&lens, 10.0, warn, sizeof warn);
  *   lf_lens_focus_thick(&lens, 1000.0, &lens.film_distance_mm, err, sizeof err);
  *   lf_lens_pupil pupil; lf_lens_pupil_build(&lens, 43.3, 0, &pupil);
- *   double w = lf_lens_sample_ray(&lens, &pupil, film_xy, u, v, 0, &ray);
- *   lf_lens_pupil_free(&pupil); lf_lens_free(&lens);
+ *   double w = lf_lens_sample_ray(&lens, &pupil, 1, fx, fy, u, v, NULL, &ray);
+ *   lf_lens_sample_rays(&lens, &pupil, 1, n, fxs, fys, us, vs, NULL, NULL, NULL, rays, ws); // n at once
+ *   lf_lens_free(&lens);
  *
  * Units: millimetres throughout.  LENS SPACE is pbrt's: the optical axis is
  * z, the film is the plane z = 0, the lens lies at negative z (the rear
@@ -161,10 +162,12 @@ typedef struct lf_lens_pupil_bin {
     double xlo[LF_LENS_PUPIL_STRIPS], xhi[LF_LENS_PUPIL_STRIPS];
     double cdf[LF_LENS_PUPIL_STRIPS + 1]; /* cumulative strip areas, normalised */
     double area;                          /* both halves, mm^2 */
+    double pdf;                           /* 1 / area: the sampling density, per mm^2 */
 } lf_lens_pupil_bin;
 
 typedef struct lf_lens_pupil {
     double film_radius_mm;  /* bins span [0, film_radius_mm] */
+    double bins_per_mm;     /* n_bins / film_radius_mm */
     double rear_disk_radius_mm; /* disk on the rear plane holding every ray that gets through */
     double lambda_nm[3];    /* wavelengths the bounds hold for (0: n_d) */
     int n_lambda;
@@ -195,6 +198,32 @@ int lf_lens_pupil_contains(const lf_lens_pupil *pupil, double film_x, double fil
  * does not get through (never NaN). */
 double lf_lens_sample_ray(const lf_lens *lens, const lf_lens_pupil *pupil, int use_bounds, double film_x,
                           double film_y, double u, double v, lf_lens_trace_opts *opts, lf_lens_ray *out);
+/* Batch form of lf_lens_sample_ray (the camera's hot path): for every i < n,
+ * the same as
+ *     lf_lens_trace_opts o = {0};
+ *     o.lambda_nm = lambda_nm ? lambda_nm[i] : 0;
+ *     o.stop_shape = stop_shape, o.stop_ctx = stop_ctx;
+ *     weights[i] = lf_lens_sample_ray(lens, pupil, use_bounds, film_x[i], film_y[i], u[i], v[i], &o, &out[i]);
+ * bit for bit: the same pupil sample, vignetting tests and weight; out[i] is
+ * written when the ray gets through the lens (as lf_lens_sample_ray does).
+ * lambda_nm and stop_shape may be NULL; the stop shape is called once per
+ * ray that reaches the stop.  Rays are traced in chunks, surface by surface
+ * in structure-of-arrays form (AVX2 where the CPU has it): several times
+ * faster per ray than the scalar call (docs/realistic.md). */
+void lf_lens_sample_rays(const lf_lens *lens, const lf_lens_pupil *pupil, int use_bounds, int n, const double *film_x,
+                         const double *film_y, const double *u, const double *v, const double *lambda_nm,
+                         lf_lens_stop_shape stop_shape, const void *stop_ctx, lf_lens_ray *out, double *weights);
+/* Batch form of lf_lens_trace_from_film without options: passed[i] is 1
+ * and out[i] is written where lf_lens_trace_from_film(lens, &in[i],
+ * &out[i], NULL) returns LF_LENS_PASSED (the same bits), else 0 (out[i]
+ * untouched).  Same kernels as lf_lens_sample_rays. */
+void lf_lens_trace_rays_from_film(const lf_lens *lens, int n, const lf_lens_ray *in, lf_lens_ray *out,
+                                  unsigned char *passed);
+/* 1 if lf_lens_sample_rays runs its AVX2 kernel on this CPU.  Tests force
+ * the generic (SSE2) kernel with lf_lens_batch_force_generic(1) to check
+ * both (not thread-safe: call before rendering). */
+int lf_lens_batch_uses_avx2(void);
+void lf_lens_batch_force_generic(int on);
 /* Radius of a disk on the rear-vertex plane that every ray from a film point
  * within film_radius_mm that gets through crosses (rear aperture plus the
  * lateral travel across the rear surface's sag). */

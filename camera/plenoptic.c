@@ -491,9 +491,11 @@ static int candidates(const plenoptic *c, double x, double y, int pick, int *ci,
     return k;
 }
 
-static double plenoptic_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+/* A camera ray up to the main lens: its weight (0: no ray) and, with a
+ * compound main lens, the ray to trace through it (lens space) in *in;
+ * with the thin main lens, the finished ray in *r. */
+static double plenoptic_front(const plenoptic *c, const lf_camera_sample *s, lf_camera_ray *r, lf_lens_ray *in)
 {
-    const plenoptic *c = state;
     int K = candidates(c, s->film_x, s->film_y, -1, NULL, NULL);
     if (K <= 0)
         return 0.0;
@@ -541,16 +543,8 @@ static double plenoptic_generate_ray(const void *state, const lf_camera_sample *
     if (c->compound) {
         /* lens space (mm; film = MLA at z = 0, light towards +z) is camera
          * space mirrored in z, laterally the camera's: upright -> negate */
-        lf_lens_ray in = {{-mx * 1e3, -my * 1e3, 0.0}, {-sx, -sy, -1.0}}, out;
-        if (lf_lens_trace_from_film(&c->lens, &in, &out, NULL) != LF_LENS_PASSED || !isfinite(w))
-            return 0.0;
-        double len = sqrt(out.d[0] * out.d[0] + out.d[1] * out.d[1] + out.d[2] * out.d[2]);
-        if (!(len > 0.0) || !isfinite(len))
-            return 0.0;
-        r->origin[0] = out.o[0] * 1e-3, r->origin[1] = out.o[1] * 1e-3;
-        r->origin[2] = -(out.o[2] + c->principal_to_mla_mm) * 1e-3; /* camera origin at H */
-        r->dir[0] = out.d[0] / len, r->dir[1] = out.d[1] / len, r->dir[2] = -out.d[2] / len;
-        return w;
+        *in = (lf_lens_ray){{-mx * 1e3, -my * 1e3, 0.0}, {-sx, -sy, -1.0}};
+        return isfinite(w) ? w : 0.0;
     }
     sx -= hx / c->focal_length, sy -= hy / c->focal_length;
     /* upright -> camera space: point reflection of the lateral coordinates */
@@ -561,6 +555,61 @@ static double plenoptic_generate_ray(const void *state, const lf_camera_sample *
     r->origin[0] = -hx, r->origin[1] = -hy, r->origin[2] = 0.0;
     r->dir[0] = dir[0] / len, r->dir[1] = dir[1] / len, r->dir[2] = dir[2] / len;
     return w;
+}
+
+/* The ray out of the compound main lens -> the camera ray; w or 0. */
+static double plenoptic_back(const plenoptic *c, const lf_lens_ray *out, double w, lf_camera_ray *r)
+{
+    double len = sqrt(out->d[0] * out->d[0] + out->d[1] * out->d[1] + out->d[2] * out->d[2]);
+    if (!(len > 0.0) || !isfinite(len))
+        return 0.0;
+    r->origin[0] = out->o[0] * 1e-3, r->origin[1] = out->o[1] * 1e-3;
+    r->origin[2] = -(out->o[2] + c->principal_to_mla_mm) * 1e-3; /* camera origin at H */
+    r->dir[0] = out->d[0] / len, r->dir[1] = out->d[1] / len, r->dir[2] = -out->d[2] / len;
+    return w;
+}
+
+static double plenoptic_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)
+{
+    const plenoptic *c = state;
+    lf_lens_ray in, out;
+    double w = plenoptic_front(c, s, r, &in);
+    if (!(w > 0.0) || !c->compound)
+        return w;
+    if (lf_lens_trace_from_film(&c->lens, &in, &out, NULL) != LF_LENS_PASSED)
+        return 0.0;
+    return plenoptic_back(c, &out, w, r);
+}
+
+/* generate_rays: with a compound main lens, the rays that reach it are
+ * traced side by side (lf_lens_trace_rays_from_film); the thin main lens
+ * one ray at a time. */
+static void plenoptic_generate_rays(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r,
+                                    double *weights)
+{
+    const plenoptic *c = state;
+    if (!c->compound) {
+        for (int i = 0; i < n; i++)
+            weights[i] = plenoptic_generate_ray(state, &s[i], &r[i]);
+        return;
+    }
+    enum { CHUNK = 64 };
+    lf_lens_ray in[CHUNK], out[CHUNK];
+    unsigned char passed[CHUNK];
+    int idx[CHUNK];
+    for (int i0 = 0; i0 < n; i0 += CHUNK) {
+        int m = n - i0 < CHUNK ? n - i0 : CHUNK, k = 0;
+        for (int i = i0; i < i0 + m; i++) {
+            weights[i] = plenoptic_front(c, &s[i], &r[i], &in[k]);
+            if (weights[i] > 0.0)
+                idx[k++] = i;
+        }
+        lf_lens_trace_rays_from_film(&c->lens, k, in, out, passed);
+        for (int q = 0; q < k; q++) {
+            int i = idx[q];
+            weights[i] = passed[q] ? plenoptic_back(c, &out[q], weights[i], &r[i]) : 0.0;
+        }
+    }
 }
 
 static void plenoptic_destroy(void *state)
@@ -652,6 +701,7 @@ const lf_camera_type lf_camera_plenoptic = {
     .create = plenoptic_create,
     .needs = plenoptic_needs,
     .generate_ray = plenoptic_generate_ray,
+    .generate_rays = plenoptic_generate_rays,
     .destroy = plenoptic_destroy,
     .describe = plenoptic_describe,
     .metadata = plenoptic_metadata,

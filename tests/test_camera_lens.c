@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <dirent.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -455,6 +456,8 @@ typedef struct store {
     const char *lensfile;
     double aperture, focus;
     int dispersion;
+    const char *shape, *model; /* "aperture", "lensmodel"; NULL: default */
+    int no_bounds;             /* "pupilbounds" false */
 } store;
 static double g_float(void *c, const char *name, double def)
 {
@@ -473,11 +476,17 @@ static int g_int(void *c, const char *name, int def)
 static int g_bool(void *c, const char *name, int def)
 {
     store *s = c;
+    if (!strcmp(name, "pupilbounds"))
+        return !s->no_bounds;
     return !strcmp(name, "dispersion") ? s->dispersion : def;
 }
 static const char *g_string(void *c, const char *name, const char *def)
 {
     store *s = c;
+    if (!strcmp(name, "aperture") && s->shape)
+        return s->shape;
+    if (!strcmp(name, "lensmodel") && s->model)
+        return s->model;
     return !strcmp(name, "lensfile") && s->lensfile ? s->lensfile : def;
 }
 static int g_floats(void *c, const char *name, double *out, int max)
@@ -492,15 +501,20 @@ static int g_image(void *c, const char *path, int *w, int *h, float **px, char *
     return -1;
 }
 
-static void *make(store *s, int w, int h, char *err, char *warn)
+static void *make_camera(const char *type, store *s, int w, int h, char *err, char *warn)
 {
     lf_camera_params p = {s, g_float, g_int, g_bool, g_string, g_floats, g_image};
     lf_camera_create_args a = {sizeof a, &p, w, h, 35.0, 0.0, 1.0, LF_SOURCE_DIR "/scenes", err, 512, warn, 512};
     void *state = NULL;
-    const lf_camera_type *t = lf_camera_find("realistic");
+    const lf_camera_type *t = lf_camera_find(type);
     if (!t || t->create(&a, &state))
         return NULL;
     return state;
+}
+
+static void *make(store *s, int w, int h, char *err, char *warn)
+{
+    return make_camera("realistic", s, w, h, err, warn);
 }
 
 static void test_camera(void)
@@ -510,7 +524,7 @@ static void test_camera(void)
     if (!t)
         return;
     char err[512] = "", warn[512] = "";
-    store s = {"lenses/dgauss.50mm.dat", 8.0, 3.0, 0};
+    store s = {"lenses/dgauss.50mm.dat", 8.0, 3.0, 0, NULL, NULL, 0};
     void *c = make(&s, 90, 60, err, warn);
     CHECK_MSG(c != NULL, "%s", err);
     if (c) {
@@ -544,7 +558,7 @@ static void test_camera(void)
         t->destroy(c);
     }
     /* Dispersion: needs wavelength, sets it as the ABI says. */
-    store sd = {"lenses/dgauss.100mm.dat", 30.0, 5.0, 1};
+    store sd = {"lenses/dgauss.100mm.dat", 30.0, 5.0, 1, NULL, NULL, 0};
     c = make(&sd, 30, 20, err, warn);
     CHECK_MSG(c != NULL, "%s", err);
     if (c) {
@@ -556,14 +570,14 @@ static void test_camera(void)
         t->destroy(c);
     }
     /* Hard cases through the camera. */
-    store none = {NULL, 0, 0, 0};
+    store none = {NULL, 0, 0, 0, NULL, NULL, 0};
     CHECK(make(&none, 30, 20, err, warn) == NULL);
     CHECK(strstr(err, "lensfile") != NULL);
-    store too_close = {"lenses/dgauss.50mm.dat", 8.0, 0.1, 0};
+    store too_close = {"lenses/dgauss.50mm.dat", 8.0, 0.1, 0, NULL, NULL, 0};
     CHECK(make(&too_close, 30, 20, err, warn) == NULL);
     CHECK_MSG(strstr(err, "closer than") != NULL, "%s", err);
     warn[0] = 0;
-    store big = {"lenses/wide.22mm.dat", 100.0, 3.0, 0};
+    store big = {"lenses/wide.22mm.dat", 100.0, 3.0, 0, NULL, NULL, 0};
     c = make(&big, 30, 20, err, warn);
     CHECK(c != NULL);
     CHECK_MSG(strstr(warn, "clamping") != NULL, "warning: %s", warn);
@@ -578,20 +592,414 @@ static void test_camera(void)
         const char *text = "50 5 1.5 30\n0 5 0 1e-6\n-50 40 1 30\n";
         CHECK(write(fd, text, strlen(text)) == (ssize_t)strlen(text));
         close(fd);
-        store dark = {tmpl, 1e-6, 3.0, 0};
+        store dark = {tmpl, 1e-6, 3.0, 0, NULL, NULL, 0};
         CHECK(make(&dark, 30, 20, err, warn) == NULL);
         CHECK_MSG(strstr(err, "admits no light") != NULL, "%s", err);
         /* A typo in a file: file:line in the camera's message. */
         FILE *f = fopen(tmpl, "w");
         fputs("# test\n50 5 1.5 30\n0 5 0 10\n-50 40 1\n", f);
         fclose(f);
-        store typo = {tmpl, 5, 3.0, 0};
+        store typo = {tmpl, 5, 3.0, 0, NULL, NULL, 0};
         CHECK(make(&typo, 30, 20, err, warn) == NULL);
         char want[128];
         snprintf(want, sizeof want, "%s:4: expected 4 or 5 columns", tmpl);
         CHECK_MSG(strstr(err, want) != NULL, "%s", err);
         unlink(tmpl);
     }
+}
+
+/* ---- the batch path: lf_lens_sample_rays against lf_lens_sample_ray ---- */
+
+/* A shaped stop with partial transmission that counts its calls (the batch
+ * must call it for exactly the rays the scalar path calls it for). */
+typedef struct shape_calls {
+    long n;
+} shape_calls;
+static double odd_shape(const void *ctx, double x, double y)
+{
+    ((shape_calls *)ctx)->n++;
+    if (x > 0.6 || y < -0.7 || x * x + y * y > 1.0)
+        return 0.0;
+    return x * x + y * y < 0.25 ? 1.0 : 0.5 + 0.25 * y;
+}
+
+/* lens.c's concentric mapping, to recover the rear point of a disk sample
+ * (only for counting why rays fail). */
+static void disk_point(double u, double v, double R, double *x, double *y)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0, r, th;
+    if (a == 0.0 && b == 0.0) {
+        *x = *y = 0.0;
+        return;
+    }
+    if (fabs(a) > fabs(b))
+        r = a, th = (M_PI / 4.0) * (b / a);
+    else
+        r = b, th = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
+    *x = r * cos(th) * R, *y = r * sin(th) * R;
+}
+
+static int close_rel(double a, double b, double scale)
+{
+    return fabs(a - b) <= 1e-9 * (fabs(a) > scale ? fabs(a) : scale);
+}
+
+typedef struct batch_stats {
+    long rays, passed, identical;
+    long status[LF_LENS_BACKWARDS + 1]; /* why the blocked rays failed (scalar trace) */
+} batch_stats;
+
+/* n rays both ways; every weight, pass/fail, output ray and stop-shape call
+ * count must agree (to 1e-9 relative: FMA contraction may differ; the
+ * current kernels are bit-identical, counted in st->identical). */
+static void compare_batch(const char *what, const lf_lens *L, const lf_lens_pupil *P, int use_bounds, int n,
+                          const double *fx, const double *fy, const double *u, const double *v, const double *lambda,
+                          int shaped, batch_stats *st)
+{
+    lf_lens_ray *rs = malloc(sizeof *rs * (size_t)n), *rb = malloc(sizeof *rb * (size_t)n);
+    double *ws = malloc(sizeof *ws * (size_t)n), *wb = malloc(sizeof *wb * (size_t)n);
+    if (!rs || !rb || !ws || !wb) {
+        CHECK(0);
+        free(rs), free(rb), free(ws), free(wb);
+        return;
+    }
+    const lf_lens_ray sentinel = {{1234.5, 1234.5, 1234.5}, {6789.0, 6789.0, 6789.0}};
+    for (int i = 0; i < n; i++)
+        rs[i] = rb[i] = sentinel;
+    shape_calls cs = {0}, cb = {0};
+    for (int i = 0; i < n; i++) {
+        lf_lens_trace_opts o = {0};
+        o.lambda_nm = lambda ? lambda[i] : 0.0;
+        if (shaped)
+            o.stop_shape = odd_shape, o.stop_ctx = &cs;
+        ws[i] = lf_lens_sample_ray(L, P, use_bounds, fx[i], fy[i], u[i], v[i], &o, &rs[i]);
+    }
+    lf_lens_sample_rays(L, P, use_bounds, n, fx, fy, u, v, lambda, shaped ? odd_shape : NULL, &cb, rb, wb);
+    long bad = 0, first = -1;
+    for (int i = 0; i < n; i++) {
+        int ok = (ws[i] > 0.0) == (wb[i] > 0.0) && close_rel(ws[i], wb[i], 1e-300) && isfinite(wb[i]) &&
+                 wb[i] >= 0.0;
+        int written_s = memcmp(&rs[i], &sentinel, sizeof sentinel) != 0;
+        int written_b = memcmp(&rb[i], &sentinel, sizeof sentinel) != 0;
+        ok &= written_s == written_b;
+        if (written_s && written_b)
+            for (int k = 0; k < 3; k++)
+                ok &= close_rel(rs[i].o[k], rb[i].o[k], 1.0) && close_rel(rs[i].d[k], rb[i].d[k], 1.0);
+        if (!ok && first < 0)
+            first = i;
+        bad += !ok;
+        st->identical += ws[i] == wb[i] && (!written_s || !memcmp(&rs[i], &rb[i], sizeof rs[i]));
+        st->passed += ws[i] > 0.0;
+        if (!(ws[i] > 0.0)) {
+            /* why: trace the same film ray (scalar) */
+            double rx, ry;
+            if (use_bounds) {
+                if (!(lf_lens_pupil_sample(P, fx[i], fy[i], u[i], v[i], &rx, &ry) > 0.0))
+                    continue;
+            } else {
+                disk_point(u[i], v[i], P->rear_disk_radius_mm, &rx, &ry);
+            }
+            lf_lens_ray in = {{fx[i], fy[i], 0}, {rx - fx[i], ry - fy[i], -L->film_distance_mm}};
+            lf_lens_trace_opts o = {0};
+            shape_calls calls = {0};
+            o.lambda_nm = lambda ? lambda[i] : 0.0;
+            if (shaped)
+                o.stop_shape = odd_shape, o.stop_ctx = &calls;
+            st->status[lf_lens_trace_from_film(L, &in, NULL, &o)]++;
+        }
+    }
+    st->rays += n;
+    CHECK_MSG(bad == 0, "%s: %ld of %d rays differ; first %ld: film (%g, %g) u,v (%g, %g): scalar w %.17g, batch %.17g",
+              what, bad, n, first, first >= 0 ? fx[first] : 0, first >= 0 ? fy[first] : 0,
+              first >= 0 ? u[first] : 0, first >= 0 ? v[first] : 0, first >= 0 ? ws[first] : 0,
+              first >= 0 ? wb[first] : 0);
+    CHECK_MSG(cs.n == cb.n, "%s: stop shape called %ld times by the scalar path, %ld by the batch", what, cs.n, cb.n);
+    /* Every chunk size: the first k rays alone give the same weights. */
+    for (int k = 1; k <= 40 && k <= n; k += 3) {
+        lf_lens_sample_rays(L, P, use_bounds, k, fx, fy, u, v, lambda, shaped ? odd_shape : NULL, &cb, rb, wb);
+        int same = 1;
+        for (int i = 0; i < k; i++)
+            same &= (ws[i] > 0.0) == (wb[i] > 0.0) && close_rel(ws[i], wb[i], 1e-300);
+        CHECK_MSG(same, "%s: n = %d differs", what, k);
+    }
+    free(rs), free(rb), free(ws), free(wb);
+}
+
+/* Film points over the film (and past its corners and its diagonal), the
+ * exact corners and centre; pupil samples including 0 and the largest value
+ * below 1; wavelengths over 360..830 nm and some 0 (n_d). */
+static int batch_inputs(int n, double film_w, double film_h, uint64_t seed, double *fx, double *fy, double *u,
+                        double *v, double *lambda)
+{
+    static const double edge[] = {0.0, 0.5, 0.999999999999999889, 0.25, 0.75};
+    int k = 0;
+    for (int cx = -1; cx <= 1; cx++)
+        for (int cy = -1; cy <= 1; cy++)
+            for (int e = 0; e < 25; e++, k++) {
+                fx[k] = 0.5 * film_w * cx, fy[k] = 0.5 * film_h * cy;
+                u[k] = edge[e % 5], v[k] = edge[e / 5];
+                lambda[k] = e % 3 ? 360.0 + 470.0 * e / 24.0 : 0.0;
+            }
+    for (; k < n; k++) {
+        fx[k] = (rnd(&seed) - 0.5) * 1.1 * film_w, fy[k] = (rnd(&seed) - 0.5) * 1.1 * film_h;
+        u[k] = rnd(&seed), v[k] = rnd(&seed);
+        lambda[k] = k % 7 ? 360.0 + 470.0 * rnd(&seed) : 0.0;
+    }
+    return k;
+}
+
+static void test_batch_matches_scalar(void)
+{
+    enum { N = 12000 };
+    double *fx = malloc(sizeof(double) * N), *fy = malloc(sizeof(double) * N), *u = malloc(sizeof(double) * N),
+           *v = malloc(sizeof(double) * N), *lam = malloc(sizeof(double) * N);
+    CHECK(fx && fy && u && v && lam);
+    if (!fx || !fy || !u || !v || !lam)
+        return;
+    const double film_w = 36, film_h = 24, film_r = 0.5 * hypot(36, 24);
+    const int have_avx2 = lf_lens_batch_uses_avx2();
+    batch_stats st;
+    memset(&st, 0, sizeof st);
+    /* Every shipped lens. */
+    DIR *dir = opendir(LENSES);
+    CHECK(dir != NULL);
+    int n_lenses = 0;
+    for (struct dirent *de; dir && (de = readdir(dir));) {
+        size_t len = strlen(de->d_name);
+        if (len < 5 || strcmp(de->d_name + len - 4, ".dat"))
+            continue;
+        lf_lens L;
+        if (load(de->d_name, &L))
+            continue;
+        n_lenses++;
+        char err[256], what[512];
+        CHECK(lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, err, sizeof err) == 0);
+        /* Glass gets dispersion for the wavelength cases (Cauchy B = 0.005 um^2
+         * through n_d) unless the file has Abbe numbers. */
+        lf_lens D = L;
+        lf_lens_surface surf[64];
+        CHECK(L.n <= 64);
+        memcpy(surf, L.s, sizeof(lf_lens_surface) * (size_t)L.n);
+        D.s = surf;
+        if (!D.has_abbe)
+            for (int i = 0; i < D.n; i++)
+                if (surf[i].ior > 1.0) {
+                    double ld = LF_LENS_LAMBDA_D * 1e-3;
+                    surf[i].cauchy_b = 0.005;
+                    surf[i].cauchy_a = surf[i].ior - 0.005 / (ld * ld);
+                }
+        D.has_abbe = 1, D.dispersive = 1;
+        for (int stop = 0; stop < 2; stop++) {
+            /* wide open, then at a third of the stop: many rays stopped */
+            lf_lens_set_stop_diameter(&L, stop ? 2.0 / 3.0 * L.stop_max_radius_mm : 1e3, NULL, 0);
+            lf_lens_set_stop_diameter(&D, stop ? 2.0 / 3.0 * L.stop_max_radius_mm : 1e3, NULL, 0);
+            lf_lens_pupil P, PD;
+            CHECK(lf_lens_pupil_build(&L, film_r, 0, &P) > 0);
+            CHECK(lf_lens_pupil_build(&D, film_r, 1, &PD) > 0);
+            int n = batch_inputs(N, film_w, film_h, 99 + n_lenses + stop, fx, fy, u, v, lam);
+            for (int generic = 0; generic <= have_avx2; generic++) {
+                lf_lens_batch_force_generic(generic);
+                for (int use_bounds = 1; use_bounds >= 0; use_bounds--)
+                    for (int shaped = 0; shaped < 2; shaped++) {
+                        snprintf(what, sizeof what, "%s %s, %s, %s%s", de->d_name, stop ? "stopped down" : "wide open",
+                                 use_bounds ? "pupil bounds" : "rear disk", shaped ? "shaped stop" : "round stop",
+                                 generic ? ", generic kernel" : "");
+                        compare_batch(what, &L, &P, use_bounds, n, fx, fy, u, v, NULL, shaped, &st);
+                        strcat(what, ", dispersion");
+                        compare_batch(what, &D, &PD, use_bounds, n, fx, fy, u, v, lam, shaped, &st);
+                    }
+            }
+            lf_lens_batch_force_generic(0);
+        }
+        /* lf_lens_trace_rays_from_film against lf_lens_trace_from_film:
+         * film rays, rays starting behind the film, turned back (d.z > 0),
+         * of zero length. */
+        enum { NT = 3001 };
+        lf_lens_set_stop_diameter(&L, 1e3, NULL, 0);
+        lf_lens_ray in[NT], out_s[NT], out_b[NT];
+        unsigned char passed[NT];
+        uint64_t ts = 31 + n_lenses;
+        lf_lens_pupil PT;
+        CHECK(lf_lens_pupil_build(&L, film_r, 0, &PT) > 0);
+        for (int i = 0; i < NT; i++) {
+            double ox = (rnd(&ts) - 0.5) * film_w, oy = (rnd(&ts) - 0.5) * film_h, oz = i % 5 == 0 ? 2.0 : 0.0;
+            double rx = 0, ry = 0; /* aimed at the exit-pupil bound (the axis if the point gets no light) */
+            lf_lens_pupil_sample(&PT, ox, oy, rnd(&ts), rnd(&ts), &rx, &ry);
+            in[i] = (lf_lens_ray){{ox, oy, oz}, {rx - ox, ry - oy, -L.film_distance_mm - oz}};
+            if (i % 97 == 0)
+                in[i].d[2] = -in[i].d[2];
+            if (i % 101 == 0)
+                in[i].d[0] = in[i].d[1] = in[i].d[2] = 0.0;
+        }
+        for (int generic = 0; generic <= have_avx2; generic++) {
+            lf_lens_batch_force_generic(generic);
+            memset(out_b, 0, sizeof out_b);
+            lf_lens_trace_rays_from_film(&L, NT, in, out_b, passed);
+            int bad = 0, through = 0;
+            for (int i = 0; i < NT; i++) {
+                int p = lf_lens_trace_from_film(&L, &in[i], &out_s[i], NULL) == LF_LENS_PASSED;
+                through += p;
+                bad += p != passed[i] || (p && memcmp(&out_s[i], &out_b[i], sizeof out_s[i]));
+            }
+            CHECK_MSG(bad == 0 && through > NT / 20, "%s: lf_lens_trace_rays_from_film: %d of %d rays differ (%d pass)",
+                      de->d_name, bad, NT, through);
+        }
+        lf_lens_batch_force_generic(0);
+        lf_lens_free(&L);
+    }
+    if (dir)
+        closedir(dir);
+    CHECK(n_lenses >= 5);
+    /* Total internal reflection and grazing rays: the meniscus and the
+     * hemisphere of test_tir_grazing_stop; rays that meet the far side of a
+     * small rear sphere (its centre in front of the film): sampled over the
+     * whole rear disk. */
+    static const struct {
+        const char *text;
+        double film_distance, film_size;
+    } odd[] = {{"10 4 1.8 19\n-1e6 20 1 19\n", 20, 20},
+               {"10 10 1.5 20\n-10 30 1 20\n", 30, 20},
+               {"5 1 1.5 9.99\n5 20 1 9.99\n", 20, 60}};
+    for (size_t k = 0; k < sizeof odd / sizeof odd[0]; k++) {
+        lf_lens L;
+        if (parse(odd[k].text, &L))
+            continue;
+        L.film_distance_mm = odd[k].film_distance;
+        lf_lens_pupil P;
+        CHECK(lf_lens_pupil_build(&L, 0.7 * odd[k].film_size, 0, &P) > 0);
+        int n = batch_inputs(N, odd[k].film_size, odd[k].film_size, 7 + k, fx, fy, u, v, lam);
+        for (int generic = 0; generic <= have_avx2; generic++) {
+            lf_lens_batch_force_generic(generic);
+            char what[128];
+            snprintf(what, sizeof what, "test lens %zu%s", k, generic ? ", generic kernel" : "");
+            compare_batch(what, &L, &P, 0, n, fx, fy, u, v, NULL, 0, &st);
+            compare_batch(what, &L, &P, 1, n, fx, fy, u, v, NULL, 1, &st);
+        }
+        lf_lens_batch_force_generic(0);
+        lf_lens_free(&L);
+    }
+    /* Random prescriptions: strongly curved surfaces (clear apertures up to
+     * the full hemisphere), thick glass, a stop somewhere, rays over the
+     * whole rear disk: rays that meet a sphere's far side, graze, reflect
+     * totally, miss. */
+    uint64_t seed = 4242;
+    int n_random = 0;
+    for (int k = 0; k < 40; k++) {
+        char text[1024] = "";
+        int ns = 2 + (int)(rnd(&seed) * 4), stop_at = (int)(rnd(&seed) * (ns + 1)), len = 0;
+        for (int i = 0; i < ns; i++) {
+            double R = (4.0 + 40.0 * rnd(&seed) * rnd(&seed)) * (rnd(&seed) < 0.5 ? -1 : 1);
+            double ap = 2.0 * fabs(R) * (0.5 + 0.5 * rnd(&seed)), ior = i == ns - 1 ? 1.0 : 1.0 + rnd(&seed);
+            len += snprintf(text + len, sizeof text - len, "%.6g %.6g %.6g %.6g %g\n", R, 0.5 + 8.0 * rnd(&seed),
+                            ior, ap, ior > 1.0 ? 25.0 + 40.0 * rnd(&seed) : 0.0);
+            if (i == stop_at)
+                len += snprintf(text + len, sizeof text - len, "0 %.6g 1 %.6g\n", 0.5 + 3.0 * rnd(&seed),
+                                2.0 + 10.0 * rnd(&seed));
+        }
+        lf_lens L;
+        char err[512];
+        if (lf_lens_parse(text, "random.dat", &L, err, sizeof err))
+            continue; /* e.g. glass right after a stop row (ior 1 there): skip */
+        L.film_distance_mm = 5.0 + 40.0 * rnd(&seed);
+        L.dispersive = k % 2;
+        lf_lens_pupil P;
+        if (lf_lens_pupil_build(&L, 12.0, L.dispersive, &P) == 0) {
+            lf_lens_free(&L);
+            continue;
+        }
+        n_random++;
+        int n = batch_inputs(4000, 18.0, 12.0, 500 + k, fx, fy, u, v, lam);
+        for (int generic = 0; generic <= have_avx2; generic++) {
+            lf_lens_batch_force_generic(generic);
+            char what[128];
+            snprintf(what, sizeof what, "random lens %d%s", k, generic ? ", generic kernel" : "");
+            compare_batch(what, &L, &P, 0, n, fx, fy, u, v, L.dispersive ? lam : NULL, k % 3 == 0, &st);
+            compare_batch(what, &L, &P, 1, n, fx, fy, u, v, L.dispersive ? lam : NULL, k % 3 == 1, &st);
+        }
+        lf_lens_batch_force_generic(0);
+        lf_lens_free(&L);
+    }
+    CHECK_MSG(n_random >= 20, "only %d random lenses admit light", n_random);
+    /* The comparison covered every way a ray can fail. */
+    CHECK_MSG(st.status[LF_LENS_MISSED] > 0 && st.status[LF_LENS_CLIPPED] > 0 && st.status[LF_LENS_STOPPED] > 0 &&
+                  st.status[LF_LENS_TIR] > 0 && st.passed > st.rays / 4,
+              "coverage: %ld rays, %ld passed, missed %ld, clipped %ld, stopped %ld, TIR %ld, backwards %ld", st.rays,
+              st.passed, st.status[LF_LENS_MISSED], st.status[LF_LENS_CLIPPED], st.status[LF_LENS_STOPPED],
+              st.status[LF_LENS_TIR], st.status[LF_LENS_BACKWARDS]);
+    printf("batch vs scalar: %ld rays (%s), %ld passed, %ld bit-identical; blocked: missed %ld, clipped %ld, "
+           "stopped %ld, TIR %ld, backwards %ld\n",
+           st.rays, have_avx2 ? "AVX2 and generic kernels" : "generic kernel", st.passed, st.identical,
+           st.status[LF_LENS_MISSED], st.status[LF_LENS_CLIPPED], st.status[LF_LENS_STOPPED], st.status[LF_LENS_TIR],
+           st.status[LF_LENS_BACKWARDS]);
+    free(fx), free(fy), free(u), free(v), free(lam);
+}
+
+/* The camera's batch entry against its scalar one, for the traced model
+ * (round and shaped apertures, dispersion, rear-disk sampling) and the
+ * polynomial one, and for the plenoptic camera with a compound main lens
+ * (lf_lens_trace_rays_from_film): the same weights and rays, time and
+ * wavelength kept. */
+static void test_camera_batch(void)
+{
+    static const struct {
+        const char *type;
+        store s;
+    } configs[] = {
+        {"realistic", {"lenses/dgauss.50mm.dat", 8.0, 3.0, 0, NULL, NULL, 0}},
+        {"realistic", {"lenses/dgauss.100mm.dat", 30.0, 5.0, 1, "star", NULL, 0}},
+        {"realistic", {"lenses/fisheye.10mm.dat", 100.0, 1.0, 0, "pentagon", NULL, 0}},
+        {"realistic", {"lenses/wide.22mm.dat", 100.0, 2.0, 0, NULL, NULL, 1}},
+        {"realistic", {"lenses/telephoto.250mm.dat", 100.0, 10.0, 0, NULL, "polynomial", 0}},
+        {"plenoptic", {"lenses/dgauss.50mm.dat", 10.0, 2.0, 0, NULL, NULL, 0}},
+    };
+    enum { N = 3001 };
+    lf_camera_sample *cs = malloc(sizeof *cs * N);
+    lf_camera_ray *r1 = malloc(sizeof *r1 * N), *r2 = malloc(sizeof *r2 * N);
+    double *w1 = malloc(sizeof *w1 * N), *w2 = malloc(sizeof *w2 * N);
+    CHECK(cs && r1 && r2 && w1 && w2);
+    for (size_t k = 0; cs && r1 && r2 && w1 && w2 && k < sizeof configs / sizeof configs[0]; k++) {
+        char err[512] = "", warn[512] = "";
+        store s = configs[k].s;
+        const lf_camera_type *t = lf_camera_find(configs[k].type);
+        CHECK_MSG(t && t->generate_rays, "%s has no generate_rays", configs[k].type);
+        if (!t || !t->generate_rays)
+            continue;
+        void *c = make_camera(configs[k].type, &s, 96, 64, err, warn);
+        CHECK_MSG(c != NULL, "%s %s: %s", configs[k].type, s.lensfile, err);
+        if (!c)
+            continue;
+        uint64_t seed = 77 + k;
+        for (int i = 0; i < N; i++) {
+            cs[i] = (lf_camera_sample){rnd(&seed) * 97 - 0.5, rnd(&seed) * 65 - 0.5, rnd(&seed), rnd(&seed),
+                                       0.25 + i, rnd(&seed)};
+            if (i < 4) /* the film's corners */
+                cs[i].film_x = i & 1 ? 96 : 0, cs[i].film_y = i & 2 ? 64 : 0;
+            r1[i] = r2[i] = (lf_camera_ray){{0}, {0}, cs[i].time, 0.0};
+        }
+        for (int i = 0; i < N; i++)
+            w1[i] = t->generate_ray(c, &cs[i], &r1[i]);
+        /* in uneven pieces: chunk boundaries anywhere */
+        for (int i0 = 0, m = 1; i0 < N; i0 += m, m = m * 3 % 211 + 1)
+            t->generate_rays(c, i0 + m <= N ? m : N - i0, &cs[i0], &r2[i0], &w2[i0]);
+        int bad = 0, through = 0;
+        for (int i = 0; i < N; i++) {
+            int ok = (w1[i] > 0) == (w2[i] > 0) && close_rel(w1[i], w2[i], 1e-300) && r1[i].time == r2[i].time &&
+                     r1[i].wavelength_nm == r2[i].wavelength_nm;
+            for (int q = 0; q < 3; q++)
+                ok &= close_rel(r1[i].origin[q], r2[i].origin[q], 1e-3) && close_rel(r1[i].dir[q], r2[i].dir[q], 1.0);
+            bad += !ok;
+            through += w1[i] > 0;
+        }
+        CHECK_MSG(bad == 0, "%s %s: %d of %d camera rays differ between generate_ray and generate_rays",
+                  configs[k].type, s.lensfile, bad, N);
+        /* (the wide angle over its whole rear disk: about 1% get through) */
+        CHECK_MSG(through > (s.no_bounds ? N / 500 : N / 10), "%s %s: only %d rays got through", configs[k].type,
+                  s.lensfile, through);
+        if (s.dispersion)
+            CHECK(r2[N - 1].wavelength_nm > 359.0);
+        t->destroy(c);
+    }
+    free(cs), free(r1), free(r2), free(w1), free(w2);
 }
 
 static void test_sensors(void)
@@ -613,6 +1021,8 @@ int main(void)
     test_pupil_unbiased();
     test_dispersion();
     test_camera();
+    test_batch_matches_scalar();
+    test_camera_batch();
     test_sensors();
     return lf_test_end();
 }

@@ -24,18 +24,20 @@ static float power_heuristic(float a, float b)
 lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s)
 {
     if (in->light_sampler == LF_LIGHTS_AUTO)
-        return s->n_lights <= LF_LIGHTS_ALL_MAX ? LF_LIGHTS_ALL : LF_LIGHTS_POWER;
+        return s->n_nee_lights <= LF_LIGHTS_ALL_MAX ? LF_LIGHTS_ALL : LF_LIGHTS_POWER;
     return in->light_sampler;
 }
 
 /* Probability that NEE samples this light at a vertex (1 when all are). */
 static double light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
 {
+    if (s->lights[light].kind == LF_LIGHT_INFINITE_UNIFORM)
+        return 0.0; /* never sampled by NEE (lf_scene.nee_lights) */
     switch (ls) {
     case LF_LIGHTS_ALL:
         return 1.0;
     case LF_LIGHTS_UNIFORM:
-        return 1.0 / s->n_lights;
+        return 1.0 / s->n_nee_lights;
     default:
         return lf_distrib1d_pmf(&s->light_distrib, light);
     }
@@ -76,9 +78,9 @@ static lf_vec3 sample_direct(const lf_scene *s, lf_light_sampler lsm, const lf_h
     float u0, u1;
     if (lsm == LF_LIGHTS_ALL) {
         lf_vec3 L = lf_v3(0, 0, 0);
-        for (int li = 0; li < s->n_lights; li++) {
+        for (int k = 0; k < s->n_nee_lights; k++) {
             lf_sample_2d(st, &u0, &u1);
-            L = lf_add(L, light_direct(s, h, bsdf, wo, li, 1.0, u0, u1, rays));
+            L = lf_add(L, light_direct(s, h, bsdf, wo, s->nee_lights[k], 1.0, u0, u1, rays));
         }
         return L;
     }
@@ -86,9 +88,9 @@ static lf_vec3 sample_direct(const lf_scene *s, lf_light_sampler lsm, const lf_h
     double pmf;
     int li;
     if (lsm == LF_LIGHTS_UNIFORM) {
-        li = (int)(ul * s->n_lights);
-        li = li < s->n_lights ? li : s->n_lights - 1;
-        pmf = 1.0 / s->n_lights;
+        int k = (int)(ul * s->n_nee_lights);
+        li = s->nee_lights[k < s->n_nee_lights ? k : s->n_nee_lights - 1];
+        pmf = 1.0 / s->n_nee_lights;
     } else {
         double ur;
         li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
@@ -154,14 +156,14 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         lf_bsdf bsdf;
         lf_material_bsdf(mat, &h.sc, &bsdf);
         int specular = lf_bsdf_is_specular(&bsdf);
-        int need_light_choice = !specular && s->n_lights > 1 && lsm != LF_LIGHTS_ALL;
+        int need_light_choice = !specular && s->n_nee_lights > 1 && lsm != LF_LIGHTS_ALL;
         int need_lobe_choice = bsdf.kind != LF_LOBE_DIFFUSE;
         float ul = 0.5f, uc = 0.5f;
         if (need_light_choice || need_lobe_choice)
             lf_sample_2d(st, &ul, &uc);
         else
             lf_sample_skip(st);
-        if (!specular && s->n_lights > 0)
+        if (!specular && s->n_nee_lights > 0)
             L = lf_add(L, lf_mul(beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
         else
             lf_sample_skip(st);

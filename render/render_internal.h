@@ -171,6 +171,12 @@ typedef struct lf_scene {
     int n_lights;
     int *infinite_lights;    /* indices of infinite lights */
     int n_infinite;
+    /* Lights next-event estimation samples: all but uniform infinite lights
+     * (a constant environment is sampled at least as well by the BSDF, so
+     * sampling it too would only add shadow rays; MIS gives its BSDF-sampled
+     * hits full weight).  The power distribution gives the others 0. */
+    int *nee_lights;
+    int n_nee_lights;
     lf_distrib1d light_distrib; /* light selection by power */
     lf_vec3 bounds_min, bounds_max;
     float scene_radius;

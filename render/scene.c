@@ -1256,8 +1256,19 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
             lf_error_set(err, LF_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        for (int i = 0; i < s->n_lights; i++)
-            s->lights[i].power = pw[i] = lf_light_power(s, &s->lights[i]);
+        s->nee_lights = malloc(sizeof(int) * (size_t)(s->n_lights ? s->n_lights : 1));
+        if (!s->nee_lights) {
+            free(pw);
+            lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (int i = 0; i < s->n_lights; i++) {
+            s->lights[i].power = lf_light_power(s, &s->lights[i]);
+            int nee = s->lights[i].kind != LF_LIGHT_INFINITE_UNIFORM;
+            pw[i] = nee ? s->lights[i].power : 0.0;
+            if (nee)
+                s->nee_lights[s->n_nee_lights++] = i;
+        }
         int rc = s->n_lights ? lf_distrib1d_init(&s->light_distrib, pw, s->n_lights, err) : 0;
         free(pw);
         if (rc)
@@ -1323,6 +1334,7 @@ void lf_scene_free(lf_scene *s)
         }
     free(s->lights);
     free(s->infinite_lights);
+    free(s->nee_lights);
     if (s->n_lights)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);

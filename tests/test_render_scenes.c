@@ -245,11 +245,11 @@ static void test_lights(void)
  * 60 degrees (E = L cos 60 = 1), a point light at height 2 (E = I/h^2 =
  * 0.75) and a uniform sky (E = pi L = pi/2) over a diffuse plane; the
  * radiance is a/pi times their sum.  Sampling every light at every vertex
- * leaves only the sky's sampling noise, while choosing one light adds the
- * choice's variance: with 16 samples per pixel its pixel-to-pixel spread
- * must be at least 2x smaller (measured 2.1x smaller than a uniform choice
- * and 63x smaller than a choice by power, which here rarely picks the point
- * light and then weights it by 1/pmf). */
+ * leaves no choice variance, while choosing one light by power adds it:
+ * with 16 samples per pixel the pixel-to-pixel spread must be at least 2x
+ * smaller (measured 4.6e-5 against 0.12: power rarely picks the point light
+ * and then weights it by 1/pmf).  A uniform choice is as good here (4.6e-5):
+ * the choice dimension is stratified over the 16 samples. */
 static void test_light_samplers(void)
 {
     const char *names[] = {"all", "power", "uniform", "bvh"};
@@ -290,9 +290,10 @@ static void test_light_samplers(void)
             lf_image_free(&img);
         }
     }
-    CHECK_MSG(spread[0] < 0.5 * spread[1] && spread[0] < 0.5 * spread[2],
-              "sampling all lights should be much less noisy: spread all %.4g, power %.4g, uniform %.4g", spread[0],
-              spread[1], spread[2]);
+    CHECK_MSG(spread[0] < 0.5 * spread[1] && spread[0] <= 1.5 * spread[2],
+              "sampling all lights should be much less noisy than choosing by power: spread all %.4g, power %.4g, "
+              "uniform %.4g",
+              spread[0], spread[1], spread[2]);
     CHECK_MSG(spread[3] == spread[0], "\"bvh\" with 3 lights should sample all of them (%.4g vs %.4g)", spread[3],
               spread[0]);
 }

@@ -23,6 +23,7 @@
 #include <stddef.h>
 
 #include "../base/lf_distrib.h"
+#include "camera_internal.h"
 #include "lf_camera.h"
 
 typedef enum lf_aperture_kind {
@@ -51,6 +52,28 @@ typedef struct lf_aperture {
 int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, char *err, size_t err_size);
 /* u, v in [0,1); returns the weight (0: no point), fills (x, y) in radius units. */
 double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, double *y);
+/* A batch kernel's lens points: lf_aperture_sample for the first n of a
+ * padded chunk of N samples (the rest get weight 0).  The circle is
+ * written branch-free over the whole chunk, so it vectorises when inlined
+ * into a kernel; other shapes sample one by one. */
+static inline __attribute__((always_inline)) void lf_aperture_sample_chunk(const lf_aperture *a, int n, int N, const double *restrict u,
+                                            const double *restrict v, double *restrict x, double *restrict y,
+                                            double *restrict w)
+{
+    if (a->kind == LF_APERTURE_CIRCLE) {
+        const double ana = a->anamorphic;
+        for (int i = 0; i < N; i++) {
+            lf_cam_concentric_disk(u[i], v[i], &x[i], &y[i]);
+            x[i] *= ana;
+            w[i] = 1.0;
+        }
+        return;
+    }
+    for (int i = 0; i < n; i++)
+        w[i] = lf_aperture_sample(a, u[i], v[i], &x[i], &y[i]);
+    for (int i = n; i < N; i++)
+        w[i] = 0.0, x[i] = y[i] = 0.0;
+}
 /* Is (x, y) (radius units) inside the open region? Returns its transmission. */
 double lf_aperture_transmission(const lf_aperture *a, double x, double y);
 double lf_aperture_area(const lf_aperture *a);

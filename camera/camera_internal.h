@@ -26,6 +26,26 @@
 #endif
 enum { LF_CAM_CHUNK = 32 }; /* rays per batch-kernel chunk */
 
+/* A batch kernel's first step: the chunk's n samples as structure of
+ * arrays, padded to LF_CAM_CHUNK by repeating the first sample. */
+static inline __attribute__((always_inline)) void lf_cam_stage_samples(int n, const lf_camera_sample *restrict s, double *restrict fx,
+                                        double *restrict fy, double *restrict lu, double *restrict lv)
+{
+    for (int i = 0; i < LF_CAM_CHUNK; i++) {
+        int k = i < n ? i : 0;
+        fx[i] = s[k].film_x, fy[i] = s[k].film_y, lu[i] = s[k].lens_u, lv[i] = s[k].lens_v;
+    }
+}
+
+/* generate_rays for a camera whose kernel takes up to LF_CAM_CHUNK rays. */
+typedef void (*lf_cam_chunk_fn)(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r, double *w);
+static inline void lf_cam_chunks(lf_cam_chunk_fn chunk, const void *state, int n, const lf_camera_sample *s,
+                                 lf_camera_ray *r, double *w)
+{
+    for (int i = 0; i < n; i += LF_CAM_CHUNK)
+        chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+}
+
 /* sin and cos of x for |x| <= pi/4 by their Taylor series through x^15
  * and x^16: the first omitted terms are below 5e-17, so the result is as
  * good as libm's here, with no call and no branch (loops over many samples

@@ -144,15 +144,14 @@ static inline double lens_ray(const projective *c, double lx, double ly, double 
 /* Up to LF_CAM_CHUNK rays, each step a loop over the whole padded chunk
  * (structure of arrays) so that the compiler vectorises it. */
 LF_CAM_SIMD_CLONES
-static void projective_chunk(const projective *c, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
+static void projective_chunk(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
 {
+    const projective *c = state;
     enum { N = LF_CAM_CHUNK };
     double fx[N], fy[N], lu[N], lv[N], lx[N], ly[N], aw[N], w[N], o[3][N], d[3][N];
-    for (int i = 0; i < N; i++) {
-        int k = i < n ? i : 0; /* padding repeats the first sample */
-        fx[i] = s[k].film_x, fy[i] = s[k].film_y, lu[i] = s[k].lens_u, lv[i] = s[k].lens_v;
+    lf_cam_stage_samples(n, s, fx, fy, lu, lv);
+    for (int i = 0; i < N; i++)
         w[i] = 1.0;
-    }
     if (c->orthographic) {
         for (int i = 0; i < N; i++) {
             double oi[3];
@@ -169,19 +168,7 @@ static void projective_chunk(const projective *c, int n, const lf_camera_sample 
         }
     }
     if (c->lens_radius > 0.0) {
-        if (c->aperture.kind == LF_APERTURE_CIRCLE) {
-            const double ana = c->aperture.anamorphic;
-            for (int i = 0; i < N; i++) {
-                lf_cam_concentric_disk(lu[i], lv[i], &lx[i], &ly[i]);
-                lx[i] *= ana;
-                aw[i] = 1.0;
-            }
-        } else {
-            for (int i = 0; i < n; i++)
-                aw[i] = lf_aperture_sample(&c->aperture, lu[i], lv[i], &lx[i], &ly[i]);
-            for (int i = n; i < N; i++)
-                aw[i] = 0.0, lx[i] = ly[i] = 0.0;
-        }
+        lf_aperture_sample_chunk(&c->aperture, n, N, lu, lv, lx, ly, aw);
         for (int i = 0; i < N; i++) {
             double oi[3] = {o[0][i], o[1][i], o[2][i]}, di[3] = {d[0][i], d[1][i], d[2][i]};
             w[i] = lens_ray(c, lx[i], ly[i], aw[i], oi, di);
@@ -199,8 +186,7 @@ static void projective_chunk(const projective *c, int n, const lf_camera_sample 
 static void projective_generate_rays(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r,
                                      double *w)
 {
-    for (int i = 0; i < n; i += LF_CAM_CHUNK)
-        projective_chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+    lf_cam_chunks(projective_chunk, state, n, s, r, w);
 }
 
 static double projective_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)

@@ -178,28 +178,14 @@ static inline double thinlens_ray(const thinlens *c, double fx, double fy, doubl
  * (structure of arrays), so the compiler vectorises it and the square roots
  * and divisions of different rays overlap. */
 LF_CAM_SIMD_CLONES
-static void thinlens_chunk(const thinlens *c, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
+static void thinlens_chunk(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r, double *wt)
 {
+    const thinlens *c = state;
     enum { N = LF_CAM_CHUNK };
     double fx[N], fy[N], lu[N], lv[N], lx[N], ly[N], aw[N];
     double ox[N], oy[N], dx[N], dy[N], dz[N], w[N];
-    for (int i = 0; i < N; i++) {
-        int k = i < n ? i : 0; /* padding repeats the first sample */
-        fx[i] = s[k].film_x, fy[i] = s[k].film_y, lu[i] = s[k].lens_u, lv[i] = s[k].lens_v;
-    }
-    const double ana = c->aperture.anamorphic;
-    if (c->aperture.kind == LF_APERTURE_CIRCLE) {
-        for (int i = 0; i < N; i++) {
-            lf_cam_concentric_disk(lu[i], lv[i], &lx[i], &ly[i]);
-            lx[i] *= ana;
-            aw[i] = 1.0;
-        }
-    } else {
-        for (int i = 0; i < n; i++)
-            aw[i] = lf_aperture_sample(&c->aperture, lu[i], lv[i], &lx[i], &ly[i]);
-        for (int i = n; i < N; i++)
-            aw[i] = 0.0, lx[i] = ly[i] = 0.0;
-    }
+    lf_cam_stage_samples(n, s, fx, fy, lu, lv);
+    lf_aperture_sample_chunk(&c->aperture, n, N, lu, lv, lx, ly, aw);
     for (int i = 0; i < N; i++) {
         double o[2], d[3];
         w[i] = thinlens_ray(c, fx[i], fy[i], lx[i], ly[i], aw[i], o, d);
@@ -215,8 +201,7 @@ static void thinlens_chunk(const thinlens *c, int n, const lf_camera_sample *s, 
 static void thinlens_generate_rays(const void *state, int n, const lf_camera_sample *s, lf_camera_ray *r,
                                    double *w)
 {
-    for (int i = 0; i < n; i += LF_CAM_CHUNK)
-        thinlens_chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+    lf_cam_chunks(thinlens_chunk, state, n, s, r, w);
 }
 
 static double thinlens_generate_ray(const void *state, const lf_camera_sample *s, lf_camera_ray *r)

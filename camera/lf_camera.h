@@ -133,7 +133,11 @@ typedef struct lf_camera_type {
                           double *weights);
 } lf_camera_type;
 
-/* ---- registry (camera/registry.c) ---- */
+/* ---- registry (camera/registry.c) ----
+ * Thread safety: lookups may run on any thread at any time; loading a
+ * plugin is serialised internally and publishes its types atomically, so a
+ * lookup sees the table before or after a load, never half of it.  Types,
+ * once registered, stay registered for the life of the process. */
 
 /* Finds a camera type by name among built-ins and loaded plugins. */
 const lf_camera_type *lf_camera_find(const char *name);

@@ -1,6 +1,8 @@
 /* The camera registry: built-ins are rows of a static table; plugins loaded
  * at run time are appended to a second table with the same row type. */
 #include <dlfcn.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -25,11 +27,15 @@ static lf_camera_type legacy_types[MAX_PLUGIN_TYPES];
 /* The size of a version-1 type record: everything up to and including
  * `metadata`. */
 #define LF_CAMERA_TYPE_V1_SIZE (offsetof(lf_camera_type, metadata) + sizeof(((lf_camera_type *)0)->metadata))
-static int n_plugin_types;
+/* Loading is serialised by a mutex; the count is published with release
+ * semantics after its rows are written, so a lookup on another thread sees
+ * either the old table or the complete new one. */
+static atomic_int n_plugin_types;
+static pthread_mutex_t plugin_lock = PTHREAD_MUTEX_INITIALIZER;
 
 int lf_camera_count(void)
 {
-    return N_BUILTIN + n_plugin_types;
+    return N_BUILTIN + atomic_load_explicit(&n_plugin_types, memory_order_acquire);
 }
 
 const lf_camera_type *lf_camera_at(int i)
@@ -60,8 +66,19 @@ void lf_camera_generate_rays(const lf_camera_type *t, const void *state, int n, 
 
 typedef const lf_camera_type *const *(*plugin_entry_fn)(int *count);
 
+static int load_plugin_locked(const char *path, char *err, size_t err_size);
+
 int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
 {
+    pthread_mutex_lock(&plugin_lock);
+    int rc = load_plugin_locked(path, err, err_size);
+    pthread_mutex_unlock(&plugin_lock);
+    return rc;
+}
+
+static int load_plugin_locked(const char *path, char *err, size_t err_size)
+{
+    int n_loaded = atomic_load_explicit(&n_plugin_types, memory_order_relaxed);
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!h) {
         snprintf(err, err_size, "cannot load camera plugin %s: %s", path, dlerror());
@@ -100,7 +117,7 @@ int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
             return -1;
         }
     }
-    if (n_plugin_types + count > MAX_PLUGIN_TYPES) {
+    if (n_loaded + count > MAX_PLUGIN_TYPES) {
         snprintf(err, err_size, "camera plugin %s: too many plugin camera types (limit %d)", path, MAX_PLUGIN_TYPES);
         dlclose(h);
         return -1;
@@ -108,13 +125,14 @@ int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
     for (int i = 0; i < count; i++) {
         const lf_camera_type *t = types[i];
         if (t->abi_version == 1u) {
-            lf_camera_type *c = &legacy_types[n_plugin_types];
+            lf_camera_type *c = &legacy_types[n_loaded];
             memset(c, 0, sizeof *c);
             memcpy(c, t, LF_CAMERA_TYPE_V1_SIZE);
             t = c;
         }
-        plugin_types[n_plugin_types++] = t;
+        plugin_types[n_loaded++] = t;
     }
+    atomic_store_explicit(&n_plugin_types, n_loaded, memory_order_release);
     /* The handle stays open for the life of the process: the types live in it. */
     return 0;
 }

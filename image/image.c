@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -508,19 +509,23 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
  * the file, CRCs, IHDR first, IEND last) rejects truncated and corrupted
  * files ourselves, quietly; only a file with valid CRCs over an invalid
  * zlib stream still reaches libpng. */
+static uint32_t png_crc_table[256];
+static pthread_once_t png_crc_once = PTHREAD_ONCE_INIT;
+
+static void png_crc_init(void)
+{
+    for (uint32_t i = 0; i < 256; i++) {
+        uint32_t c = i;
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+        png_crc_table[i] = c;
+    }
+}
+
 static uint32_t png_crc_update(uint32_t crc, const unsigned char *buf, size_t n)
 {
-    static uint32_t table[256];
-    static atomic_int ready;
-    if (!atomic_load(&ready)) { /* idempotent: racing threads write equal values */
-        for (uint32_t i = 0; i < 256; i++) {
-            uint32_t c = i;
-            for (int k = 0; k < 8; k++)
-                c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-            table[i] = c;
-        }
-        atomic_store(&ready, 1);
-    }
+    const uint32_t *table = png_crc_table;
+    pthread_once(&png_crc_once, png_crc_init);
     for (size_t i = 0; i < n; i++)
         crc = table[(crc ^ buf[i]) & 0xffu] ^ (crc >> 8);
     return crc;

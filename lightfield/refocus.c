@@ -1,5 +1,6 @@
 /* Shift-and-add refocusing (Ng 2005, sub-aperture form), view interpolation,
  * focal stacks, all-in-focus and disparity maps. */
+#include <stdatomic.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -115,10 +116,14 @@ static void accumulate_row_half(float *restrict acc, const uint16_t *restrict r0
                                 float a, float b, float c, float e, int n)
 {
 #ifdef LF_HAVE_F16C_PATH
-    static int f16c = -1;
-    if (f16c < 0)
-        f16c = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
-    if (f16c) {
+    /* relaxed atomics: every thread computes the same answer */
+    static atomic_int f16c = -1;
+    int have = atomic_load_explicit(&f16c, memory_order_relaxed);
+    if (have < 0) {
+        have = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+        atomic_store_explicit(&f16c, have, memory_order_relaxed);
+    }
+    if (have) {
         accumulate_row_half_f16c(acc, r0, r1, a, b, c, e, n);
         return;
     }

@@ -3,6 +3,7 @@
 #define LF_RENDER_INTERNAL_H
 
 #include <embree3/rtcore.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -149,6 +150,8 @@ typedef struct lf_light {
 
 typedef struct lf_scene {
     RTCDevice device;
+    atomic_int rtc_error_claimed; /* the first Embree error message is kept */
+    char rtc_error_msg[256];
     RTCScene rtc;
     lf_mesh *meshes;
     int n_meshes;

@@ -13,6 +13,7 @@
  * decomposed interpolation and rays traverse a static BVH.  Shapes that ask
  * for "motionsegments", emitters, full spheres and motions Embree's
  * decomposition cannot represent get keyframed vertices (or centres). */
+#include <stdatomic.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -673,11 +674,15 @@ static void sphere_occluded_fn(const struct RTCOccludedFunctionNArguments *a)
         r->tfar = -INFINITY;
 }
 
+/* Embree's error callback may run on any thread: keep the first message
+ * (claimed with an atomic flag) so the build error below can name it. */
 static void rtc_error_cb(void *user, enum RTCError code, const char *str)
 {
-    (void)user;
+    lf_scene *s = user;
     (void)code;
-    (void)str;
+    if (!s || atomic_exchange(&s->rtc_error_claimed, 1))
+        return;
+    snprintf(s->rtc_error_msg, sizeof s->rtc_error_msg, "%s", str ? str : "");
 }
 
 /* Embree takes at most RTC_MAX_TIME_STEP_COUNT (129) time steps per geometry. */
@@ -1123,7 +1128,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         lf_error_set(err, LF_ERR_INTERNAL, "cannot create the Embree device (error %d)", (int)rtcGetDeviceError(NULL));
         goto fail;
     }
-    rtcSetDeviceErrorFunction(s->device, rtc_error_cb, NULL);
+    rtcSetDeviceErrorFunction(s->device, rtc_error_cb, s);
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     int n_moving_spheres = 0;
@@ -1239,7 +1244,8 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
          * what went wrong while building is an error here. */
         enum RTCError e = rtcGetDeviceError(s->device);
         if (e != RTC_ERROR_NONE) {
-            lf_error_set(err, LF_ERR_INTERNAL, "Embree could not build the scene (error %d)", (int)e);
+            lf_error_set(err, LF_ERR_INTERNAL, "Embree could not build the scene (error %d%s%s)", (int)e,
+                         s->rtc_error_msg[0] ? ": " : "", s->rtc_error_msg);
             goto fail;
         }
     }

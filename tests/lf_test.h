@@ -2,7 +2,8 @@
  *
  *   int main(void) { CHECK(1 + 1 == 2); CHECK_NEAR(x, 2.0, 1e-9); return lf_test_end(); }
  *
- * Each test binary prints "N passed, N failed" and exits non-zero on failure.
+ * Each test binary prints "N passed, N failed" and exits non-zero on failure,
+ * or when no check ran at all.
  */
 #ifndef LF_TEST_H
 #define LF_TEST_H
@@ -46,8 +47,14 @@ static int lf_test_passed, lf_test_failed;
         }                                                                                  \
     } while (0)
 
+/* A test binary in which no check ran has tested nothing: that fails. */
 static inline int lf_test_end(void)
 {
+    if (lf_test_passed + lf_test_failed == 0) {
+        fprintf(stderr, "no check ran: a test that checks nothing fails\n");
+        printf("0 passed, 1 failed\n");
+        return 1;
+    }
     printf("%d passed, %d failed\n", lf_test_passed, lf_test_failed);
     return lf_test_failed ? 1 : 0;
 }

@@ -9,7 +9,7 @@
  *   "float cameragridbounds"    [minx maxx miny maxy] on the camera-space plane z = 0 ([-0.5 0.5 -0.5 0.5])
  *   "float lensradius", "float focaldistance"   optional thin lens per data camera (pbrt semantics)
  *
- * Layout (PHYSICS.md "Light fields"): the film is cut into nx x ny tiles of
+ * Layout (docs/physics.md "Light fields"): the film is cut into nx x ny tiles of
  * W/nx x H/ny pixels (the resolution must divide).  Tile column i holds the
  * camera at x_i = minx + i (maxx - minx)/(nx - 1), tile row j the camera at
  * y_j = maxy - j (maxy - miny)/(ny - 1): seen from behind the grid looking

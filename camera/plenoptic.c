@@ -48,7 +48,7 @@
  *      scene) s_in = (m - p_s)/d, s_out = s_in - (m - c)/f_mla;
  *   4. h = m + s_out z_i on the main lens; |h| > R: vignetted, weight 0;
  *   5. thin main lens: s = s_out - h/f; the ray leaves h along (s, 1).
- * Radiometry (PHYSICS.md "Exposure and radiometry"): the irradiance at p_s
+ * Radiometry (docs/physics.md "Exposure and radiometry"): the irradiance at p_s
  * is E = (1/d^2) \int_{microlenses} L cos^4(theta) dA over the MLA plane,
  * theta the angle of m - p_s to the axis (ideal thin lenses conserve
  * radiance), so the weight is K A_cell cos^4(theta) / d^2.  Like thinlens,
@@ -201,7 +201,7 @@ static void place_lattice(plenoptic *c)
  * where lf_lens_focus_thick puts the film.  Camera space has its origin at
  * the lens's front principal point H, so that with z from H and z_i from H'
  * the thin-lens relations the light-field library uses (1/z + 1/z_i = 1/f,
- * PHYSICS.md) hold for the paraxial lens.  The lattice geometry sees the
+ * docs/physics.md) hold for the paraxial lens.  The lattice geometry sees the
  * aperture as the paraxial exit pupil; candidates are searched within a
  * radius there that bounds every ray that gets through (traced at create). */
 static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, const char *lensfile, double zo)

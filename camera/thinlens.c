@@ -3,7 +3,7 @@
  * that are exposure, not radiance.  docs/thinlens.md is the user's page.
  *
  * Geometry (camera space, metres; course notes "Ray Tracing for Defocus Blur
- * (Thin Lens)"; PHYSICS.md "Two thin-lens cameras"):
+ * (Thin Lens)"; docs/physics.md "Two thin-lens cameras"):
  *   - the thin lens is the plane z = 0, centred on the origin, looking +z;
  *   - the sensor is the plane z = -z_s behind it, z_s the image distance of
  *     the focus plane z = z_o: 1/f = 1/z_s + 1/z_o, so z_s = f z_o/(z_o - f)
@@ -21,7 +21,7 @@
  *     every ray from p_s through any lens point p_l passes through P (the
  *     lens images p_s to P), so the ray leaves p_l towards P.
  *
- * Radiometry (PHYSICS.md "Exposure and radiometry"): the irradiance at p_s is
+ * Radiometry (docs/physics.md "Exposure and radiometry"): the irradiance at p_s is
  *   E = (1/z_s^2) \int_aperture L cos^4(theta) dA,
  * theta the angle between p_l - p_s and the axis.  With p_l uniform over the
  * open aperture of area A_ap = R^2 lf_aperture_area() (R = f/2N), the
@@ -259,7 +259,7 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
         LF_CAM_APPEND("far limit of acceptable sharpness: infinity\n");
     else
         LF_CAM_APPEND("far limit of acceptable sharpness: %.6g m\n", s * (H - f) / (H - s));
-    /* C = A z_s |1/d - 1/z| (PHYSICS.md), in pixels of the sensor pitch */
+    /* C = A z_s |1/d - 1/z| (docs/physics.md), in pixels of the sensor pitch */
     static const double factors[] = {0.5, 0.8, 2.0, 10.0};
     for (int i = 0; i < 4; i++) {
         double z = factors[i] * s;

@@ -1,7 +1,7 @@
 /* Light-field cameras without the renderer: the camera-array layout of
  * "lightfield" (CS348B) and the microlens geometry and radiometry of
  * "plenoptic" (Ng 2005).  Expected numbers come from the thin-lens and
- * pinhole formulas of PHYSICS.md and the layout of
+ * pinhole formulas of docs/physics.md and the layout of
  * docs/lightfield-format.md, computed here; Monte Carlo estimates use fixed
  * stratified samples, so they are deterministic. */
 #include <math.h>

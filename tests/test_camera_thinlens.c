@@ -3,7 +3,7 @@
  * ray weights (camera equation, cos^4), the sensor table, --explain facts,
  * unbiased aperture sampling for every shape, pbrt's perspective with
  * apertures, and the hard cases.  Every expected number is computed here
- * from the formulas in PHYSICS.md, never copied from the program. */
+ * from the formulas in docs/physics.md, never copied from the program. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -388,7 +388,7 @@ static void test_thinlens_blur_circle(void)
     for (int i = 0; i < 5; i++) {
         double z = depths[i], zi = thin_zs(f, z);
         double C = A * fabs(zs - zi) / zi;
-        CHECK_NEAR(C, A * zs * fabs(1 / d - 1 / z), 1e-12); /* the two forms in PHYSICS.md */
+        CHECK_NEAR(C, A * zs * fabs(1 / d - 1 / z), 1e-12); /* the two forms in docs/physics.md */
         double phys_x = R * (1 - zs / zi);                   /* physical film point */
         CHECK_NEAR(fabs(phys_x), C / 2, 1e-12);
         double sx = -phys_x; /* upright coordinate */

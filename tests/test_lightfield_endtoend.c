@@ -13,7 +13,7 @@
  * A z_s |1/2 - 1/1| m^-1 = 0.46 mm, about 3 microlens pitches, so
  * refocusing matters.
  *
- * Expected geometry from PHYSICS.md (never from the program's output):
+ * Expected geometry from docs/physics.md (never from the program's output):
  *   - z_i = f d/(d - f) (MLA), physical pitch p from the matched design
  *     P = W/24 = p (1 + p/D) (docs/lightfield.md), f_mla = p z_i / D;
  *   - refocus plane for depth z: 1/z + 1/(alpha z_i) = 1/f;

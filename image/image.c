@@ -3,6 +3,7 @@
  * non-finite checks, tonemapping to 8 bits and atomic replacement of the
  * target file.  Format codecs live in exr.c and oiio_adapter.cpp. */
 #include "lf_image.h"
+#include "../base/lf_file_write.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -309,93 +310,6 @@ static int ext_is(const char *ext, const char *const *list)
 /* Formats OpenImageIO stores as float; every other format gets 8-bit sRGB. */
 static const char *const float_exts[] = {"tif", "tiff", "hdr", "rgbe", "pfm", NULL};
 
-/* Creates an empty temporary file beside `path`, named
- * "<dir>/.<name>.tmpXXXXXX.<ext>" so it is hidden, cannot collide with the
- * target, and still ends in the real extension (OpenImageIO picks the
- * format from it).  Created with O_EXCL and mode 0666 so the umask, not a
- * hard-coded 0600, decides the final file's permissions. */
-static int make_temp(const char *path, char *tmp, size_t tmp_size, lf_error *err)
-{
-    static atomic_uint counter;
-    const char *slash = strrchr(path, '/');
-    const char *base = slash ? slash + 1 : path;
-    if (!*base)
-        return lf_error_set(err, LF_ERR_PARAM, "cannot write '%s': path names a directory", path);
-    int dir_len = slash ? (int)(slash - path) : 0;
-    const char *ext = path_extension(path);
-    static const char alphabet[] = "abcdefghijklmnopqrstuvwxyz0123456789";
-
-    for (int attempt = 0; attempt < 100; attempt++) {
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        uint64_t r = ((uint64_t)getpid() << 32) ^ (uint64_t)ts.tv_nsec ^ ((uint64_t)ts.tv_sec << 20) ^
-                     ((uint64_t)atomic_fetch_add(&counter, 1) * 0x9E3779B97F4A7C15ull);
-        r *= 0xBF58476D1CE4E5B9ull; /* splitmix-style scramble */
-        r ^= r >> 31;
-        char rnd[7];
-        for (int i = 0; i < 6; i++, r /= 36)
-            rnd[i] = alphabet[r % 36];
-        rnd[6] = '\0';
-        int n = snprintf(tmp, tmp_size, "%.*s%s.%s.tmp%s%s%s", dir_len, path, slash ? "/" : "", base, rnd,
-                         *ext ? "." : "", ext);
-        if (n < 0 || (size_t)n >= tmp_size)
-            return lf_error_set(err, LF_ERR_PARAM, "cannot write '%s': path too long", path);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd >= 0) {
-            close(fd);
-            return LF_OK;
-        }
-        if (errno == EEXIST)
-            continue;
-        int e = errno;
-        if (e == ENOENT || e == ENOTDIR) {
-            char dir[PATH_MAX];
-            snprintf(dir, sizeof dir, "%.*s", dir_len, path);
-            return lf_error_set(err, LF_ERR_IO, "cannot write '%s': directory '%s' does not exist", path,
-                                slash ? dir : ".");
-        }
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': cannot create a temporary file beside it: %s",
-                            path, strerror(e));
-    }
-    return lf_error_set(err, LF_ERR_IO, "cannot write '%s': no free temporary file name", path);
-}
-
-/* Makes the finished temporary file durable and moves it over the target:
- * fsync before rename, or a crash could leave the new name pointing at
- * unwritten blocks. */
-static int commit_temp(const char *tmp, const char *path, lf_error *err)
-{
-    int fd = open(tmp, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': temporary file '%s' vanished: %s", path, tmp,
-                            strerror(errno));
-    struct stat st;
-    /* Replacing a file keeps its permissions, as editing it in place would. */
-    if (stat(path, &st) == 0 && S_ISREG(st.st_mode))
-        fchmod(fd, st.st_mode & 07777);
-    if (fsync(fd) != 0) {
-        int e = errno;
-        close(fd);
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': fsync failed: %s", path, strerror(e));
-    }
-    close(fd);
-    if (rename(tmp, path) != 0)
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': rename from '%s' failed: %s", path, tmp,
-                            strerror(errno));
-    /* Persist the directory entry too.  A failure here is not reported: the
-     * image is complete and in place, only its durability across a power
-     * cut is uncertain. */
-    const char *slash = strrchr(path, '/');
-    char dir[PATH_MAX];
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
-    int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (dfd >= 0) {
-        fsync(dfd);
-        close(dfd);
-    }
-    return LF_OK;
-}
-
 /* Linear floats -> 8-bit: exposure, clamp, sRGB curve.  Alpha (the last
  * channel of 2- and 4-channel images) is coverage, not light: it is only
  * clamped and quantised. */
@@ -484,7 +398,7 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
     }
 
     char tmp[PATH_MAX];
-    rc = make_temp(path, tmp, sizeof tmp, err);
+    rc = lf_file_temp_create(path, tmp, sizeof tmp, err);
     if (rc) {
         free(bytes);
         return rc;
@@ -497,7 +411,7 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_UINT8, bytes, err);
     free(bytes);
     if (!rc)
-        rc = commit_temp(tmp, path, err);
+        rc = lf_file_temp_commit(tmp, path, err);
     if (rc)
         unlink(tmp);
     return rc;

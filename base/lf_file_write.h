@@ -1,0 +1,39 @@
+/* lf_file_write.h - atomic file output, the one way lensfield writes files.
+ *
+ * Data goes to a hidden temporary file beside the target
+ * ("<dir>/.<name>.tmpXXXXXX.<ext>": same filesystem, same extension so a
+ * library that picks the format from the name still can), which is
+ * fsync'ed and renamed over the target only when complete.  A crash or an
+ * error never leaves a half-written file under the target's name.
+ *
+ *   lf_error err = {0};
+ *   if (lf_file_write_atomic("out/page.html", text, strlen(text), &err)) ... err.msg ...
+ *
+ *   char tmp[PATH_MAX];                   // for writers that need a path
+ *   if (lf_file_temp_create(path, tmp, sizeof tmp, &err)) ...;
+ *   ... write tmp ...
+ *   if (failed) unlink(tmp); else lf_file_temp_commit(tmp, path, &err);
+ */
+#ifndef LF_FILE_WRITE_H
+#define LF_FILE_WRITE_H
+
+#include <stddef.h>
+
+#include "lf_error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Creates an empty temporary file beside `path` and puts its name in tmp. */
+int lf_file_temp_create(const char *path, char *tmp, size_t tmp_size, lf_error *err);
+/* fsyncs tmp and renames it over path (keeping an existing target's
+ * permissions).  On failure tmp is left for the caller to unlink. */
+int lf_file_temp_commit(const char *tmp, const char *path, lf_error *err);
+/* Writes len bytes to path atomically. */
+int lf_file_write_atomic(const char *path, const void *data, size_t len, lf_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -290,14 +290,41 @@ static void flag_notes(const lf_arg *a, lf_strbuf *b)
         lf_strbuf_puts(b, "]");
 }
 
+/* Appends text word-wrapped to `width` columns; the cursor starts at column
+ * `col` and continuation lines are indented by `indent`. */
+static void wrap(lf_strbuf *b, const char *text, int col, int indent, int width)
+{
+    const char *p = text;
+    while (*p) {
+        while (*p == ' ')
+            p++;
+        size_t len = strcspn(p, " ");
+        if (!len)
+            break;
+        if (col > indent && col + 1 + (int)len > width) {
+            lf_strbuf_printf(b, "\n%*s", indent, "");
+            col = indent;
+        } else if (col > indent) {
+            lf_strbuf_puts(b, " ");
+            col++;
+        }
+        lf_strbuf_append(b, p, len);
+        col += (int)len;
+        p += len;
+    }
+}
+
 static void command_usage(const lf_tool *tool, const lf_command *c, lf_strbuf *b)
 {
     lf_strbuf_printf(b, "usage: %s%s%s %s\n", tool->name, c->name ? " " : "", c->name ? c->name : "",
                      c->synopsis ? c->synopsis : "");
     if (c->summary)
         lf_strbuf_printf(b, "  %s\n", c->summary);
-    if (c->description)
-        lf_strbuf_printf(b, "\n%s\n", c->description);
+    if (c->description) {
+        lf_strbuf_puts(b, "\n");
+        wrap(b, c->description, 0, 0, 79);
+        lf_strbuf_puts(b, "\n");
+    }
     lf_strbuf_puts(b, "\noptions:\n");
     for (int i = 0; i < c->n_args; i++) {
         const lf_arg *a = &c->args[i];
@@ -312,8 +339,11 @@ static void command_usage(const lf_tool *tool, const lf_command *c, lf_strbuf *b
             lf_strbuf_printf(b, "%*s", (int)(26 - width), "");
         else
             lf_strbuf_puts(b, "\n                            ");
-        lf_strbuf_puts(b, a->help ? a->help : "");
-        flag_notes(a, b);
+        lf_strbuf help = {0};
+        lf_strbuf_puts(&help, a->help ? a->help : "");
+        flag_notes(a, &help);
+        wrap(b, help.s ? help.s : "", 28, 28, 79);
+        lf_strbuf_free(&help);
         lf_strbuf_puts(b, "\n");
     }
     lf_strbuf_puts(b, "  -h, --help                this help\n  --version                 print the version\n");
@@ -335,8 +365,11 @@ char *lf_args_usage(const lf_tool *tool, const lf_command *cmd)
         lf_strbuf_printf(&b, "\nRun `%s COMMAND --help` for a command's flags; `%s --version` prints the version.\n",
                          tool->name, tool->name);
     }
-    if (tool->description && !cmd)
-        lf_strbuf_printf(&b, "\n%s\n", tool->description);
+    if (tool->description && !cmd) {
+        lf_strbuf_puts(&b, "\n");
+        wrap(&b, tool->description, 0, 0, 79);
+        lf_strbuf_puts(&b, "\n");
+    }
     if (b.failed) {
         lf_strbuf_free(&b);
         return NULL;

@@ -1486,6 +1486,21 @@ int lf_lens_field_angle(const lf_lens *L, double film_r, double *theta)
     return 0;
 }
 
+int lf_lens_chief_ray_angle(const lf_lens *L, double film_r, double *theta)
+{
+    double rs = lf_lens_rear_disk_radius(L, film_r);
+    pupil_ctx c = {L, film_r, L->film_distance_mm, NULL, 1, 0};
+    double lam = 0.0, xc;
+    c.lambda = &lam;
+    if (!chief_ray_x(&c, rs, &xc))
+        return -1;
+    lf_lens_ray in = {{film_r, 0, 0}, {xc - film_r, 0, -L->film_distance_mm}}, out;
+    if (trace(L, &in, &out, NULL, 1) != LF_LENS_PASSED)
+        return -1;
+    *theta = atan2(sqrt(out.d[0] * out.d[0] + out.d[1] * out.d[1]), -out.d[2]);
+    return 0;
+}
+
 double lf_lens_image_circle_radius(const lf_lens *L, double r_max)
 {
     double th;

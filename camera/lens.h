@@ -234,6 +234,10 @@ double lf_lens_rear_disk_radius(const lf_lens *lens, double film_radius_mm);
  * the middle of the passing interval on the rear plane.  Returns 0 and the
  * field angle (radians from the axis, object side), or -1 if no light. */
 int lf_lens_field_angle(const lf_lens *lens, double film_r_mm, double *theta);
+/* The chief ray from the film point (r, 0): through the centre of the
+ * aperture stop.  0 and its field angle (radians, object side), or -1 if it
+ * does not get through (or the lens has no stop row). */
+int lf_lens_chief_ray_angle(const lf_lens *lens, double film_r_mm, double *theta);
 /* Largest film radius (up to r_max) that receives light: the image circle. */
 double lf_lens_image_circle_radius(const lf_lens *lens, double r_max_mm);
 

@@ -42,6 +42,11 @@ enum lf_camera_needs {
     LF_CAMERA_NEEDS_WAVELENGTH = 4u  /* wavelength_u is used (dispersion) */
 };
 
+/* The wavelength range of spectral camera rays, nm (the host's spectral
+ * range: the renderer checks at build time that the two agree). */
+#define LF_CAMERA_LAMBDA_MIN_NM 360.0
+#define LF_CAMERA_LAMBDA_MAX_NM 830.0
+
 typedef struct lf_camera_sample {
     double film_x, film_y; /* raster position in pixels; (0,0) is the top-left corner of the full image */
     double lens_u, lens_v; /* in [0,1)^2; 0.5 when the camera does not need them */
@@ -54,10 +59,10 @@ typedef struct lf_camera_ray {
     double dir[3];         /* camera space, unit length */
     double time;           /* scene time; the host sets it from the sample before the call */
     double wavelength_nm;  /* 0 unless the camera needs wavelength; then a camera sets
-                            * LF_LAMBDA_MIN + wavelength_u (LF_LAMBDA_MAX - LF_LAMBDA_MIN)
-                            * nm (360..830, uniform) and the host weights the ray's RGB
-                            * radiance by that wavelength's sRGB response
-                            * (base/lf_color.h lf_wavelength_rgb_weight) */
+                            * LF_CAMERA_LAMBDA_MIN_NM + wavelength_u (LF_CAMERA_LAMBDA_MAX_NM -
+                            * LF_CAMERA_LAMBDA_MIN_NM) nm (360..830, uniform) and the host
+                            * weights the ray's RGB radiance by that wavelength's sRGB
+                            * response */
 } lf_camera_ray;
 
 /* Read access to the camera's own parameters in the scene file.  Every

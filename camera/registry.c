@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "camera_internal.h"
-
 static const lf_camera_type *const builtin[] = {
     &lf_camera_perspective,
     &lf_camera_orthographic,

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/lf_color.h"
 #include "camera/lf_camera.h"
 #include "lf_test.h"
 
@@ -44,5 +45,7 @@ int main(void)
         CHECK_NEAR(r[2].dir[0], 1.0 / sqrt(2.25), 1e-15);
         lt->destroy(state);
     }
+    /* the plugin header states the spectral range on its own: the host's */
+    CHECK(LF_CAMERA_LAMBDA_MIN_NM == LF_LAMBDA_MIN && LF_CAMERA_LAMBDA_MAX_NM == LF_LAMBDA_MAX);
     return lf_test_end();
 }

@@ -12,6 +12,10 @@
 
 #include "lf_camera.h"
 
+#ifndef M_PI /* strict ISO C does not define it */
+#define M_PI 3.14159265358979323846
+#endif
+
 typedef struct panorama {
     int width, height;
     double hfov_rad, vfov_rad;

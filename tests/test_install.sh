@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# test_install.sh BUILD_DIR - `cmake --install` gives a working lensfield:
+# the tools and man pages, the camera plugin header alone as strict C11,
+# the CMake package and the pkg-config file; the example plugin is built
+# against the installed package both ways and rendered by the installed
+# lfrender.
+set -u
+build=$(cd "$1" && pwd)
+src=$(cd "$(dirname "$0")/.." && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0 fail=0
+check() { # check DESCRIPTION COMMAND...
+    local what=$1; shift
+    if "$@" >"$tmp/out" 2>&1; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $what"; tail -20 "$tmp/out"; fi
+}
+prefix=$tmp/prefix
+check "cmake --install" cmake --install "$build" --prefix "$prefix"
+for t in lfrender lftool lflens lfgrade; do
+    check "installed $t" test -x "$prefix/bin/$t"
+done
+check "lflens --version from the install" sh -c "'$prefix/bin/lflens' --version | grep -q '^lflens [0-9]'"
+check "man page lflens.1" sh -c "grep -q '^.TH lflens 1' '$prefix/share/man/man1/lflens.1'"
+check "man page lists a flag" sh -c "grep -q 'aperture' '$prefix/share/man/man1/lflens.1'"
+check "installed header" test -f "$prefix/include/lensfield/lf_camera.h"
+printf '#include <lf_camera.h>\nint main(void) { lf_camera_sample s = {0}; return (int)s.film_x + (LF_CAMERA_ABI_VERSION > 0 ? 0 : 1); }\n' >"$tmp/alone.c"
+check "lf_camera.h alone as strict C11" cc -std=c11 -pedantic-errors -Wall -Werror -I"$prefix/include/lensfield" -c "$tmp/alone.c" -o "$tmp/alone.o"
+
+# The example plugin against the CMake package.
+mkdir -p "$tmp/plugin"
+cp "$src/tests/plugin/example_camera.c" "$tmp/plugin/"
+cat >"$tmp/plugin/CMakeLists.txt" <<'CMK'
+cmake_minimum_required(VERSION 3.18)
+project(panorama C)
+find_package(lensfield 0 REQUIRED)
+add_library(example_camera MODULE example_camera.c)
+target_link_libraries(example_camera PRIVATE lensfield::camera m)
+CMK
+check "configure a plugin with find_package(lensfield)" cmake -S "$tmp/plugin" -B "$tmp/plugin/build" -DCMAKE_PREFIX_PATH="$prefix"
+check "build the plugin" cmake --build "$tmp/plugin/build"
+so=$(ls "$tmp"/plugin/build/*example_camera*.so 2>/dev/null | head -1)
+# ... and with pkg-config.
+lib=$(ls -d "$prefix"/lib*/pkgconfig "$prefix"/lib/*/pkgconfig 2>/dev/null | head -1)
+check "pkg-config --cflags lensfield-camera" sh -c "PKG_CONFIG_PATH='$lib' pkg-config --cflags lensfield-camera | grep -q include/lensfield"
+check "build the plugin with pkg-config" sh -c "cc -std=c11 -shared -fPIC \$(PKG_CONFIG_PATH='$lib' pkg-config --cflags lensfield-camera) '$tmp/plugin/example_camera.c' -lm -o '$tmp/pkgconfig_camera.so'"
+
+cat >"$tmp/pano.pbrt" <<'PBRT'
+Camera "panorama"
+Film "rgb" "integer xresolution" [16] "integer yresolution" [8] "string filename" "pano.exr"
+Sampler "independent" "integer pixelsamples" [1]
+WorldBegin
+LightSource "infinite" "rgb L" [0.5 0.5 0.5]
+PBRT
+check "installed lfrender renders with the CMake-built plugin" "$prefix/bin/lfrender" --camera-plugin "${so:-missing.so}" "$tmp/pano.pbrt" -o "$tmp/pano.exr" --quiet
+check "installed lfrender renders with the pkg-config-built plugin" "$prefix/bin/lfrender" --camera-plugin "$tmp/pkgconfig_camera.so" "$tmp/pano.pbrt" -o "$tmp/pano2.exr" --quiet
+check "the render exists" test -s "$tmp/pano.exr"
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

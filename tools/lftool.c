@@ -22,15 +22,13 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include <arpa/inet.h>
 #include <limits.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include "image/lf_image.h"
 #include "lightfield/lf_lightfield.h"
+#include "web/lf_web.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
 
@@ -804,359 +802,40 @@ static int cmd_calibrate(const opts *o)
     return rc;
 }
 
-/* ---------- export-web and serve (docs/web.md) ---------- */
-
-/* Atlases stay within 4096 px a side: the texture size every WebGL 2
- * implementation in use supports (the spec's minimum is 2048). */
-enum { WEB_MAX_TEXTURE = 4096, WEB_SEARCH_STEPS = 25, WEB_DEPTH_STEPS = 33 };
-
-static int web_file_exists(const char *path)
-{
-    struct stat s;
-    return stat(path, &s) == 0 && S_ISREG(s.st_mode);
-}
-
-/* The page's hand-written files (index.html, lf.js) live in web/ of the
- * source tree, found from this file's compile-time path; $LF_WEB_DIR
- * overrides it, and an installed lftool looks next to its binary
- * (BIN/web, BIN/../share/lensfield/web). */
-static int web_find_assets(char *dir, size_t n)
-{
-    enum { LEN = PATH_MAX + 64 };
-    char cand[4][LEN];
-    int k = 0;
-    const char *env = getenv("LF_WEB_DIR");
-    if (env && *env)
-        snprintf(cand[k++], LEN, "%.*s", PATH_MAX, env);
-    const char *src = __FILE__, *tail = strstr(src, "tools/lftool.c");
-    if (tail)
-        snprintf(cand[k++], LEN, "%.*sweb", (int)(tail - src), src);
-    char exe[PATH_MAX];
-    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (len > 0) {
-        exe[len] = '\0';
-        char *slash = strrchr(exe, '/');
-        if (slash) {
-            *slash = '\0';
-            snprintf(cand[k++], LEN, "%s/web", exe);
-            snprintf(cand[k++], LEN, "%s/../share/lensfield/web", exe);
-        }
-    }
-    for (int i = 0; i < k; i++) {
-        char probe[LEN + 16];
-        snprintf(probe, sizeof probe, "%.*s/index.html", (int)LEN - 1, cand[i]);
-        if (web_file_exists(probe) && strlen(cand[i]) < n) {
-            snprintf(dir, n, "%s", cand[i]);
-            return 0;
-        }
-    }
-    fprintf(stderr, "lftool: export-web: cannot find the page's files (web/index.html, web/lf.js); set LF_WEB_DIR\n");
-    return EXIT_INPUT;
-}
-
-static long web_copy(const char *from, const char *to)
-{
-    char tmp[PATH_MAX + 8];
-    snprintf(tmp, sizeof tmp, "%s.tmp", to);
-    FILE *in = fopen(from, "rb"), *out = in ? fopen(tmp, "wb") : NULL;
-    long total = 0;
-    int ok = in && out;
-    char buf[65536];
-    size_t got;
-    while (ok && (got = fread(buf, 1, sizeof buf, in)) > 0) {
-        ok = fwrite(buf, 1, got, out) == got;
-        total += (long)got;
-    }
-    if (in && ferror(in))
-        ok = 0;
-    if (in)
-        fclose(in);
-    if (out && fclose(out))
-        ok = 0;
-    if (!ok || rename(tmp, to)) {
-        fprintf(stderr, "lftool: cannot copy %s to %s\n", from, to);
-        remove(tmp);
-        return -1;
-    }
-    return total;
-}
-
-/* Appends the file as a base64 data: URI string literal; returns its length. */
-static long web_put_data_uri(FILE *js, const char *path, const char *mime)
-{
-    static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "lftool: cannot read back %s\n", path);
-        return -1;
-    }
-    long n = fprintf(js, "\"data:%s;base64,", mime);
-    unsigned char in[3];
-    size_t got;
-    while ((got = fread(in, 1, 3, f)) > 0) {
-        unsigned v = (unsigned)in[0] << 16 | (got > 1 ? (unsigned)in[1] << 8 : 0) | (got > 2 ? in[2] : 0);
-        char q[4] = {b64[v >> 18 & 63], b64[v >> 12 & 63], got > 1 ? b64[v >> 6 & 63] : '=', got > 2 ? b64[v & 63] : '='};
-        fwrite(q, 1, 4, js);
-        n += 4;
-    }
-    fclose(f);
-    fputc('"', js);
-    return n + 1;
-}
-
-/* Writes img to a temporary file in dir and appends it to js as a data URI. */
-static int web_put_image(FILE *js, const char *dir, const char *name, const char *ext, const lf_image *img)
-{
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/.%s.%s", dir, name, ext);
-    int rc = write_image(path, img, NULL);
-    if (!rc && web_put_data_uri(js, path, strcmp(ext, "jpg") ? "image/png" : "image/jpeg") < 0)
-        rc = EXIT_INPUT;
-    remove(path);
-    return rc;
-}
-
-/* Disparity map over [d0, d1] in n slices (full aperture). */
-static int web_depth(const loaded *l, double d0, double d1, int n, lf_image *dm)
-{
-    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
-    lf_image af;
-    lf_error err = {0};
-    if (lf_lf_allfocus(&l->lf, &ro, d0, d1, n, &af, dm, &err)) {
-        fprintf(stderr, "lftool: export-web: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    lf_image_free(&af);
-    return 0;
-}
-
-/* The range of disparities in the picture: the 2nd..98th percentile of a
- * coarse depth estimate over a wide search range, padded by one step. */
-static void web_focus_range(const lf_image *dm, double d0, double d1, int n, double *q0, double *q1)
-{
-    size_t count[WEB_SEARCH_STEPS] = {0}, total = (size_t)dm->width * dm->height;
-    double step = (d1 - d0) / (n - 1);
-    for (size_t i = 0; i < total; i++) {
-        int k = (int)floor((dm->data[i] - d0) / step + 0.5);
-        count[k < 0 ? 0 : k >= n ? n - 1 : k]++;
-    }
-    size_t acc = 0;
-    int lo = -1, hi = n - 1;
-    for (int k = 0; k < n; k++) {
-        acc += count[k];
-        if (lo < 0 && acc > total / 50)
-            lo = k;
-        if (acc >= total - total / 50) {
-            hi = k;
-            break;
-        }
-    }
-    lo = lo > 0 ? lo - 1 : 0, hi = hi < n - 1 ? hi + 1 : n - 1;
-    if (hi - lo < 2)
-        lo = lo > 0 ? lo - 1 : lo, hi = hi < n - 1 ? hi + 1 : hi;
-    *q0 = d0 + lo * step, *q1 = d0 + hi * step;
-}
-
-/* Tiles n images of w x h into cols x rows (row-major from the top left). */
-static int web_atlas(const float *const *src, int n, int w, int h, int cols, lf_image *atlas)
-{
-    int rows = (n + cols - 1) / cols;
-    lf_error err = {0};
-    if (lf_image_alloc(atlas, cols * w, rows * h, 3, &err)) {
-        fprintf(stderr, "lftool: export-web: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    for (int k = 0; k < n; k++)
-        for (int t = 0; t < h; t++)
-            memcpy(lf_image_px(atlas, (k % cols) * w, (k / cols) * h + t), src[k] + (size_t)t * w * 3,
-                   sizeof(float) * 3 * (size_t)w);
-    return 0;
-}
+/* ---------- export-web and serve (web/lf_web.h, docs/web.md) ---------- */
 
 static int cmd_export_web(const opts *o)
 {
     int rc = need_output(o);
     if (rc)
         return rc;
-    char assets[PATH_MAX];
-    if ((rc = web_find_assets(assets, sizeof assets)))
-        return rc;
-    int stack_n = o->have_steps ? o->steps : 9;
-    if (stack_n < 2 || stack_n > 64)
-        return usage("%s", "export-web: --steps (focal-stack slices) must be 2..64");
     if (o->have_from != o->have_to)
         return usage("%s", "export-web: give both --from and --to, or neither");
-    const char *ext = o->format ? o->format : "jpg";
+    lf_web_export_opts wo = lf_web_export_defaults();
+    wo.format = o->format ? o->format : "jpg";
+    wo.stack_slices = o->have_steps ? o->steps : 9;
+    wo.have_range = o->have_from, wo.focus_min = o->from, wo.focus_max = o->to;
+    wo.threads = o->threads;
+    wo.source = o->input;
     loaded l;
     if ((rc = load(o, &l, 0)))
         return rc;
-    const lf_lightfield *lf = &l.lf;
-    if (lf->ns > WEB_MAX_TEXTURE || lf->nt > WEB_MAX_TEXTURE) {
-        fprintf(stderr, "lftool: %s: views of %d x %d exceed the page's %d px texture limit\n", o->input, lf->ns,
-                lf->nt, WEB_MAX_TEXTURE);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    for (int g = 0; g < 256; g++)
-        if (lf_srgb_encode(lf_srgb_decode((unsigned char)g)) != g) {
-            fprintf(stderr, "lftool: export-web: 8-bit sRGB round trip fails at %d\n", g);
-            unload(&l);
-            return EXIT_INPUT;
-        }
     clock_t c0 = clock();
-
-    /* focus range and per-pixel disparity (docs/lftool.md "Focal stack,
-     * all-in-focus, depth"); the page maps a click to the median around it */
-    double q0, q1;
-    lf_image dm = {0};
-    if (o->have_from) {
-        q0 = o->from, q1 = o->to;
-    } else {
-        double d0 = -1, d1 = 1; /* plenoptic: d = 0 at the focus distance */
-        if (lf->layout.kind == LF_LF_CAMERA_ARRAY)
-            d0 = 0, d1 = lf->disp_per_inv_m > 0 ? lf->disp_per_inv_m / 0.5 : 4; /* infinity .. 0.5 m */
-        if ((rc = web_depth(&l, d0, d1, WEB_SEARCH_STEPS, &dm))) {
-            unload(&l);
-            return rc;
-        }
-        web_focus_range(&dm, d0, d1, WEB_SEARCH_STEPS, &q0, &q1);
-        lf_image_free(&dm);
-    }
-    if (!(q1 > q0)) {
-        unload(&l);
-        return usage("%s", "export-web: --to must be above --from");
-    }
-    if ((rc = web_depth(&l, q0, q1, WEB_DEPTH_STEPS, &dm)) || (rc = make_dir(o->output))) {
-        lf_image_free(&dm);
-        unload(&l);
-        return rc;
-    }
-    /* 8-bit disparity: g = round((d - q0) / (q1 - q0) * 255), stored as a
-     * grey PNG whose sRGB encoding gives back exactly g */
-    lf_image grey = {dm.width, dm.height, 1, dm.data};
-    for (size_t i = 0; i < (size_t)dm.width * dm.height; i++) {
-        double g = floor((dm.data[i] - q0) / (q1 - q0) * 255 + 0.5);
-        dm.data[i] = lf_srgb_decode((unsigned char)(g < 0 ? 0 : g > 255 ? 255 : g));
-    }
-
-    char path[PATH_MAX], tmp[PATH_MAX + 8];
-    snprintf(path, sizeof path, "%s/data.js", o->output);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *js = fopen(tmp, "wb");
-    if (!js) {
-        fprintf(stderr, "lftool: cannot write %s: %s\n", tmp, strerror(errno));
-        lf_image_free(&dm);
+    lf_web_export_info info;
+    lf_error err = {0};
+    if (lf_web_export(&l.lf, o->output, &wo, &info, &err)) {
+        fprintf(stderr, "lftool: export-web: %s: %s\n", o->input, err.msg);
         unload(&l);
         return EXIT_INPUT;
     }
-    int nviews = lf->nu * lf->nv;
-    int cols = WEB_MAX_TEXTURE / lf->ns, rows_max = WEB_MAX_TEXTURE / lf->nt;
-    cols = cols > nviews ? nviews : cols;
-    /* as few atlases as fit, the views spread evenly over them: the page
-     * allocates every layer of its texture array at the largest atlas size */
-    int atlases = (nviews + cols * rows_max - 1) / (cols * rows_max);
-    int per = cols * (((nviews + atlases - 1) / atlases + cols - 1) / cols);
-    /* the input's file name, kept to what needs no escaping in a JS string */
-    char source[256];
-    const char *base = strrchr(o->input, '/') ? strrchr(o->input, '/') + 1 : o->input;
-    size_t sl = 0;
-    for (; base[sl] && sl < sizeof source - 1; sl++)
-        source[sl] = base[sl] >= ' ' && base[sl] < 127 && base[sl] != '"' && base[sl] != '\\' && base[sl] != '<'
-                         ? base[sl]
-                         : '_';
-    source[sl] = '\0';
-    fprintf(js,
-            "/* lensfield light field for the web page (lftool export-web; docs/web.md). */\n"
-            "window.LF_DATA = {\n  \"version\": 1, \"source\": \"%s\",\n"
-            "  \"nu\": %d, \"nv\": %d, \"ns\": %d, \"nt\": %d, \"dispVPerU\": %.9g,\n"
-            "  \"dispAtInf\": %.9g, \"dispPerInvM\": %.9g, \"focusMin\": %.9g, \"focusMax\": %.9g,\n"
-            "  \"views\": {\"cols\": %d, \"perAtlas\": %d, \"atlases\": [",
-            source, lf->nu, lf->nv, lf->ns, lf->nt,
-            lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0, lf->disp_at_inf, lf->disp_per_inv_m, q0, q1, cols, per);
-    const float **src = malloc(sizeof *src * (size_t)(nviews > stack_n ? nviews : stack_n));
-    if (!src)
-        rc = EXIT_INPUT;
-    for (int a = 0; a < atlases && !rc; a++) {
-        int n = nviews - a * per < per ? nviews - a * per : per;
-        for (int k = 0; k < n; k++)
-            src[k] = lf_lf_view(lf, (a * per + k) % lf->nu, (a * per + k) / lf->nu);
-        lf_image atlas;
-        if ((rc = web_atlas(src, n, lf->ns, lf->nt, cols, &atlas)))
-            break;
-        char name[32];
-        snprintf(name, sizeof name, "views%d", a);
-        fputs(a ? ",\n    " : "\n    ", js);
-        rc = web_put_image(js, o->output, name, ext, &atlas);
-        lf_image_free(&atlas);
-    }
-    if (!rc) {
-        fprintf(js, "]},\n  \"disparity\": {\"min\": %.9g, \"max\": %.9g, \"src\": ", q0, q1);
-        rc = web_put_image(js, o->output, "disparity", "png", &grey);
-    }
-    /* focal stack over the same range: the page's fallback without WebGL 2 */
-    lf_image *slices = rc ? NULL : calloc((size_t)stack_n, sizeof *slices);
-    if (!rc && !slices)
-        rc = EXIT_INPUT;
-    if (!rc) {
-        fprintf(js, "},\n  \"stack\": {\"disparities\": [");
-        lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
-        ro.threads = o->threads;
-        for (int k = 0; k < stack_n && !rc; k++) {
-            lf_error err = {0};
-            ro.disparity_px = q0 + (q1 - q0) * k / (stack_n - 1);
-            fprintf(js, "%s%.9g", k ? ", " : "", ro.disparity_px);
-            if (lf_lf_refocus(lf, &ro, &slices[k], &err)) {
-                fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-                rc = EXIT_INPUT;
-            }
-            src[k] = slices[k].data;
-        }
-        int scols = (int)ceil(sqrt((double)stack_n));
-        lf_image atlas;
-        if (!rc && !(rc = web_atlas(src, stack_n, lf->ns, lf->nt, scols, &atlas))) {
-            fprintf(js, "], \"cols\": %d, \"src\": ", scols);
-            rc = web_put_image(js, o->output, "stack", ext, &atlas);
-            lf_image_free(&atlas);
-        }
-        for (int k = 0; k < stack_n; k++)
-            lf_image_free(&slices[k]);
-    }
-    free(slices);
-    free(src);
-    if (!rc)
-        fprintf(js, "}\n};\n");
-    long data_bytes = ftell(js);
-    if (fclose(js) || rc || rename(tmp, path)) {
-        if (!rc)
-            fprintf(stderr, "lftool: cannot write %s\n", path);
-        remove(tmp);
-        lf_image_free(&dm);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    long page = data_bytes;
-    static const char *const files[] = {"index.html", "lf.js"};
-    for (int i = 0; i < 2 && !rc; i++) {
-        char from[PATH_MAX + 16];
-        snprintf(from, sizeof from, "%s/%s", assets, files[i]);
-        snprintf(path, sizeof path, "%s/%s", o->output, files[i]);
-        long n = web_copy(from, path);
-        if (n < 0)
-            rc = EXIT_INPUT;
-        page += n;
-    }
-    if (!rc)
-        printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
-               "(%.1f KiB, %.2f s CPU)\n",
-               o->input, lf->nu, lf->nv, lf->ns, lf->nt, q0, q1, stack_n, o->output, page / 1024.0,
-               (double)(clock() - c0) / CLOCKS_PER_SEC);
-    lf_image_free(&dm);
+    printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
+           "(%.1f KiB, %.2f s CPU)\n",
+           o->input, l.lf.nu, l.lf.nv, l.lf.ns, l.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
+           info.page_bytes / 1024.0, (double)(clock() - c0) / CLOCKS_PER_SEC);
     unload(&l);
-    return rc;
+    return EXIT_OK;
 }
 
-/* serve: a minimal static HTTP/1.0 server on 127.0.0.1, one request at a
- * time, for viewing an export over http:// rather than file://. */
 static volatile sig_atomic_t serve_stop;
 static void serve_on_signal(int sig)
 {
@@ -1164,139 +843,12 @@ static void serve_on_signal(int sig)
     serve_stop = 1;
 }
 
-static int serve_reply(int fd, const char *status, const char *type, long length)
-{
-    char hdr[512];
-    int n = snprintf(hdr, sizeof hdr,
-                     "HTTP/1.0 %s\r\nContent-Type: %s\r\nContent-Length: %ld\r\nCache-Control: no-cache\r\n"
-                     "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
-                     status, type, length);
-    return send(fd, hdr, (size_t)n, MSG_NOSIGNAL) < 0 ? -1 : 0;
-}
-
-static void serve_error(int fd, const char *status)
-{
-    if (!serve_reply(fd, status, "text/plain", (long)strlen(status) + 1))
-        send(fd, status, strlen(status), MSG_NOSIGNAL), send(fd, "\n", 1, MSG_NOSIGNAL);
-}
-
-static const char *serve_type(const char *path)
-{
-    static const char *const types[][2] = {{".html", "text/html; charset=utf-8"},
-                                           {".js", "text/javascript; charset=utf-8"},
-                                           {".css", "text/css"},
-                                           {".png", "image/png"},
-                                           {".jpg", "image/jpeg"},
-                                           {".json", "application/json"}};
-    const char *dot = strrchr(path, '.');
-    for (size_t i = 0; dot && i < sizeof types / sizeof types[0]; i++)
-        if (!strcmp(dot, types[i][0]))
-            return types[i][1];
-    return "application/octet-stream";
-}
-
-/* Decodes %XX; fails on NUL, backslash, a ".." segment or a bad escape. */
-static int serve_clean_path(const char *raw, char *out, size_t n)
-{
-    size_t k = 0;
-    for (const char *p = raw; *p && *p != '?' && *p != '#'; p++) {
-        int c = (unsigned char)*p;
-        if (c == '%') {
-            unsigned v;
-            if (!p[1] || !p[2] || sscanf(p + 1, "%2x", &v) != 1)
-                return -1;
-            c = (int)v, p += 2;
-        }
-        if (c == 0 || c == '\\' || k + 1 >= n)
-            return -1;
-        out[k++] = (char)c;
-    }
-    out[k] = '\0';
-    if (out[0] != '/')
-        return -1;
-    for (const char *s = out; (s = strstr(s, "..")) != NULL; s += 2)
-        if (s[-1] == '/' && (s[2] == '/' || s[2] == '\0'))
-            return -1;
-    return 0;
-}
-
-static void serve_one(int fd, const char *root)
-{
-    char req[8192];
-    size_t got = 0;
-    while (got < sizeof req - 1) {
-        ssize_t r = recv(fd, req + got, sizeof req - 1 - got, 0);
-        if (r <= 0)
-            break;
-        got += (size_t)r;
-        req[got] = '\0';
-        if (strstr(req, "\r\n\r\n") || strstr(req, "\n\n"))
-            break;
-    }
-    req[got] = '\0';
-    char method[8], target[4096], rel[4096], full[PATH_MAX * 2], real[PATH_MAX];
-    if (sscanf(req, "%7s %4095s", method, target) != 2) {
-        serve_error(fd, "400 Bad Request");
-        return;
-    }
-    int head = !strcmp(method, "HEAD");
-    if (!head && strcmp(method, "GET")) {
-        serve_error(fd, "405 Method Not Allowed");
-        return;
-    }
-    if (serve_clean_path(target, rel, sizeof rel)) {
-        serve_error(fd, "403 Forbidden");
-        return;
-    }
-    snprintf(full, sizeof full, "%s%s%s", root, rel, rel[strlen(rel) - 1] == '/' ? "index.html" : "");
-    /* the resolved file must lie inside the root (no symlink escapes either) */
-    size_t rootlen = strlen(root);
-    if (!realpath(full, real)) {
-        serve_error(fd, "404 Not Found");
-        return;
-    }
-    if (strncmp(real, root, rootlen) || real[rootlen] != '/') {
-        serve_error(fd, "403 Forbidden");
-        return;
-    }
-    FILE *f = fopen(real, "rb");
-    struct stat st;
-    if (!f || fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
-        if (f)
-            fclose(f);
-        serve_error(fd, "404 Not Found");
-        return;
-    }
-    int failed = serve_reply(fd, "200 OK", serve_type(real), (long)st.st_size);
-    char buf[65536];
-    size_t n;
-    while (!head && !failed && (n = fread(buf, 1, sizeof buf, f)) > 0)
-        if (send(fd, buf, n, MSG_NOSIGNAL) < 0)
-            break;
-    fclose(f);
-}
-
 static int cmd_serve(const opts *o)
 {
-    char root[PATH_MAX];
-    struct stat st;
-    if (!realpath(o->input, root) || stat(root, &st) || !S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "lftool: serve: %s is not a directory\n", o->input);
-        return EXIT_INPUT;
-    }
-    int s = socket(AF_INET, SOCK_STREAM, 0);
-    int one = 1;
-    struct sockaddr_in addr = {0};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons((uint16_t)o->port);
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK); /* never reachable from other machines */
-    socklen_t alen = sizeof addr;
-    if (s < 0 || setsockopt(s, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) ||
-        bind(s, (struct sockaddr *)&addr, sizeof addr) || listen(s, 16) ||
-        getsockname(s, (struct sockaddr *)&addr, &alen)) {
-        fprintf(stderr, "lftool: serve: cannot listen on 127.0.0.1:%d: %s\n", o->port, strerror(errno));
-        if (s >= 0)
-            close(s);
+    lf_web_server *srv;
+    lf_error err = {0};
+    if (lf_web_server_open(o->input, o->port, &srv, &err)) {
+        fprintf(stderr, "lftool: serve: %s\n", err.msg);
         return EXIT_INPUT;
     }
     struct sigaction sa = {0};
@@ -1304,24 +856,16 @@ static int cmd_serve(const opts *o)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", root, ntohs(addr.sin_port));
+    printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", lf_web_server_root(srv), lf_web_server_port(srv));
     fflush(stdout);
-    while (!serve_stop) {
-        int c = accept(s, NULL, NULL);
-        if (c < 0) {
-            if (errno == EINTR || errno == ECONNABORTED)
-                continue;
-            fprintf(stderr, "lftool: serve: accept: %s\n", strerror(errno));
-            close(s);
-            return EXIT_INPUT;
-        }
-        struct timeval tv = {5, 0}; /* a silent client cannot hold the server */
-        setsockopt(c, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-        setsockopt(c, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-        serve_one(c, root);
-        close(c);
+    int rc = LF_OK;
+    while (!serve_stop && (rc == LF_OK || rc == LF_ERR_INTERRUPTED))
+        rc = lf_web_server_serve_one(srv, &err);
+    lf_web_server_close(srv);
+    if (rc != LF_OK && rc != LF_ERR_INTERRUPTED) {
+        fprintf(stderr, "lftool: serve: %s\n", err.msg);
+        return EXIT_INPUT;
     }
-    close(s);
     printf("stopped\n");
     return EXIT_OK;
 }

@@ -187,7 +187,7 @@ double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, d
     switch (a->kind) {
     case LF_APERTURE_CIRCLE:
         /* rotation is meaningless for a circle; skipping it keeps pbrt's lens points */
-        lf_cam_concentric_disk(u, v, &px, &py);
+        lf_concentric_disk(u, v, &px, &py);
         *x = px * a->anamorphic;
         *y = py;
         return 1.0;

@@ -63,7 +63,7 @@ static inline __attribute__((always_inline)) void lf_aperture_sample_chunk(const
     if (a->kind == LF_APERTURE_CIRCLE) {
         const double ana = a->anamorphic;
         for (int i = 0; i < N; i++) {
-            lf_cam_concentric_disk(u[i], v[i], &x[i], &y[i]);
+            lf_concentric_disk(u[i], v[i], &x[i], &y[i]);
             x[i] *= ana;
             w[i] = 1.0;
         }

@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "../base/lf_math.h"
 #include "lf_camera.h"
 
 #ifndef M_PI
@@ -44,36 +45,6 @@ static inline void lf_cam_chunks(lf_cam_chunk_fn chunk, const void *state, int n
 {
     for (int i = 0; i < n; i += LF_CAM_CHUNK)
         chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
-}
-
-/* sin and cos of x for |x| <= pi/4 by their Taylor series through x^15
- * and x^16: the first omitted terms are below 5e-17, so the result is as
- * good as libm's here, with no call and no branch (loops over many samples
- * vectorise). */
-static inline void lf_cam_sincos_quarter(double x, double *s, double *c)
-{
-    double x2 = x * x;
-    *s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
-         x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0))))))));
-    *c = 1.0 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 + x2 * (-1.0 / 3628800 +
-         x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (1.0 / 20922789888000.0))))))));
-}
-
-/* Shirley-Chiu concentric mapping of [0,1)^2 onto the unit disk: area
- * preserving, so a uniform sample stays uniform and strata stay compact.
- * Written with selects instead of branches (same points as pbrt's form:
- * for |a| > |b| the angle is pi/4 b/a; otherwise pi/2 - pi/4 a/b, whose cos
- * and sin are the sin and cos of pi/4 a/b). */
-static inline void lf_cam_concentric_disk(double u, double v, double *x, double *y)
-{
-    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
-    int horizontal = fabs(a) > fabs(b);
-    double r = horizontal ? a : b, num = horizontal ? b : a;
-    double t = num / (r != 0.0 ? r : 1.0); /* r == 0 only at the centre, where num == 0 */
-    double sn, cs;
-    lf_cam_sincos_quarter((M_PI / 4.0) * t, &sn, &cs);
-    *x = r * (horizontal ? cs : sn);
-    *y = r * (horizontal ? sn : cs);
 }
 
 /* "string sensor" (named format) or "float sensorsize" [w h] mm; default

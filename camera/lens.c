@@ -15,6 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_math.h"
+
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
@@ -1103,25 +1105,6 @@ int lf_lens_pupil_contains(const lf_lens_pupil *P, double film_x, double film_y,
     return x >= bin->xlo[j] && x <= bin->xhi[j];
 }
 
-static void concentric_disk(double u, double v, double *x, double *y)
-{
-    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
-    if (a == 0.0 && b == 0.0) {
-        *x = *y = 0.0;
-        return;
-    }
-    double r, th;
-    if (fabs(a) > fabs(b)) {
-        r = a;
-        th = (M_PI / 4.0) * (b / a);
-    } else {
-        r = b;
-        th = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
-    }
-    *x = r * cos(th);
-    *y = r * sin(th);
-}
-
 /* The rear-plane point a camera ray is aimed at and its pdf (per mm^2); 0:
  * the film point gets no light.  Shared by the scalar and batch paths. */
 static inline double rear_point(const lf_lens_pupil *P, int use_bounds, double fx, double fy, double u, double v,
@@ -1130,7 +1113,7 @@ static inline double rear_point(const lf_lens_pupil *P, int use_bounds, double f
     if (use_bounds)
         return lf_lens_pupil_sample(P, fx, fy, u, v, rx, ry);
     double R = P->rear_disk_radius_mm;
-    concentric_disk(u, v, rx, ry);
+    lf_concentric_disk(u, v, rx, ry);
     *rx *= R, *ry *= R;
     return 1.0 / (M_PI * R * R);
 }

@@ -3,6 +3,8 @@
 #include "lens_poly.h"
 
 #include <math.h>
+
+#include "../base/lf_math.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -286,25 +288,6 @@ int lf_lens_poly_eval(const lf_lens_poly *P, double fx, double fy, double rx, do
     return 1;
 }
 
-static void concentric_disk(double u, double v, double *x, double *y)
-{
-    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
-    if (a == 0.0 && b == 0.0) {
-        *x = *y = 0.0;
-        return;
-    }
-    double r, th;
-    if (fabs(a) > fabs(b)) {
-        r = a;
-        th = (M_PI / 4.0) * (b / a);
-    } else {
-        r = b;
-        th = M_PI / 2.0 - (M_PI / 4.0) * (a / b);
-    }
-    *x = r * cos(th);
-    *y = r * sin(th);
-}
-
 double lf_lens_poly_sample_ray(const lf_lens *L, const lf_lens_poly *P, const lf_lens_pupil *pupil, int use_bounds,
                                double fx, double fy, double u, double v, lf_lens_stop_shape stop_shape,
                                const void *stop_ctx, lf_lens_ray *out)
@@ -318,7 +301,7 @@ double lf_lens_poly_sample_ray(const lf_lens *L, const lf_lens_poly *P, const lf
         /* Same samples as lf_lens_sample_ray; the polynomial is only valid
          * inside the bound, and nothing outside it gets through anyway. */
         double R = pupil->rear_disk_radius_mm;
-        concentric_disk(u, v, &rx, &ry);
+        lf_concentric_disk(u, v, &rx, &ry);
         rx *= R, ry *= R;
         pdf = 1.0 / (M_PI * R * R);
         if (!lf_lens_pupil_contains(pupil, fx, fy, rx, ry))

@@ -136,7 +136,7 @@ static double lightfield_generate_ray(const void *state, const lf_camera_sample 
     d[0] *= inv, d[1] *= inv, d[2] *= inv;
     if (c->lens_radius > 0.0) {
         double ux, uy;
-        lf_cam_concentric_disk(s->lens_u, s->lens_v, &ux, &uy);
+        lf_concentric_disk(s->lens_u, s->lens_v, &ux, &uy);
         double ft = c->focal_distance / d[2];
         double f[3] = {d[0] * ft, d[1] * ft, d[2] * ft}; /* relative to the data camera */
         double e[3] = {f[0] - ux * c->lens_radius, f[1] - uy * c->lens_radius, f[2]};

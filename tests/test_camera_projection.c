@@ -241,7 +241,7 @@ static void test_concentric_disk(void)
             ex = a * cos(M_PI / 4 * (b / a)), ey = a * sin(M_PI / 4 * (b / a));
         else
             ex = b * cos(M_PI / 2 - M_PI / 4 * (a / b)), ey = b * sin(M_PI / 2 - M_PI / 4 * (a / b));
-        lf_cam_concentric_disk(u, v, &x, &y);
+        lf_concentric_disk(u, v, &x, &y);
         double e = fmax(fabs(x - ex), fabs(y - ey));
         worst = e > worst ? e : worst;
     }

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# test_layers.sh BIN_DIR - the module layering holds (docs/design.md):
+# dependencies point down, checked on the sources' includes and on what the
+# tools link.
+set -u
+bin=$1
+cd "$(dirname "$0")/.."
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAILED: $*"; }
+# module -> folders it must not include from
+rules=(
+  "base:image camera render lightfield grade web tools"
+  "image:camera render lightfield grade web tools"
+  "camera:image render lightfield grade web tools"
+  "lightfield:camera render grade web tools"
+  "render:lightfield grade web tools"
+  "web:camera render grade tools"
+  "grade:web tools"
+)
+for rule in "${rules[@]}"; do
+  mod=${rule%%:*}
+  for other in ${rule#*:}; do
+    hits=$(grep -lE "#include \"(\.\./)?$other/" "$mod"/*.c "$mod"/*.h "$mod"/*.cpp 2>/dev/null)
+    if [ -n "$hits" ]; then bad "$mod/ includes from $other/: $hits"; else ok; fi
+  done
+done
+# Libraries never print to stdout/stderr or exit (only tools/ do).
+hits=$(grep -nE "\b(exit|abort)\(|\bprintf\(|fprintf\(std(out|err)|\bputs\(|perror\(" base/*.c image/*.c image/*.cpp camera/*.c render/*.c lightfield/*.c grade/*.c web/*.c 2>/dev/null | grep -v "^\s*//" )
+if [ -n "$hits" ]; then bad "a library prints or exits: $hits"; else ok; fi
+# The tools link only the layers they use.
+for t in lflens lftool; do
+  if ldd "$bin/$t" | grep -qi embree; then bad "$t links Embree"; else ok; fi
+done
+if ldd "$bin/lfrender" | grep -qi embree; then ok; else bad "lfrender does not link Embree?"; fi
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

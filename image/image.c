@@ -313,7 +313,7 @@ static const char *const float_exts[] = {"tif", "tiff", "hdr", "rgbe", "pfm", NU
 /* Linear floats -> 8-bit: exposure, clamp, sRGB curve.  Alpha (the last
  * channel of 2- and 4-channel images) is coverage, not light: it is only
  * clamped and quantised. */
-static unsigned char *tonemap_8bit(const lf_image *img, float exposure)
+static unsigned char *tonemap_8bit(const lf_image *img, float exposure, lf_tonemap op)
 {
     size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
     unsigned char *out = malloc(n ? n : 1);
@@ -328,7 +328,7 @@ static unsigned char *tonemap_8bit(const lf_image *img, float exposure)
             float a = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;
             out[i] = (unsigned char)(a * 255.0f + 0.5f);
         } else {
-            out[i] = lf_srgb_encode(v * scale);
+            out[i] = lf_srgb_encode(op == LF_TONEMAP_CLAMP ? v * scale : lf_tonemap_apply(op, v * scale));
         }
     }
     return out;
@@ -392,7 +392,7 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
     unsigned char *bytes = NULL;
     int as_float = is_exr || ext_is(ext, float_exts);
     if (!as_float) {
-        bytes = tonemap_8bit(img, opts->exposure);
+        bytes = tonemap_8bit(img, opts->exposure, opts->tonemap);
         if (!bytes)
             return lf_error_set(err, LF_ERR_NOMEM, "cannot write '%s': out of memory", path);
     }

@@ -75,11 +75,32 @@ int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16]);
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name);
 void lf_attrs_free(lf_attrs *a);
 
+/* Tone curves for 8-bit outputs, applied per channel after the exposure
+ * and before the sRGB transfer curve (docs/design.md "Output images"). */
+typedef enum lf_tonemap {
+    LF_TONEMAP_CLAMP = 0, /* min(x, 1): linear up to white */
+    LF_TONEMAP_FILMIC,    /* Hable's filmic curve (Uncharted 2), white point 11.2, exposure bias 2 */
+    LF_TONEMAP_ACES       /* Narkowicz's fit of the ACES reference rendering + sRGB display transform */
+} lf_tonemap;
+
 typedef struct lf_write_opts {
     int half;            /* EXR: store HALF instead of FLOAT */
     float exposure;      /* 8-bit outputs: multiply by 2^exposure before tonemapping */
     int allow_nonfinite; /* write NaN/Inf instead of failing */
+    lf_tonemap tonemap;  /* 8-bit outputs: the tone curve (default clamp) */
 } lf_write_opts;
+
+/* The tone curve alone: linear scene value (after exposure) -> linear
+ * display value in [0, 1]. */
+float lf_tonemap_apply(lf_tonemap op, float x);
+/* "clamp", "filmic", "aces" -> 0 and *op; -1 for another name. */
+int lf_tonemap_parse(const char *name, lf_tonemap *op);
+
+/* A scalar image (channel 0 of src) as a colour picture: values in [lo, hi]
+ * through the viridis colour map (NaN/Inf grey), with a legend strip below
+ * (the colour bar and the range's two ends written in digits), as linear
+ * RGB ready for an 8-bit writer.  For depth and disparity maps. */
+int lf_image_colormap(const lf_image *src, double lo, double hi, lf_image *out, lf_error *err);
 
 /* Format from the extension (.exr, .png, .jpg, .tif, .hdr, .pfm ...).
  * opts may be NULL.  attrs may be NULL; formats without headers drop them. */

@@ -11,6 +11,8 @@
  *   lftool export-web RAW.exr -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]
  *   lftool serve DIR [--port P]
  *
+ * RAW may also be a folder of views (HCI layout or PREFIX_RR_CC names).
+ *
  * Exit codes: 0 ok, 1 bad input (the message names the file and what is
  * missing or wrong), 2 usage.
  */
@@ -58,7 +60,10 @@ static const char *usage_text =
     "  --kind camera-array|plenoptic --camsperdim NX NY --griddim MINX MAXX MINY MAXY --inputfov DEG\n"
     "  --tilesize W H --grid square|hex --pitch PX --rotation RAD --offset X Y --lenscount NX NY\n"
     "  --mainlens FOCAL_MM FSTOP MLA_DISTANCE_MM MICROLENS_PITCH_UM\n"
-    "other: --threads N, --allow-nonfinite (treat NaN/Inf raw pixels as missing samples), --help\n";
+    "other: --threads N, --allow-nonfinite (treat NaN/Inf raw pixels as missing samples), --help\n"
+    "every RAW.exr / LF.exr may also be a folder of views (docs/lightfield-format.md): the HCI layout\n"
+    "  (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC[...].png|exr (row, column; from 0 or 1);\n"
+    "  decode --layout hci writes the HCI layout (with gt_disp_lowres.pfm when the raw has disparity)\n";
 
 /* ---------- flags ---------- */
 

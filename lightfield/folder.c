@@ -602,7 +602,7 @@ int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *di
     fprintf(f, "image_resolution_x_px = %d\nimage_resolution_y_px = %d\n", lf->ns, lf->nt);
     fprintf(f, "\n[extrinsics]\nnum_cams_x = %d\nnum_cams_y = %d\n", lf->nu, lf->nv);
     if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_BOUNDS) && lf->nu > 1)
-        fprintf(f, "baseline_mm = %.9g\n", 1000 * (y->grid_bounds[1] - y->grid_bounds[0]) / (lf->nu - 1));
+        fprintf(f, "baseline_mm = %.7g\n", 1000 * (y->grid_bounds[1] - y->grid_bounds[0]) / (lf->nu - 1));
     if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_CONVERGENCE))
         fprintf(f, "focus_distance_m = %.9g\n", y->convergence_m);
     fprintf(f, "\n[meta]\nsource = lensfield (lftool decode --layout hci)\n");

@@ -123,6 +123,23 @@ int main(void)
     CHECK(run("%s decode %s -o %s --format exr", LFTOOL, hci, rc_dir) == 0);
     CHECK(run("%s info %s", LFTOOL, rc_dir) == 0); /* view_RR_CC.exr read back */
     CHECK(strstr(out_text, "folder of 3 x 3 views") && strstr(out_text, "row/column"));
+    /* row/column folders carry no geometry: the layout flags give it */
+    CHECK(run("%s refocus %s --depth 2 -o %s/r3.exr", LFTOOL, rc_dir, dir) == 1);
+    CHECK(strstr(out_text, "--griddim") != NULL);
+    CHECK(run("%s info %s --griddim -0.05 0.05 -0.05 0.05 --inputfov 40", LFTOOL, rc_dir) == 0);
+    {
+        char want[64];
+        snprintf(want, sizeof want, "0 + %.6g / depth", 8 / tan(20 * M_PI / 180) * 0.05);
+        CHECK_MSG(strstr(out_text, want) != NULL, "%s lacks %s", out_text, want);
+    }
+    CHECK(run("%s info %s --camsperdim 2 2", LFTOOL, rc_dir) == 1);
+    CHECK(strstr(out_text, "--camsperdim") != NULL);
+    /* a disparity map written as PFM by the generic image path */
+    CHECK(run("%s depth %s --from 0 --to 1 --steps 5 -o %s/d.pfm", LFTOOL, hci, dir) == 0);
+    lf_image dm;
+    snprintf(path, sizeof path, "%s/d.pfm", dir);
+    CHECK(lf_image_read(path, &dm, NULL, &err) == 0 && dm.width == 24 && dm.height == 16 && dm.channels == 1);
+    lf_image_free(&dm);
 
     /* a missing view and an unreadable one: exit 1, the file named */
     snprintf(path, sizeof path, "%s/input_Cam005.png", hci);

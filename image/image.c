@@ -308,7 +308,7 @@ static int ext_is(const char *ext, const char *const *list)
 }
 
 /* Formats OpenImageIO stores as float; every other format gets 8-bit sRGB. */
-static const char *const float_exts[] = {"tif", "tiff", "hdr", "rgbe", "pfm", NULL};
+static const char *const float_exts[] = {"tif", "tiff", "hdr", "rgbe", NULL};
 
 /* Linear floats -> 8-bit: exposure, clamp, sRGB curve.  Alpha (the last
  * channel of 2- and 4-channel images) is coverage, not light: it is only
@@ -369,7 +369,10 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
     const char *ext = path_extension(path);
     if (!*ext)
         return lf_error_set(err, LF_ERR_PARAM, "cannot write '%s': no file extension to choose a format", path);
-    int is_exr = strcasecmp(ext, "exr") == 0;
+    int is_exr = strcasecmp(ext, "exr") == 0, is_pfm = strcasecmp(ext, "pfm") == 0;
+    if (is_pfm && img->channels != 1 && img->channels != 3)
+        return lf_error_set(err, LF_ERR_UNSUPPORTED, "cannot write '%s': PFM holds 1 or 3 channels, the image has %d",
+                            path, img->channels);
 
     if (!opts->allow_nonfinite) {
         size_t first, bad = count_beyond(img, INFINITY, &first);
@@ -390,7 +393,7 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
     /* Convert before touching the file system, so running out of memory
      * leaves no temporary file behind. */
     unsigned char *bytes = NULL;
-    int as_float = is_exr || ext_is(ext, float_exts);
+    int as_float = is_exr || is_pfm || ext_is(ext, float_exts);
     if (!as_float) {
         bytes = tonemap_8bit(img, opts->exposure, opts->tonemap);
         if (!bytes)
@@ -405,6 +408,8 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
     }
     if (is_exr)
         rc = lf_exr_write(tmp, path, img, attrs, opts->half, err);
+    else if (is_pfm)
+        rc = lf_pfm_write(tmp, path, img, err);
     else if (as_float)
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_FLOAT, img->data, err);
     else
@@ -531,6 +536,8 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
         rc = lf_exr_read(path, path, &tmp, attrs ? &tmp_attrs : NULL, err);
     } else if (strcasecmp(path_extension(path), "exr") == 0) {
         rc = lf_error_set(err, LF_ERR_PARSE, "cannot read '%s': not an OpenEXR file (bad magic number)", path);
+    } else if (got >= 2 && magic[0] == 'P' && (magic[1] == 'F' || magic[1] == 'f')) {
+        rc = lf_pfm_read(path, path, &tmp, err);
     } else {
         rc = (size_t)got >= 4 && memcmp(magic, png_signature, 4) == 0 ? png_check(path, err) : LF_OK;
         lf_oiio_read_info info = {0, -1};

@@ -29,6 +29,11 @@ int lf_exr_write(const char *file, const char *name, const lf_image *img, const 
                  lf_error *err);
 int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *attrs, lf_error *err);
 
+/* PFM (pfm.c): 1 or 3 float channels, rows bottom-up in the file, either
+ * byte order on read (the scale's sign), little-endian on write. */
+int lf_pfm_write(const char *file, const char *name, const lf_image *img, lf_error *err);
+int lf_pfm_read(const char *file, const char *name, lf_image *img, lf_error *err);
+
 /* 1 if the first bytes of a file are the EXR magic number. */
 int lf_exr_is_exr_magic(const unsigned char *bytes, size_t n);
 

@@ -4,6 +4,8 @@
  * row 0 at the top.  Files:
  *   - EXR (OpenEXRCore): linear float (or half) RGB/RGBA/Y, with typed header
  *     attributes - lensfield writes its own as "lensfield:<key>".
+ *   - PFM (pfm.c): 1 or 3 float channels, rows stored bottom-up, either
+ *     byte order read (the scale's sign), little-endian written.
  *   - PNG, JPEG, TIFF, HDR, ... (OpenImageIO, behind image/oiio_adapter.cpp):
  *     8-bit outputs are tonemapped: exposure, clamp, sRGB transfer curve.
  * Writes are atomic: data goes to a temporary file beside the target, which

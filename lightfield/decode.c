@@ -228,7 +228,7 @@ static int hex_to_rect(const lf_lightfield *h, lf_lightfield *r, lf_error *err)
     return LF_OK;
 }
 
-static void geometry(lf_lightfield *lf, const lf_lf_layout *l)
+void lf_lf_set_geometry(lf_lightfield *lf, const lf_lf_layout *l)
 {
     lf->layout = *l;
     lf->disp_v_per_u = 1.0;
@@ -241,11 +241,23 @@ static void geometry(lf_lightfield *lf, const lf_lf_layout *l)
             lf->disp_per_inv_m = fpx * b;
             if (bx > 0 && by > 0)
                 lf->disp_v_per_u = by / bx;
+            /* sensors shifted so that disparity vanishes at the convergence depth (HCI) */
+            if ((l->have & LF_LF_HAVE_CONVERGENCE) && l->convergence_m > 0)
+                lf->disp_at_inf = -lf->disp_per_inv_m / l->convergence_m;
         }
     } else if (l->have & LF_LF_HAVE_MAIN_LENS) {
         double f = l->main_focal_mm * 1e-3, F = l->mla_distance_mm * 1e-3;
         double du = f / (2 * l->main_fstop) * 2 / l->pitch_px; /* lens metres per one-pixel view step */
         double k = du / (l->pitch_um * 1e-6);
+        /* Exact when the microlens focal length is known (docs/lightfield-format.md,
+         * "Disparity"): a pixel offset of one pixel under a microlens sees the main
+         * lens (z_i / d) pixels away, and microlens images are P = p (z_i + d) / z_i
+         * pixels apart, so k = (pixel z_i / d) / p = (z_i + d) / (d P) (d: microlens
+         * to sensor).  The aperture-based estimate above equals it for matched
+         * f-numbers up to a factor z_i / (z_i + d). */
+        double d = (l->microlens_focal_mm + l->sensor_offset_mm) * 1e-3;
+        if (l->microlens_focal_mm > 0 && d > 0 && F > 0)
+            k = (F + d) / (d * l->pitch_px);
         lf->disp_per_alpha = k;
         lf->disp_at_inf = k * (1 - F / f);
         lf->disp_per_inv_m = k * F;
@@ -328,7 +340,7 @@ int lf_lf_decode(const lf_image *raw, const lf_lf_layout *l, const lf_image *whi
     *lf = a;
     lf->missing = count_missing(lf);
     lf->nonfinite = nonfinite;
-    geometry(lf, l);
+    lf_lf_set_geometry(lf, l);
     return LF_OK;
 }
 

@@ -152,6 +152,19 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
     n += attr_num(a, "lensfield:microlens_pitch_um", &lay->pitch_um, err) > 0;
     attr_num(a, "lensfield:focus_distance_m", &lay->focus_distance_m, err);
     attr_num(a, "lensfield:microlens_focal_mm", &lay->microlens_focal_mm, err);
+    attr_num(a, "lensfield:sensor_offset_mm", &lay->sensor_offset_mm, err);
+    if (!(isfinite(lay->microlens_focal_mm) && lay->microlens_focal_mm >= 0 && lay->microlens_focal_mm < 1e6 &&
+          isfinite(lay->sensor_offset_mm) && fabs(lay->sensor_offset_mm) < 1e6))
+        lay->microlens_focal_mm = 0, lay->sensor_offset_mm = 0;
+    double rng[2];
+    if ((r = attr_vec(a, "lensfield:disparity_range", 2, rng, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r && finite_within(rng, 2, 1e9) && rng[0] <= rng[1])
+        lay->disp_min = rng[0], lay->disp_max = rng[1], lay->have |= LF_LF_HAVE_DISP_RANGE;
+    if ((r = attr_num(a, "lensfield:convergence_distance", &lay->convergence_m, err)) < 0)
+        return err ? err->code : LF_ERR_PARSE;
+    if (r && isfinite(lay->convergence_m) && lay->convergence_m > 0)
+        lay->have |= LF_LF_HAVE_CONVERGENCE;
     if (err && err->code)
         return err->code;
     if (n == 4)
@@ -302,6 +315,8 @@ int lf_lf_layout_to_attrs(const lf_lf_layout *lay, lf_attrs *a, lf_error *err)
             r |= lf_attrs_set_double(a, "lensfield:fov_deg", lay->fov_deg);
         v[0] = (float)lay->tile_w, v[1] = (float)lay->tile_h;
         r |= lf_attrs_set_floats(a, "lensfield:tile_size", v, 2);
+        if (lay->have & LF_LF_HAVE_CONVERGENCE)
+            r |= lf_attrs_set_double(a, "lensfield:convergence_distance", lay->convergence_m);
     } else if (lay->kind == LF_LF_PLENOPTIC) {
         r |= lf_attrs_set_string(a, "lensfield:kind", "plenoptic");
         r |= lf_attrs_set_string(a, "lensfield:grid", lay->grid == LF_LF_GRID_HEX ? "hex" : "square");
@@ -318,11 +333,27 @@ int lf_lf_layout_to_attrs(const lf_lf_layout *lay, lf_attrs *a, lf_error *err)
             r |= lf_attrs_set_double(a, "lensfield:microlens_pitch_um", lay->pitch_um);
         }
     }
+    if (lay->have & LF_LF_HAVE_DISP_RANGE) {
+        v[0] = (float)lay->disp_min, v[1] = (float)lay->disp_max;
+        r |= lf_attrs_set_floats(a, "lensfield:disparity_range", v, 2);
+    }
     return r ? lf_error_set(err, LF_ERR_NOMEM, "out of memory writing layout attributes") : LF_OK;
 }
 
+static void describe_kind(const lf_lf_layout *l, char *buf, size_t n);
+
 void lf_lf_layout_describe(const lf_lf_layout *l, char *buf, size_t n)
 {
+    describe_kind(l, buf, n);
+    size_t k = strlen(buf);
+    if ((l->have & LF_LF_HAVE_DISP_RANGE) && k < n)
+        snprintf(buf + k, n - k, "disparity range %g .. %g px per view step\n", l->disp_min, l->disp_max);
+}
+
+static void describe_kind(const lf_lf_layout *l, char *buf, size_t n)
+{
+    if (n)
+        buf[0] = '\0';
     if (l->kind == LF_LF_CAMERA_ARRAY) {
         int k = snprintf(buf, n, "kind camera-array\ngrid %d x %d cameras\nviews %d\nview resolution %d x %d\n",
                          l->cams_x, l->cams_y, l->cams_x * l->cams_y, l->tile_w, l->tile_h);
@@ -332,8 +363,10 @@ void lf_lf_layout_describe(const lf_lf_layout *l, char *buf, size_t n)
         if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_FOV))
             k += snprintf(buf + k, n - (size_t)k, "fov %g deg\n", l->fov_deg);
         if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_CAM_LENS))
-            snprintf(buf + k, n - (size_t)k, "data camera lens radius %g, focal distance %g\n", l->lens_radius,
-                     l->focal_distance);
+            k += snprintf(buf + k, n - (size_t)k, "data camera lens radius %g, focal distance %g\n", l->lens_radius,
+                          l->focal_distance);
+        if (k > 0 && (size_t)k < n && (l->have & LF_LF_HAVE_CONVERGENCE))
+            k += snprintf(buf + k, n - (size_t)k, "sensors shifted: disparity 0 at depth %g\n", l->convergence_m);
     } else {
         int views = 2 * (int)floor((l->pitch_px - 1) / 2) + 1;
         int nt = l->grid == LF_LF_GRID_HEX ? (int)floor((l->lens_y - 1) * sqrt(3.0) / 2) + 1 : l->lens_y;

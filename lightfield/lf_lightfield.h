@@ -57,7 +57,9 @@ enum {
     LF_LF_HAVE_ROTATION = 1u << 8,    /* rotation_rad */
     LF_LF_HAVE_OFFSET = 1u << 9,      /* offset_px */
     LF_LF_HAVE_LENS_COUNT = 1u << 10, /* lens_x, lens_y */
-    LF_LF_HAVE_MAIN_LENS = 1u << 11   /* main_focal_mm, main_fstop, mla_distance_mm, pitch_um */
+    LF_LF_HAVE_MAIN_LENS = 1u << 11,  /* main_focal_mm, main_fstop, mla_distance_mm, pitch_um */
+    LF_LF_HAVE_DISP_RANGE = 1u << 12, /* disp_min, disp_max */
+    LF_LF_HAVE_CONVERGENCE = 1u << 13 /* convergence_m */
 };
 
 typedef struct lf_lf_layout {
@@ -68,12 +70,16 @@ typedef struct lf_lf_layout {
     double grid_bounds[4]; /* minx maxx miny maxy on the z = 0 plane */
     double fov_deg;        /* per data camera, across the tile's shorter side */
     int tile_w, tile_h;
+    double convergence_m;  /* sensors shifted so that disparity is 0 at this depth (HCI); 0: parallel */
     double lens_radius, focal_distance;
     /* plenoptic (Ng 2005) */
     lf_lf_grid grid;
     double pitch_px, rotation_rad, offset_px[2];
     int lens_x, lens_y;
     double pitch_um, microlens_focal_mm, main_focal_mm, main_fstop, focus_distance_m, mla_distance_mm;
+    double sensor_offset_mm; /* plenoptic: sensor behind the microlens focal plane (0: plenoptic 1.0) */
+    /* any kind: the scene's disparity range (px per view step) when the data says it */
+    double disp_min, disp_max;
 } lf_lf_layout;
 
 void lf_lf_layout_init(lf_lf_layout *lay);
@@ -192,6 +198,57 @@ lf_lf_synth_opts lf_lf_synth_defaults(void);
  * uncovered (may be NULL) gets the count of pixels with no covered sample. */
 int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *out, lf_image *coverage,
                 size_t *uncovered, lf_error *err);
+
+/* Folders of views (docs/lightfield-format.md, "Folders of views"):
+ *   - HCI benchmark layout: input_CamNNN.<ext>, NNN = row * num_cams_x + column
+ *     from the top-left view, with parameters.cfg (optional when the view
+ *     count is a square or the flags give the grid);
+ *   - views named <prefix>_RR_CC<suffix>.<ext> (row, column, 0- or 1-based;
+ *     the last pair of all-digit '_' fields), e.g. decoded Lytro captures
+ *     scene_05_07.png and the Stanford archive's out_05_07_-3.1_11.2.png.
+ * Views are PNG (8/16-bit, sRGB decoded to linear), EXR, TIFF or PFM.
+ *
+ *   lf_lf_folder f; lf_lightfield lf;
+ *   if (lf_lf_is_folder(path)) {
+ *       lf_lf_folder_scan(path, &f, &err);            // names and parameters.cfg only
+ *       lf_lf_folder_load(&f, &flags, &lf, &err);      // reads every view
+ *       lf_lf_folder_free(&f);
+ *   }
+ */
+typedef enum lf_lf_folder_kind { LF_LF_FOLDER_HCI = 1, LF_LF_FOLDER_ROWCOL } lf_lf_folder_kind;
+typedef struct lf_lf_folder {
+    lf_lf_folder_kind kind;
+    char *dir;
+    int nu, nv;      /* views per row, per column */
+    int base;        /* ROWCOL: index of the first row and column (0 or 1) */
+    char **files;    /* nu * nv paths; view (iu, iv) at iv * nu + iu */
+    lf_lf_layout layout; /* what the folder says: camera array, cams, tile size when cfg gives it, ... */
+    int cfg_w, cfg_h;    /* image_resolution_x/y_px of parameters.cfg (0: not given) */
+    double focal_mm, sensor_mm; /* parameters.cfg focal_length_mm, sensor_size_mm (longer side); 0: not given */
+    char *gt_disparity;  /* gt_disp_lowres.pfm beside the views, or NULL */
+    char pattern[256];   /* how views are named, for messages: "input_Cam%03d.png", "scene_RR_CC.png" */
+} lf_lf_folder;
+
+int lf_lf_is_folder(const char *path);
+/* Lists the views and reads parameters.cfg.  Fails (LF_ERR_PARSE / LF_ERR_IO)
+ * naming the missing view files, or the cfg line that is wrong. */
+int lf_lf_folder_scan(const char *dir, lf_lf_folder *f, lf_error *err);
+/* Reads every view into *lf (same layout as lf_lf_decode gives), merges the
+ * folder's layout with flags as lf_lf_layout_resolve does, sets the
+ * geometry.  Views must all be readable and of one size; errors name the
+ * file(s).  Non-finite values become missing samples (lf->nonfinite). */
+int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_lightfield *lf, lf_error *err);
+void lf_lf_folder_free(lf_lf_folder *f);
+/* Writes the HCI layout: input_CamNNN.png (8-bit sRGB), parameters.cfg
+ * (camera arrays: focal length, sensor size, baseline; disparity range when
+ * known) and, when disparity is given (the centre view's, 1 channel),
+ * gt_disp_lowres.pfm.  Camera arrays only need cams; the cfg gets what the
+ * layout knows. */
+int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err);
+
+/* Fills the geometry fields of lf (disp_per_inv_m, ...) from lf->layout's
+ * values: lf_lf_decode and lf_lf_folder_load call it. */
+void lf_lf_set_geometry(lf_lightfield *lf, const lf_lf_layout *lay);
 
 /* Microlens-grid estimate from a white plenoptic image: pitch, rotation,
  * offset, square or hex (peak detection + lattice fit).  Sets kind, grid,

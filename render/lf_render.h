@@ -71,6 +71,14 @@ char *lf_renderer_explain(const lf_renderer *r);
  * with lensfield:* attributes.  Samples whose radiance is NaN/Inf are
  * dropped and counted (lensfield:nonfinite_samples, lf_renderer_stats). */
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err);
+/* Ground-truth disparity AOV of a light-field camera (docs/lightfield-format.md,
+ * "Disparity AOV"): one channel, the crop window's size; per pixel the
+ * disparity (px per view step) of the first surface hit by the centre-view
+ * ray of the pixel's view (camera array: its data camera's ray through the
+ * pixel centre; plenoptic: the chief ray of the pixel's microlens), at the
+ * shutter's opening.  No hit: the disparity at infinity.  LF_ERR_PARAM for
+ * cameras that are not light-field cameras. */
+int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err);
 /* Merges part files written with opts.part (sample ranges and/or row bands
  * of the same scene and settings) into the image an unsplit render gives,
  * bit for bit: parts carry exact fixed-point sums.  Checks that the parts

@@ -246,6 +246,25 @@ void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit);
 /* Origin offset off a surface to avoid self-intersection, on the side of w. */
 lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w);
 
+/* ---- ground-truth disparity of light-field cameras (render/disparity.c) ---- */
+typedef struct lf_disparity_geom {
+    int kind; /* LF_LF_CAMERA_ARRAY_KIND or LF_LF_PLENOPTIC_KIND */
+    int xres, yres;
+    double a, b; /* d = a + b / Z */
+    /* camera array */
+    int nx, ny, tw, th;
+    double bounds[4], tan_half, screen[4], sx, sy;
+    /* plenoptic */
+    int hex, lx, ly;
+    double pitch_px, row_px, cos_r, sin_r, origin[2], slope_per_px;
+    double fmla_mm, sensor_offset_mm, zi_mm, f_mm;
+} lf_disparity_geom;
+enum { LF_LF_CAMERA_ARRAY_KIND = 1, LF_LF_PLENOPTIC_KIND = 2 };
+/* From the camera's lensfield:* attributes; LF_ERR_PARAM for other cameras. */
+int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparity_geom *g, lf_error *err);
+/* Centre-view ray (camera space, unit direction) for the film point (fx, fy). */
+void lf_disparity_centre_ray(const lf_disparity_geom *g, double fx, double fy, double o[3], double d[3]);
+
 /* ---- integrator (render/integrator.c) ---- */
 /* How next-event estimation picks lights ("string lightsampler"). */
 typedef enum lf_light_sampler {

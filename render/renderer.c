@@ -943,6 +943,52 @@ static void sink_doubles(void *ctx, const char *name, const double *v, int n)
     lf_attrs_set_floats(ctx, name, tmp, n);
 }
 
+int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    lf_attrs meta = {0};
+    if (r->camera_type->metadata) {
+        lf_camera_attr_sink sink = {&meta, sink_string, sink_int, sink_double, sink_doubles};
+        r->camera_type->metadata(r->camera, &sink);
+    }
+    lf_disparity_geom g;
+    int rc = lf_disparity_geom_init(&meta, r->xres, r->yres, &g, err);
+    lf_attrs_free(&meta);
+    if (rc)
+        return rc;
+    if ((rc = lf_image_alloc(out, r->px1 - r->px0, r->py1 - r->py0, 1, err)))
+        return rc;
+    /* the scene and camera as they are when the shutter opens */
+    double tau = r->time1 > r->time0 ? (r->shutter_open - r->time0) / (r->time1 - r->time0) : 0;
+    tau = tau < 0 ? 0 : tau > 1 ? 1 : tau;
+    lf_transform moving;
+    const lf_transform *c2w = &r->camera_to_world;
+    if (r->camera_moving) {
+        lf_motion_pair_matrix(&r->camera_motion, tau, moving.m);
+        c2w = &moving;
+    }
+    for (int y = r->py0; y < r->py1; y++)
+        for (int x = r->px0; x < r->px1; x++) {
+            double o[3], d[3];
+            lf_disparity_centre_ray(&g, x + 0.5, y + 0.5, o, d);
+            lf_dvec3 ow = lf_xform_point_d(c2w, (lf_dvec3){o[0], o[1], o[2]});
+            lf_dvec3 dw = lf_xform_vector_d(c2w, (lf_dvec3){d[0], d[1], d[2]});
+            double len = sqrt(dw.x * dw.x + dw.y * dw.y + dw.z * dw.z);
+            lf_hit hit;
+            float disp = (float)g.a; /* nothing hit: infinitely far */
+            if (lf_scene_intersect(&r->scene, lf_v3((float)ow.x, (float)ow.y, (float)ow.z),
+                                   lf_v3((float)(dw.x / len), (float)(dw.y / len), (float)(dw.z / len)), INFINITY,
+                                   (float)tau, &hit)) {
+                /* world distance / |M d| = camera-space distance along the unit d */
+                double z = o[2] + hit.t / len * d[2];
+                if (z > 0)
+                    disp = (float)(g.a + g.b / z);
+            }
+            out->data[(size_t)(y - r->py0) * out->width + (x - r->px0)] = disp;
+        }
+    return LF_OK;
+}
+
 static double now_seconds(void)
 {
     struct timespec ts;

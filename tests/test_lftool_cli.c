@@ -113,7 +113,7 @@ int main(void)
     /* decode: one file per view plus a mosaic; png; HCI layout */
     snprintf(out, sizeof out, "%s/views", dir);
     CHECK(run("%s decode %s -o %s", LFTOOL, raw_path, out) == 0);
-    snprintf(path, sizeof path, "%s/view_02_01.exr", out);
+    snprintf(path, sizeof path, "%s/view_01_02.exr", out); /* row 1, column 2 */
     lf_image v;
     CHECK(lf_image_read(path, &v, NULL, &err) == 0);
     CHECK(v.width == TW && v.height == TH);

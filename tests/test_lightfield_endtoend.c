@@ -150,12 +150,16 @@ int main(void)
     double f = F_MM * 1e-3, zi = f * FOCUS_M / (FOCUS_M - f), alpha = 1 / (zi * (1 / f - 1 / ZA));
     CHECK(lf_lf_alpha_to_disparity(&lf, alpha, &disp_alpha, &err) == 0);
     CHECK_MSG(fabs(disp - disp_alpha) < 1e-9, "depth -> disparity %.9g, alpha %.6g -> %.9g", disp, alpha, disp_alpha);
-    /* expected disparity per view step, from the design: the views split the
-     * aperture D over the 15 pixels of an image; a view step is D/15 on the
-     * lens, and a point at alpha z_i shifts by (1 - 1/alpha) D/15 on the MLA,
-     * in microlens pitches p */
+    /* expected disparity per view step, from the design: a pixel one pixel
+     * (Pm / 15 on the sensor) off a microlens image's centre sees, through the
+     * microlens centre, the main lens z_i / f_mla times as far off its centre:
+     * a view step is (Pm / 15) z_i / f_mla = (D + p) / 15 on the lens (matched
+     * f-numbers: Pm = p (1 + p / D), f_mla = p z_i / D; the aperture's image
+     * alone is D / (D + p) of the 15 pixels), and a point at alpha z_i shifts
+     * by (1 - 1/alpha) times that on the MLA, in microlens pitches p */
     double D = f / FSTOP, Pm = SENSOR_W * 1e-3 / NLX, p = D * (sqrt(1 + 4 * Pm / D) - 1) / 2, fm = p * zi / D;
-    double disp_expect = (1 - 1 / alpha) * D / PITCH_PX / p;
+    double disp_expect = (1 - 1 / alpha) * (Pm / PITCH_PX) * zi / fm / p;
+    CHECK_NEAR((Pm / PITCH_PX) * zi / fm, (D + p) / PITCH_PX, 1e-12);
     CHECK_MSG(fabs(disp / disp_expect - 1) < 1e-6, "disparity %.6g px per view, expected %.6g", disp, disp_expect);
     lf_lf_refocus_opts o = lf_lf_refocus_defaults();
     o.disparity_px = disp;

@@ -13,6 +13,7 @@
  * failure, and outputs are replaced atomically.
  */
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <limits.h>
 #include <stdio.h>
@@ -51,6 +52,8 @@ static void usage(FILE *f)
                "  --checkpoint PATH where checkpoints go\n"
                "  --resume          continue from the checkpoint (same scene and settings)\n"
                "  --camera-plugin L load camera types from the shared object L\n"
+               "  --aov disparity   light-field cameras: also write OUT.disparity.exr, the ground-truth\n"
+               "                    disparity (px per view step) of every pixel's view (docs/lightfield-format.md)\n"
                "\n"
                "       lfrender merge PART.exr... -o OUT.exr   sum parts into the unsplit image, bit for bit\n");
 }
@@ -142,6 +145,48 @@ static int check_writable(const char *path, char *msg, size_t n)
     return 0;
 }
 
+/* --aov disparity: OUT.disparity.exr beside OUT.exr (1 channel, 32-bit
+ * float, the render's lensfield:* attributes plus lensfield:aov); OUT's
+ * header names it (lensfield:disparity_file) and gets the range. */
+static int write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, int quiet, lf_error *err)
+{
+    lf_image d;
+    int rc = lf_renderer_disparity(r, &d, err);
+    if (rc)
+        return rc;
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%.*s.disparity.exr", (int)(strlen(out) - 4), out);
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    float range[2] = {INFINITY, -INFINITY};
+    for (size_t i = 0; i < (size_t)d.width * d.height; i++)
+        range[0] = d.data[i] < range[0] ? d.data[i] : range[0], range[1] = d.data[i] > range[1] ? d.data[i] : range[1];
+    lf_attrs_set_string(meta, "lensfield:disparity_file", base);
+    lf_attrs_set_floats(meta, "lensfield:disparity_range", range, 2);
+    lf_attrs a = {0};
+    for (size_t k = 0; k < meta->count && !rc; k++) {
+        const lf_attr *at = &meta->items[k];
+        switch (at->type) {
+        case LF_ATTR_STRING: rc = lf_attrs_set_string(&a, at->name, at->s); break;
+        case LF_ATTR_INT: rc = lf_attrs_set_int(&a, at->name, at->i); break;
+        case LF_ATTR_FLOAT: rc = lf_attrs_set_float(&a, at->name, (float)at->d); break;
+        case LF_ATTR_DOUBLE: rc = lf_attrs_set_double(&a, at->name, at->d); break;
+        case LF_ATTR_FLOATS: rc = lf_attrs_set_floats(&a, at->name, at->v, at->n); break;
+        case LF_ATTR_M44D: rc = lf_attrs_set_m44d(&a, at->name, at->m); break;
+        }
+    }
+    if (!rc)
+        rc = lf_attrs_set_string(&a, "lensfield:aov", "disparity");
+    if (rc)
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the disparity AOV's attributes");
+    else
+        rc = lf_image_write(path, &d, &a, NULL, err);
+    if (!rc && !quiet)
+        fprintf(stderr, "lfrender: wrote %s (disparity %.6g .. %.6g px per view step)\n", path, range[0], range[1]);
+    lf_attrs_free(&a);
+    lf_image_free(&d);
+    return rc;
+}
+
 static volatile int stop_requested;
 
 static void on_signal(int sig)
@@ -203,7 +248,7 @@ int main(int argc, char **argv)
         return merge_main(argc, argv);
     const char *scene = NULL, *out = NULL, *checkpoint = NULL;
     lf_render_opts o = lf_render_opts_default();
-    int quiet = 0, explain = 0;
+    int quiet = 0, explain = 0, aov_disparity = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         long v;
@@ -245,6 +290,12 @@ int main(int argc, char **argv)
                 return 2;
             }
             i += 4;
+        } else if (!strcmp(a, "--aov") && i + 1 < argc) {
+            if (strcmp(argv[++i], "disparity")) {
+                fprintf(stderr, "lfrender: --aov expects \"disparity\" (the only AOV), got \"%s\"\n", argv[i]);
+                return 2;
+            }
+            aov_disparity = 1;
         } else if (!strcmp(a, "--quiet")) {
             quiet = 1;
         } else if (!strcmp(a, "--explain")) {
@@ -344,6 +395,13 @@ int main(int argc, char **argv)
         lf_scene_desc_free(&desc);
         return 2;
     }
+    if (aov_disparity && (o.part || strlen(out) < 4 || strcasecmp(out + strlen(out) - 4, ".exr"))) {
+        fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
+                        "--spp-range)\n");
+        lf_renderer_free(r);
+        lf_scene_desc_free(&desc);
+        return 2;
+    }
     char ckpath[4200];
     if (o.checkpoint_every > 0 || o.resume || checkpoint) {
         if (!checkpoint) {
@@ -387,7 +445,10 @@ int main(int argc, char **argv)
         if (!quiet)
             fprintf(stderr, "lfrender: %lld camera paths in %.3f s: %.3f M paths/s, %.3f M rays/s\n",
                     st.camera_paths, st.seconds, st.camera_paths / st.seconds * 1e-6, st.rays / st.seconds * 1e-6);
-        rc = lf_image_write(out, &img, &meta, &wo, &err);
+        if (aov_disparity)
+            rc = write_disparity(r, out, &meta, quiet, &err);
+        if (!rc)
+            rc = lf_image_write(out, &img, &meta, &wo, &err);
         if (!rc && !quiet)
             fprintf(stderr, "lfrender: wrote %s\n", out);
         lf_image_free(&img);

@@ -11,6 +11,8 @@
  *   lftool export-web RAW.exr -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]
  *   lftool serve DIR [--port P]
  *
+ * RAW may also be a folder of views (HCI layout or PREFIX_RR_CC names).
+ *
  * Exit codes: 0 ok, 1 bad input (the message names the file and what is
  * missing or wrong), 2 usage.
  */
@@ -56,7 +58,10 @@ static const char *usage_text =
     "  --kind camera-array|plenoptic --camsperdim NX NY --griddim MINX MAXX MINY MAXY --inputfov DEG\n"
     "  --tilesize W H --grid square|hex --pitch PX --rotation RAD --offset X Y --lenscount NX NY\n"
     "  --mainlens FOCAL_MM FSTOP MLA_DISTANCE_MM MICROLENS_PITCH_UM\n"
-    "other: --threads N, --allow-nonfinite (treat NaN/Inf raw pixels as missing samples), --help\n";
+    "other: --threads N, --allow-nonfinite (treat NaN/Inf raw pixels as missing samples), --help\n"
+    "every RAW.exr / LF.exr may also be a folder of views (docs/lightfield-format.md): the HCI layout\n"
+    "  (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC[...].png|exr (row, column; from 0 or 1);\n"
+    "  decode --layout hci writes the HCI layout (with gt_disp_lowres.pfm when the raw has disparity)\n";
 
 /* ---------- flags ---------- */
 
@@ -343,6 +348,7 @@ typedef struct loaded {
     lf_attrs attrs;
     lf_lf_layout layout;
     lf_lightfield lf;
+    lf_lf_folder folder; /* when the input is a folder of views (folder.dir != NULL) */
 } loaded;
 
 static void unload(loaded *l)
@@ -350,13 +356,43 @@ static void unload(loaded *l)
     lf_lf_free(&l->lf);
     lf_image_free(&l->raw);
     lf_attrs_free(&l->attrs);
+    lf_lf_folder_free(&l->folder);
 }
 
-/* Reads the raw, resolves its layout (attributes + flags); decodes unless
- * layout_only. Prints the error and returns EXIT_INPUT on failure. */
+/* A folder of views (docs/lightfield-format.md): every view is read, even
+ * for info, so a missing or unreadable view is reported at once. */
+static int load_folder(const opts *o, loaded *l)
+{
+    lf_error err = {0};
+    if (o->white) {
+        fprintf(stderr, "lftool: %s: --white applies to raws, not to a folder of views\n", o->input);
+        return EXIT_INPUT;
+    }
+    if (lf_lf_folder_scan(o->input, &l->folder, &err) || lf_lf_folder_load(&l->folder, &o->flags, &l->lf, &err)) {
+        fprintf(stderr, "lftool: %s\n", err.msg);
+        unload(l);
+        return EXIT_INPUT;
+    }
+    l->layout = l->lf.layout;
+    if (l->lf.nonfinite && !o->allow_nonfinite) {
+        fprintf(stderr,
+                "lftool: %s: %zu non-finite pixel values (NaN/Inf); pass --allow-nonfinite to treat them as "
+                "missing samples\n",
+                o->input, l->lf.nonfinite);
+        unload(l);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+/* Reads the raw (or folder of views), resolves its layout (attributes +
+ * flags); decodes unless layout_only. Prints the error and returns
+ * EXIT_INPUT on failure. */
 static int load(const opts *o, loaded *l, int layout_only)
 {
     memset(l, 0, sizeof *l);
+    if (lf_lf_is_folder(o->input))
+        return load_folder(o, l);
     lf_error err = {0};
     if (lf_image_read(o->input, &l->raw, &l->attrs, &err)) {
         fprintf(stderr, "lftool: %s\n", err.msg);
@@ -441,11 +477,71 @@ static int cmd_info(const opts *o)
         return rc;
     char buf[2048];
     lf_lf_layout_describe(&l.layout, buf, sizeof buf);
+    if (l.folder.dir) {
+        printf("%s: folder of %d x %d views (%s layout, %s)\n%s", o->input, l.lf.nu, l.lf.nv,
+               l.folder.kind == LF_LF_FOLDER_HCI ? "HCI" : "row/column", l.folder.pattern, buf);
+        if (l.lf.disp_per_inv_m > 0)
+            printf("disparity %.6g + %.6g / depth px per view step\n", l.lf.disp_at_inf, l.lf.disp_per_inv_m);
+        if (l.folder.gt_disparity)
+            printf("ground-truth disparity: %s\n", l.folder.gt_disparity);
+        if (l.lf.nonfinite)
+            printf("non-finite pixel values: %zu\n", l.lf.nonfinite);
+        unload(&l);
+        return EXIT_OK;
+    }
     printf("%s: %d x %d raw, %d channels\n%s", o->input, l.raw.width, l.raw.height, l.raw.channels, buf);
     size_t bad = lf_image_count_nonfinite(&l.raw);
     if (bad)
         printf("non-finite pixel values: %zu\n", bad);
     unload(&l);
+    return EXIT_OK;
+}
+
+/* The centre view's ground-truth disparity (docs/lightfield-format.md,
+ * "Disparity AOV"): from the render's disparity image named by the raw's
+ * lensfield:disparity_file, decoded with the raw's layout, or a folder's
+ * gt_disp_lowres.pfm.  *gt stays empty when there is none. */
+static int centre_disparity(const opts *o, const loaded *l, lf_image *gt)
+{
+    memset(gt, 0, sizeof *gt);
+    lf_error err = {0};
+    if (l->folder.dir) {
+        if (l->folder.gt_disparity && lf_image_read(l->folder.gt_disparity, gt, NULL, &err)) {
+            fprintf(stderr, "lftool: %s\n", err.msg);
+            return EXIT_INPUT;
+        }
+        return EXIT_OK;
+    }
+    const lf_attr *a = lf_attrs_get(&l->attrs, "lensfield:disparity_file");
+    if (!a || a->type != LF_ATTR_STRING || !a->s[0])
+        return EXIT_OK;
+    if (l->lf.nu % 2 == 0 || l->lf.nv % 2 == 0) {
+        fprintf(stderr, "lftool: %s: note: %d x %d views have no centre view; gt_disp_lowres.pfm not written\n",
+                o->input, l->lf.nu, l->lf.nv);
+        return EXIT_OK;
+    }
+    char path[PATH_MAX];
+    const char *slash = strrchr(o->input, '/');
+    if (a->s[0] == '/' || !slash)
+        snprintf(path, sizeof path, "%s", a->s);
+    else
+        snprintf(path, sizeof path, "%.*s/%s", (int)(slash - o->input), o->input, a->s);
+    lf_image raw = {0};
+    lf_lightfield d = {0};
+    if (lf_image_read(path, &raw, NULL, &err) ||
+        (raw.width != l->raw.width || raw.height != l->raw.height
+             ? lf_error_set(&err, LF_ERR_PARAM, "%s is %d x %d, the raw %d x %d", path, raw.width, raw.height,
+                            l->raw.width, l->raw.height)
+             : 0) ||
+        lf_lf_decode(&raw, &l->layout, NULL, &d, &err) || lf_image_alloc(gt, d.ns, d.nt, 1, &err)) {
+        fprintf(stderr, "lftool: %s: disparity: %s\n", o->input, err.msg);
+        lf_image_free(&raw), lf_lf_free(&d), lf_image_free(gt);
+        return EXIT_INPUT;
+    }
+    const float *v = lf_lf_view(&d, d.nu / 2, d.nv / 2);
+    for (size_t i = 0; i < (size_t)d.ns * d.nt; i++)
+        gt->data[i] = v[i * 3];
+    lf_image_free(&raw), lf_lf_free(&d);
     return EXIT_OK;
 }
 
@@ -458,7 +554,21 @@ static int cmd_decode(const opts *o)
     if ((rc = load(o, &l, 0)))
         return rc;
     const lf_lightfield *lf = &l.lf;
-    const char *ext = o->hci ? "png" : (o->format ? o->format : "exr");
+    if (o->hci) {
+        lf_image gt;
+        lf_error err = {0};
+        if (!(rc = centre_disparity(o, &l, &gt)) && lf_lf_write_hci(o->output, lf, gt.data ? &gt : NULL, &err)) {
+            fprintf(stderr, "lftool: %s\n", err.msg);
+            rc = EXIT_INPUT;
+        }
+        if (!rc)
+            printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu,
+                   lf->nv, lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
+        lf_image_free(&gt);
+        unload(&l);
+        return rc;
+    }
+    const char *ext = o->format ? o->format : "exr";
     if ((rc = make_dir(o->output))) {
         unload(&l);
         return rc;
@@ -467,10 +577,7 @@ static int cmd_decode(const opts *o)
     for (int iv = 0; iv < lf->nv && !rc; iv++)
         for (int iu = 0; iu < lf->nu && !rc; iu++) {
             lf_image v = view_image(lf, iu, iv);
-            if (o->hci)
-                snprintf(path, sizeof path, "%s/input_Cam%03d.png", o->output, iv * lf->nu + iu);
-            else
-                snprintf(path, sizeof path, "%s/view_%02d_%02d.%s", o->output, iu, iv, ext);
+            snprintf(path, sizeof path, "%s/view_%02d_%02d.%s", o->output, iv, iu, ext); /* row, column */
             rc = write_image(path, &v, NULL);
         }
     /* mosaic: views tiled as the cameras sit (view (0,0) top-left) */
@@ -485,29 +592,6 @@ static int cmd_decode(const opts *o)
         snprintf(path, sizeof path, "%s/mosaic.%s", o->output, ext);
         rc = write_image(path, &m, NULL);
         lf_image_free(&m);
-    }
-    if (!rc && o->hci) {
-        snprintf(path, sizeof path, "%s/parameters.cfg", o->output);
-        FILE *f = fopen(path, "w");
-        if (!f) {
-            fprintf(stderr, "lftool: cannot write %s\n", path);
-            rc = EXIT_INPUT;
-        } else {
-            const lf_lf_layout *y = &lf->layout;
-            fprintf(f, "[intrinsics]\nwidth = %d\nheight = %d\n", lf->ns, lf->nt);
-            if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_FOV)) {
-                /* HCI gives focal length and sensor size in mm: use a 35 mm sensor across the width */
-                double fpx = 0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt) / tan(y->fov_deg * M_PI / 360);
-                fprintf(f, "focal_length_mm = %.6g\nsensor_size_mm = 35\n", fpx * 35.0 / lf->ns);
-            } else if (y->have & LF_LF_HAVE_MAIN_LENS) {
-                fprintf(f, "focal_length_mm = %.6g\nfstop = %.6g\n", y->main_focal_mm, y->main_fstop);
-            }
-            fprintf(f, "\n[extrinsics]\nnum_cams_x = %d\nnum_cams_y = %d\n", lf->nu, lf->nv);
-            if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_BOUNDS) && lf->nu > 1)
-                fprintf(f, "baseline_mm = %.6g\n", 1000 * (y->grid_bounds[1] - y->grid_bounds[0]) / (lf->nu - 1));
-            fprintf(f, "\n[meta]\nsource = lftool decode --layout hci\n");
-            fclose(f);
-        }
     }
     if (!rc)
         printf("%s: %d x %d views of %d x %d -> %s (%zu missing samples)\n", o->input, lf->nu, lf->nv, lf->ns, lf->nt,

@@ -1,0 +1,630 @@
+/* Folders of views: the HCI benchmark layout and <prefix>_RR_CC names
+ * (docs/lightfield-format.md, "Folders of views"), read into the same
+ * L(u, v, s, t) as a decoded raw; and the HCI layout written back. */
+#include <ctype.h>
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "lf_lightfield.h"
+
+enum { MAX_SIDE = 4096 };
+
+int lf_lf_is_folder(const char *path)
+{
+    struct stat st;
+    return path && stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+void lf_lf_folder_free(lf_lf_folder *f)
+{
+    if (!f)
+        return;
+    if (f->files)
+        for (int i = 0; i < f->nu * f->nv; i++)
+            free(f->files[i]);
+    free(f->files);
+    free(f->dir);
+    free(f->gt_disparity);
+    memset(f, 0, sizeof *f);
+}
+
+static char *join(const char *dir, const char *name)
+{
+    size_t n = strlen(dir) + strlen(name) + 2;
+    char *p = malloc(n);
+    if (p)
+        snprintf(p, n, "%s/%s", dir, name);
+    return p;
+}
+
+static const char *extension(const char *name)
+{
+    const char *dot = strrchr(name, '.');
+    return dot ? dot + 1 : "";
+}
+
+static int is_image_name(const char *name)
+{
+    static const char *const exts[] = {"png", "exr", "tif", "tiff", "pfm", "jpg", "jpeg", NULL};
+    const char *e = extension(name);
+    for (int i = 0; exts[i]; i++)
+        if (!strcasecmp(e, exts[i]))
+            return 1;
+    return 0;
+}
+
+typedef struct names {
+    char **v;
+    size_t n, cap;
+} names;
+
+static void names_free(names *s)
+{
+    for (size_t i = 0; i < s->n; i++)
+        free(s->v[i]);
+    free(s->v);
+    memset(s, 0, sizeof *s);
+}
+
+static int names_list(const char *dir, names *out, lf_error *err)
+{
+    memset(out, 0, sizeof *out);
+    DIR *d = opendir(dir);
+    if (!d)
+        return lf_error_set(err, LF_ERR_IO, "cannot open the folder '%s': %s", dir, strerror(errno));
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.')
+            continue;
+        if (out->n == out->cap) {
+            size_t cap = out->cap ? 2 * out->cap : 64;
+            char **v = realloc(out->v, cap * sizeof *v);
+            if (!v)
+                break;
+            out->v = v, out->cap = cap;
+        }
+        if (!(out->v[out->n] = strdup(e->d_name)))
+            break;
+        out->n++;
+    }
+    int bad = e != NULL;
+    closedir(d);
+    if (bad) {
+        names_free(out);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory listing '%s'", dir);
+    }
+    return LF_OK;
+}
+
+/* ---------- parameters.cfg ---------- */
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    size_t n = strlen(s);
+    while (n && isspace((unsigned char)s[n - 1]))
+        s[--n] = '\0';
+    return s;
+}
+
+typedef struct cfg_key {
+    const char *section, *key;
+    double *dst;
+    int *seen;
+} cfg_key;
+
+/* The keys lensfield uses; others are kept by the benchmark and ignored here. */
+static int read_cfg(const char *path, lf_lf_folder *f, lf_error *err)
+{
+    FILE *in = fopen(path, "r");
+    if (!in)
+        return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    double focal = 0, sensor = 0, resx = 0, resy = 0, camsx = 0, camsy = 0, base = 0, focus = 0, dmin = 0, dmax = 0;
+    int s_focal = 0, s_sensor = 0, s_resx = 0, s_resy = 0, s_cx = 0, s_cy = 0, s_base = 0, s_focus = 0, s_dmin = 0,
+        s_dmax = 0;
+    const cfg_key keys[] = {
+        {"intrinsics", "focal_length_mm", &focal, &s_focal},
+        {"intrinsics", "sensor_size_mm", &sensor, &s_sensor},
+        {"intrinsics", "image_resolution_x_px", &resx, &s_resx},
+        {"intrinsics", "image_resolution_y_px", &resy, &s_resy},
+        {"extrinsics", "num_cams_x", &camsx, &s_cx},
+        {"extrinsics", "num_cams_y", &camsy, &s_cy},
+        {"extrinsics", "baseline_mm", &base, &s_base},
+        {"extrinsics", "focus_distance_m", &focus, &s_focus},
+        {"meta", "disp_min", &dmin, &s_dmin},
+        {"meta", "disp_max", &dmax, &s_dmax},
+    };
+    char line[1024], section[64] = "";
+    int lineno = 0, rc = LF_OK;
+    while (!rc && fgets(line, sizeof line, in)) {
+        lineno++;
+        if (!strchr(line, '\n') && !feof(in)) {
+            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: line longer than %zu characters", path, lineno,
+                              sizeof line - 2);
+            break;
+        }
+        char *s = trim(line);
+        if (!*s || *s == '#' || *s == ';')
+            continue;
+        if (*s == '[') {
+            char *close = strchr(s, ']');
+            if (!close || close[1] || close - s - 1 >= (long)sizeof section || close == s + 1) {
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected a section header like [intrinsics], got \"%s\"",
+                                  path, lineno, s);
+                break;
+            }
+            *close = '\0';
+            snprintf(section, sizeof section, "%s", trim(s + 1));
+            continue;
+        }
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected \"key = value\" or a [section], got \"%s\"", path,
+                              lineno, s);
+            break;
+        }
+        *eq = '\0';
+        char *key = trim(s), *val = trim(eq + 1);
+        if (!*key) {
+            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected \"key = value\", the key is empty", path, lineno);
+            break;
+        }
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++) {
+            if (strcmp(key, keys[k].key) || (section[0] && strcmp(section, keys[k].section)))
+                continue;
+            char *end;
+            errno = 0;
+            double v = strtod(val, &end);
+            if (!*val || *end || errno || !isfinite(v)) {
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s: expected a number, got \"%s\"", path, lineno, key,
+                                  val);
+                break;
+            }
+            *keys[k].dst = v;
+            *keys[k].seen = 1;
+        }
+    }
+    if (!rc && ferror(in))
+        rc = lf_error_set(err, LF_ERR_IO, "cannot read '%s'", path);
+    fclose(in);
+    if (rc)
+        return rc;
+#define WHOLE(v, lo, hi) ((v) >= (lo) && (v) <= (hi) && (v) == floor(v))
+    if ((s_cx && !WHOLE(camsx, 1, MAX_SIDE)) || (s_cy && !WHOLE(camsy, 1, MAX_SIDE)))
+        return lf_error_set(err, LF_ERR_PARSE, "%s: num_cams_x / num_cams_y must be whole numbers in 1..%d (got %g, %g)",
+                            path, MAX_SIDE, camsx, camsy);
+    if (s_cx != s_cy)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: give both num_cams_x and num_cams_y", path);
+    if ((s_resx && !WHOLE(resx, 1, 1 << 20)) || (s_resy && !WHOLE(resy, 1, 1 << 20)))
+        return lf_error_set(err, LF_ERR_PARSE, "%s: image_resolution_x_px / _y_px must be whole numbers >= 1", path);
+    if ((s_focal && !(focal > 0)) || (s_sensor && !(sensor > 0)) || (s_base && !(base > 0)) ||
+        (s_focus && !(focus > 0)))
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "%s: focal_length_mm, sensor_size_mm, baseline_mm and focus_distance_m must be > 0", path);
+    if (s_dmin != s_dmax || (s_dmin && !(dmin <= dmax)))
+        return lf_error_set(err, LF_ERR_PARSE, "%s: give both disp_min and disp_max, disp_min <= disp_max", path);
+#undef WHOLE
+    lf_lf_layout *L = &f->layout;
+    if (s_cx) {
+        f->nu = (int)camsx, f->nv = (int)camsy;
+        L->cams_x = f->nu, L->cams_y = f->nv, L->have |= LF_LF_HAVE_CAMS;
+    }
+    f->cfg_w = s_resx ? (int)resx : 0;
+    f->cfg_h = s_resy ? (int)resy : 0;
+    if (s_base && s_cx) {
+        /* cameras on the z = 0 plane, centred; metres */
+        double b = base * 1e-3;
+        L->grid_bounds[0] = -0.5 * b * (f->nu - 1), L->grid_bounds[1] = 0.5 * b * (f->nu - 1);
+        L->grid_bounds[2] = -0.5 * b * (f->nv - 1), L->grid_bounds[3] = 0.5 * b * (f->nv - 1);
+        L->have |= LF_LF_HAVE_BOUNDS;
+    }
+    if (s_focal && s_sensor) {
+        /* HCI: the sensor size spans the longer image side; the fov is set
+         * once the view size is known (lf_lf_folder_load) */
+        f->focal_mm = focal, f->sensor_mm = sensor;
+    }
+    if (s_focus)
+        L->convergence_m = focus, L->have |= LF_LF_HAVE_CONVERGENCE;
+    if (s_dmin)
+        L->disp_min = dmin, L->disp_max = dmax, L->have |= LF_LF_HAVE_DISP_RANGE;
+    return LF_OK;
+}
+
+/* ---------- view names ---------- */
+
+static int all_digits(const char *s, size_t n)
+{
+    if (!n || n > 6)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (!isdigit((unsigned char)s[i]))
+            return 0;
+    return 1;
+}
+
+/* The last pair of '_'-separated all-digit fields of the name's stem:
+ * row, column, and the prefix length (up to the '_' before the row). */
+static int rowcol(const char *name, int *row, int *col, size_t *prefix)
+{
+    const char *dot = strrchr(name, '.');
+    size_t stem = dot ? (size_t)(dot - name) : strlen(name);
+    /* field boundaries: positions of '_' and the stem's end */
+    size_t starts[64], lens[64];
+    int nf = 0;
+    size_t a = 0;
+    for (size_t i = 0; i <= stem && nf < 64; i++)
+        if (i == stem || name[i] == '_') {
+            starts[nf] = a, lens[nf] = i - a, nf++;
+            a = i + 1;
+        }
+    for (int k = nf - 2; k >= 1; k--)
+        if (all_digits(name + starts[k], lens[k]) && all_digits(name + starts[k + 1], lens[k + 1])) {
+            *row = atoi(name + starts[k]);
+            *col = atoi(name + starts[k + 1]);
+            *prefix = starts[k] - 1;
+            return 1;
+        }
+    return 0;
+}
+
+static int hci_index(const char *name, int *idx)
+{
+    if (strncmp(name, "input_Cam", 9) || !is_image_name(name))
+        return 0;
+    const char *p = name + 9;
+    size_t n = strspn(p, "0123456789");
+    if (!n || n > 6 || p[n] != '.')
+        return 0;
+    *idx = atoi(p);
+    return 1;
+}
+
+/* Appends names to a message, at most `limit` of them, "... and N more". */
+static void list_append(char *msg, size_t cap, int *count, int limit, const char *name)
+{
+    size_t k = strlen(msg);
+    if (*count < limit)
+        snprintf(msg + k, cap - k, "%s%s", *count ? ", " : "", name);
+    (*count)++;
+}
+
+static int scan_hci(const char *dir, const names *ls, lf_lf_folder *f, lf_error *err)
+{
+    f->kind = LF_LF_FOLDER_HCI;
+    int maxidx = -1, count = 0;
+    const char *ext = NULL;
+    for (size_t i = 0; i < ls->n; i++) {
+        int idx;
+        if (hci_index(ls->v[i], &idx)) {
+            count++;
+            if (idx > maxidx)
+                maxidx = idx;
+            if (!ext)
+                ext = extension(ls->v[i]);
+        }
+    }
+    if (!count)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: parameters.cfg but no views input_Cam000.png ...", dir);
+    if (!f->nu) {
+        int side = (int)floor(sqrt((double)(maxidx + 1)) + 0.5);
+        if (side * side != maxidx + 1)
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "%s: %d views (input_Cam000 .. input_Cam%03d) do not make a square grid and there is "
+                                "no parameters.cfg with num_cams_x / num_cams_y; give --camsperdim NX NY",
+                                dir, count, maxidx);
+        f->nu = f->nv = side;
+        f->layout.cams_x = f->layout.cams_y = side;
+        f->layout.have |= LF_LF_HAVE_CAMS;
+    }
+    int n = f->nu * f->nv;
+    snprintf(f->pattern, sizeof f->pattern, "input_Cam%%03d.%s", ext);
+    f->files = calloc((size_t)n, sizeof *f->files);
+    if (!f->files)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    char extra[512] = "";
+    int nextra = 0;
+    for (size_t i = 0; i < ls->n; i++) {
+        int idx;
+        if (!hci_index(ls->v[i], &idx))
+            continue;
+        if (idx >= n) {
+            list_append(extra, sizeof extra, &nextra, 6, ls->v[i]);
+            continue;
+        }
+        if (f->files[idx]) {
+            return lf_error_set(err, LF_ERR_PARSE, "%s: two files for view %d: %s and %s", dir, idx,
+                                strrchr(f->files[idx], '/') + 1, ls->v[i]);
+        }
+        if (!(f->files[idx] = join(dir, ls->v[i])))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    if (nextra)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: the grid is %d x %d views (parameters.cfg) but there are more: %s%s",
+                            dir, f->nu, f->nv, extra, nextra > 6 ? " ..." : "");
+    char missing[640] = "";
+    int nmiss = 0;
+    for (int i = 0; i < n; i++)
+        if (!f->files[i]) {
+            char name[64];
+            snprintf(name, sizeof name, f->pattern, i);
+            list_append(missing, sizeof missing, &nmiss, 8, name);
+        }
+    if (nmiss)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: %d of %d views missing: %s%s (the grid is %d x %d)", dir, nmiss, n,
+                            missing, nmiss > 8 ? " ..." : "", f->nu, f->nv);
+    return LF_OK;
+}
+
+static int scan_rowcol(const char *dir, const names *ls, lf_lf_folder *f, lf_error *err)
+{
+    f->kind = LF_LF_FOLDER_ROWCOL;
+    int rmin = MAX_SIDE, cmin = MAX_SIDE, rmax = -1, cmax = -1, count = 0;
+    const char *first = NULL;
+    size_t first_prefix = 0;
+    for (size_t i = 0; i < ls->n; i++) {
+        int r, c;
+        size_t pre;
+        if (!is_image_name(ls->v[i]) || !rowcol(ls->v[i], &r, &c, &pre))
+            continue;
+        if (!first) {
+            first = ls->v[i], first_prefix = pre;
+        } else if (pre != first_prefix || strncmp(first, ls->v[i], pre)) {
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "%s: views of two sets: %s and %s (one light field per folder, named PREFIX_RR_CC...)",
+                                dir, first, ls->v[i]);
+        }
+        count++;
+        rmin = r < rmin ? r : rmin, cmin = c < cmin ? c : cmin;
+        rmax = r > rmax ? r : rmax, cmax = c > cmax ? c : cmax;
+    }
+    if (!count)
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "%s: no light-field views: expected input_CamNNN.png with parameters.cfg (HCI) or images "
+                            "named PREFIX_RR_CC[...].png|exr (row, column)",
+                            dir);
+    if (rmin != cmin || (rmin != 0 && rmin != 1))
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "%s: view rows start at %d and columns at %d: expected both to start at 0 or both at 1", dir,
+                            rmin, cmin);
+    f->base = rmin;
+    f->nv = rmax - rmin + 1, f->nu = cmax - cmin + 1;
+    if (f->nu > MAX_SIDE || f->nv > MAX_SIDE)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: %d x %d views is too many", dir, f->nu, f->nv);
+    f->layout.cams_x = f->nu, f->layout.cams_y = f->nv, f->layout.have |= LF_LF_HAVE_CAMS;
+    snprintf(f->pattern, sizeof f->pattern, "%.*s_RR_CC...%s (rows and columns from %d)", (int)first_prefix, first,
+             strrchr(first, '.') ? strrchr(first, '.') : "", f->base);
+    size_t n = (size_t)f->nu * f->nv;
+    f->files = calloc(n, sizeof *f->files);
+    if (!f->files)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ls->n; i++) {
+        int r, c;
+        size_t pre;
+        if (!is_image_name(ls->v[i]) || !rowcol(ls->v[i], &r, &c, &pre))
+            continue;
+        size_t k = (size_t)(r - f->base) * f->nu + (size_t)(c - f->base);
+        if (f->files[k])
+            return lf_error_set(err, LF_ERR_PARSE, "%s: two files for row %d column %d: %s and %s", dir, r, c,
+                                strrchr(f->files[k], '/') + 1, ls->v[i]);
+        if (!(f->files[k] = join(dir, ls->v[i])))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    char missing[640] = "";
+    int nmiss = 0;
+    for (int r = 0; r < f->nv; r++)
+        for (int c = 0; c < f->nu; c++)
+            if (!f->files[(size_t)r * f->nu + c]) {
+                char name[64];
+                snprintf(name, sizeof name, "row %d column %d", r + f->base, c + f->base);
+                list_append(missing, sizeof missing, &nmiss, 8, name);
+            }
+    if (nmiss)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: %d of %zu views missing (%s): %s%s", dir, nmiss, n, f->pattern,
+                            missing, nmiss > 8 ? " ..." : "");
+    return LF_OK;
+}
+
+int lf_lf_folder_scan(const char *dir, lf_lf_folder *f, lf_error *err)
+{
+    memset(f, 0, sizeof *f);
+    lf_lf_layout_init(&f->layout);
+    f->layout.kind = LF_LF_CAMERA_ARRAY;
+    f->layout.have |= LF_LF_HAVE_KIND;
+    if (!(f->dir = strdup(dir)))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    names ls;
+    int rc = names_list(dir, &ls, err);
+    if (rc) {
+        lf_lf_folder_free(f);
+        return rc;
+    }
+    int hci = 0, cfg = 0, gt = 0;
+    for (size_t i = 0; i < ls.n; i++) {
+        int idx;
+        hci |= hci_index(ls.v[i], &idx);
+        cfg |= !strcmp(ls.v[i], "parameters.cfg");
+        gt |= !strcmp(ls.v[i], "gt_disp_lowres.pfm");
+    }
+    if (cfg) {
+        char *p = join(dir, "parameters.cfg");
+        rc = p ? read_cfg(p, f, err) : lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        free(p);
+    }
+    if (!rc && gt && !(f->gt_disparity = join(dir, "gt_disp_lowres.pfm")))
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    if (!rc)
+        rc = hci || cfg ? scan_hci(dir, &ls, f, err) : scan_rowcol(dir, &ls, f, err);
+    names_free(&ls);
+    if (rc)
+        lf_lf_folder_free(f);
+    return rc;
+}
+
+/* ---------- loading ---------- */
+
+int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_lightfield *lf, lf_error *err)
+{
+    memset(lf, 0, sizeof *lf);
+    int n = f->nu * f->nv, rc = LF_OK;
+    lf_image first = {0};
+    if ((rc = lf_image_read(f->files[0], &first, NULL, err)))
+        return rc;
+    int w = first.width, h = first.height;
+    if ((f->cfg_w && f->cfg_w != w) || (f->cfg_h && f->cfg_h != h)) {
+        lf_image_free(&first);
+        return lf_error_set(err, LF_ERR_PARSE, "%s is %d x %d but %s/parameters.cfg says %d x %d", f->files[0], w, h,
+                            f->dir, f->cfg_w ? f->cfg_w : w, f->cfg_h ? f->cfg_h : h);
+    }
+    /* the folder's layout, completed with the view size, merged with the flags */
+    lf_lf_layout file = f->layout, lay;
+    file.tile_w = w, file.tile_h = h, file.have |= LF_LF_HAVE_TILE;
+    if (f->focal_mm > 0 && f->sensor_mm > 0) {
+        double fpx = f->focal_mm / f->sensor_mm * (w > h ? w : h);
+        file.fov_deg = 2 * atan(0.5 * (w < h ? w : h) / fpx) * 180 / M_PI;
+        file.have |= LF_LF_HAVE_FOV;
+    }
+    if ((flags && (flags->have & LF_LF_HAVE_KIND) && flags->kind != LF_LF_CAMERA_ARRAY)) {
+        lf_image_free(&first);
+        return lf_error_set(err, LF_ERR_PARAM, "%s: a folder of views is a camera array (--kind plenoptic given)",
+                            f->dir);
+    }
+    if ((rc = lf_lf_layout_resolve(&file, flags, w * f->nu, h * f->nv, &lay, err))) {
+        lf_image_free(&first);
+        return rc;
+    }
+    if (lay.tile_w != w || lay.tile_h != h) {
+        lf_image_free(&first);
+        return lf_error_set(err, LF_ERR_PARAM, "%s: --tilesize %d %d contradicts the views' size %d x %d", f->dir,
+                            lay.tile_w, lay.tile_h, w, h);
+    }
+    if ((rc = lf_lf_alloc(lf, f->nu, f->nv, w, h, err))) {
+        lf_image_free(&first);
+        return rc;
+    }
+    char odd[768] = "";
+    int nodd = 0;
+    for (int k = 0; k < n && !rc; k++) {
+        lf_image img = {0};
+        if (k == 0) {
+            img = first, first.data = NULL;
+        } else if ((rc = lf_image_read(f->files[k], &img, NULL, err))) {
+            break;
+        }
+        if (img.width != w || img.height != h) {
+            char item[600];
+            snprintf(item, sizeof item, "%s (%d x %d)", f->files[k], img.width, img.height);
+            list_append(odd, sizeof odd, &nodd, 4, item);
+            lf_image_free(&img);
+            continue;
+        }
+        float *dst = lf->data + (size_t)k * w * h * 3;
+        for (size_t p = 0; p < (size_t)w * h; p++) {
+            const float *s = img.data + p * (size_t)img.channels;
+            float c[3];
+            if (img.channels >= 3)
+                c[0] = s[0], c[1] = s[1], c[2] = s[2];
+            else
+                c[0] = c[1] = c[2] = s[0];
+            if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
+                if (!lf->valid) {
+                    size_t all = (size_t)n * w * h;
+                    if (!(lf->valid = malloc(all * sizeof *lf->valid))) {
+                        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
+                        break;
+                    }
+                    for (size_t i = 0; i < all; i++)
+                        lf->valid[i] = 1.f;
+                }
+                lf->valid[(size_t)k * w * h + p] = 0.f;
+                lf->nonfinite++, lf->missing++;
+                c[0] = c[1] = c[2] = 0.f;
+            }
+            memcpy(dst + p * 3, c, sizeof c);
+        }
+        lf_image_free(&img);
+    }
+    lf_image_free(&first);
+    if (!rc && nodd)
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: views differ in size: %s is %d x %d, but %s%s", f->dir, f->files[0],
+                          w, h, odd, nodd > 4 ? " ..." : "");
+    if (rc) {
+        lf_lf_free(lf);
+        return rc;
+    }
+    lf_lf_set_geometry(lf, &lay);
+    return LF_OK;
+}
+
+/* ---------- writing the HCI layout ---------- */
+
+int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
+{
+    if (mkdir(dir, 0777) && errno != EEXIST)
+        return lf_error_set(err, LF_ERR_IO, "cannot create the folder '%s': %s", dir, strerror(errno));
+    char path[4096];
+    int rc = LF_OK;
+    for (int iv = 0; iv < lf->nv && !rc; iv++)
+        for (int iu = 0; iu < lf->nu && !rc; iu++) {
+            lf_image v = {lf->ns, lf->nt, 3, lf_lf_view(lf, iu, iv)};
+            snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, iv * lf->nu + iu);
+            rc = lf_image_write(path, &v, NULL, NULL, err);
+        }
+    if (!rc && disparity) {
+        snprintf(path, sizeof path, "%s/gt_disp_lowres.pfm", dir);
+        rc = lf_image_write(path, disparity, NULL, NULL, err);
+    }
+    if (rc)
+        return rc;
+    /* parameters.cfg, written beside and renamed into place */
+    const lf_lf_layout *y = &lf->layout;
+    char tmp[4200];
+    snprintf(path, sizeof path, "%s/parameters.cfg", dir);
+    snprintf(tmp, sizeof tmp, "%s/.parameters.cfg.tmp", dir);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", tmp, strerror(errno));
+    int wide = lf->ns > lf->nt ? lf->ns : lf->nt, narrow = lf->ns < lf->nt ? lf->ns : lf->nt;
+    fprintf(f, "[intrinsics]\n");
+    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_FOV)) {
+        /* HCI: focal length and the sensor size across the longer side, in mm;
+         * a 35 mm sensor, the focal length giving the same focal length in pixels */
+        double fpx = 0.5 * narrow / tan(y->fov_deg * M_PI / 360);
+        fprintf(f, "focal_length_mm = %.9g\n", fpx * 35.0 / wide);
+        fprintf(f, "sensor_size_mm = 35.0\n");
+    }
+    fprintf(f, "image_resolution_x_px = %d\nimage_resolution_y_px = %d\n", lf->ns, lf->nt);
+    fprintf(f, "\n[extrinsics]\nnum_cams_x = %d\nnum_cams_y = %d\n", lf->nu, lf->nv);
+    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_BOUNDS) && lf->nu > 1)
+        fprintf(f, "baseline_mm = %.7g\n", 1000 * (y->grid_bounds[1] - y->grid_bounds[0]) / (lf->nu - 1));
+    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_CONVERGENCE))
+        fprintf(f, "focus_distance_m = %.9g\n", y->convergence_m);
+    fprintf(f, "\n[meta]\nsource = lensfield (lftool decode --layout hci)\n");
+    if (y->kind == LF_LF_PLENOPTIC)
+        fprintf(f, "# plenoptic capture: views are sub-aperture images; disparity 0 at the main lens's focus\n");
+    double dmin = y->disp_min, dmax = y->disp_max;
+    int have = (y->have & LF_LF_HAVE_DISP_RANGE) != 0;
+    if (disparity) {
+        /* the range of the ground truth itself */
+        dmin = INFINITY, dmax = -INFINITY;
+        for (size_t i = 0; i < (size_t)disparity->width * disparity->height; i++) {
+            float d = disparity->data[i * (size_t)disparity->channels];
+            dmin = d < dmin ? d : dmin, dmax = d > dmax ? d : dmax;
+        }
+        have = dmin <= dmax;
+    }
+    if (have)
+        fprintf(f, "disp_min = %.9g\ndisp_max = %.9g\n", dmin, dmax);
+    int bad = ferror(f);
+    if (fclose(f) || bad || rename(tmp, path)) {
+        remove(tmp);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s'", path);
+    }
+    return LF_OK;
+}

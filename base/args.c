@@ -52,7 +52,7 @@ static unsigned range_flags(const lf_arg *a)
 static void describe_range(const lf_arg *a, char *out, size_t n)
 {
     unsigned f = range_flags(a);
-    const char *what = a->type == LF_ARG_INT ? "an integer" : "a number";
+    const char *what = a->type == LF_ARG_INT || a->type == LF_ARG_LONG ? "an integer" : "a number";
     if ((f & LF_ARG_HAS_MIN) && (f & LF_ARG_HAS_MAX) && !(f & (LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN)))
         snprintf(out, n, "%s from %.10g to %.10g", what, a->min, a->max);
     else if ((f & LF_ARG_HAS_MIN) && (f & LF_ARG_HAS_MAX))
@@ -107,6 +107,17 @@ static lf_args_status store(const lf_arg *a, int k, const char *text, char *err,
             return fail(err, err_size, "%s wants %s, got \"%s\"", a->name, range, text);
         }
         ((int *)a->value)[k] = (int)v;
+        return LF_ARGS_OK;
+    }
+    case LF_ARG_LONG: {
+        char *end;
+        errno = 0;
+        long long v = strtoll(text, &end, 10);
+        if (end == text || *end || errno == ERANGE || !in_range(a, (double)v)) {
+            describe_range(a, range, sizeof range);
+            return fail(err, err_size, "%s wants %s, got \"%s\"", a->name, range, text);
+        }
+        ((long long *)a->value)[k] = v;
         return LF_ARGS_OK;
     }
     case LF_ARG_DOUBLE: {
@@ -262,6 +273,8 @@ static void flag_label(const lf_arg *a, lf_strbuf *b)
     int nval = (a->type == LF_ARG_INT || a->type == LF_ARG_DOUBLE) && a->count > 1 ? a->count : 1;
     if (a->type == LF_ARG_CHOICE && !a->metavar)
         lf_strbuf_printf(b, " %s", a->choices);
+    else if (a->type != LF_ARG_FLAG && a->metavar && strchr(a->metavar, ' '))
+        lf_strbuf_printf(b, " %s", a->metavar); /* "X0 X1 Y0 Y1": one name per value, given whole */
     else if (a->type != LF_ARG_FLAG)
         for (int k = 0; k < nval; k++)
             lf_strbuf_printf(b, " %s", a->metavar ? a->metavar : "V");
@@ -273,12 +286,13 @@ static void flag_notes(const lf_arg *a, lf_strbuf *b)
     unsigned f = range_flags(a);
     char range[160];
     int any = 0;
-    if ((a->type == LF_ARG_INT || a->type == LF_ARG_DOUBLE) && (f & (LF_ARG_HAS_MIN | LF_ARG_HAS_MAX))) {
+    if ((a->type == LF_ARG_INT || a->type == LF_ARG_LONG || a->type == LF_ARG_DOUBLE) &&
+        (f & (LF_ARG_HAS_MIN | LF_ARG_HAS_MAX))) {
         describe_range(a, range, sizeof range);
         lf_strbuf_printf(b, " [%s", range);
         any = 1;
     }
-    if (a->type == LF_ARG_CHOICE && a->metavar) {
+    if (a->type == LF_ARG_CHOICE && a->metavar && strchr(a->choices, '|')) {
         lf_strbuf_printf(b, "%sone of %s", any ? "; " : " [", a->choices);
         any = 1;
     }
@@ -352,8 +366,16 @@ static void command_usage(const lf_tool *tool, const lf_command *c, lf_strbuf *b
 char *lf_args_usage(const lf_tool *tool, const lf_command *cmd)
 {
     lf_strbuf b = {0};
-    if (cmd || (tool->n_commands == 1 && !tool->commands[0].name)) {
-        command_usage(tool, cmd ? cmd : &tool->commands[0], &b);
+    const lf_command *fallback = lf_args_find(tool, NULL);
+    if (cmd || fallback) {
+        command_usage(tool, cmd ? cmd : fallback, &b);
+        if (!cmd && tool->n_commands > 1) { /* the other commands of a tool that runs one without a name */
+            lf_strbuf_puts(&b, "\nother commands:\n");
+            for (int i = 0; i < tool->n_commands; i++)
+                if (tool->commands[i].name)
+                    lf_strbuf_printf(&b, "  %s %-10s %s\n", tool->name, tool->commands[i].name,
+                                     tool->commands[i].summary ? tool->commands[i].summary : "");
+        }
     } else {
         lf_strbuf_printf(&b, "usage: %s COMMAND [options]\n  %s\n\ncommands:\n", tool->name,
                          tool->summary ? tool->summary : "");

@@ -42,7 +42,8 @@ typedef enum lf_arg_type {
     LF_ARG_DOUBLE, /* double (count > 1: double[count]) */
     LF_ARG_STRING, /* const char * (points into argv) */
     LF_ARG_CHOICE, /* const char *, one of `choices` ("a|b|c") */
-    LF_ARG_LIST    /* const char **, appended; *count_out counts; up to `count` */
+    LF_ARG_LIST,   /* const char **, appended; *count_out counts; up to `count` */
+    LF_ARG_LONG    /* long long (seeds, byte counts) */
 } lf_arg_type;
 
 enum {

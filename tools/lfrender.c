@@ -1,16 +1,12 @@
 /* lfrender - render a pbrt-v4 scene through lensfield's camera pack.
  *
- * usage: lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [--spp N] [--threads N]
- *                 [--seed S] [--crop x0 x1 y0 y1] [--quiet] [--explain] [--white]
- *                 [--spp-range A B] [--tile I/N] [--part]
- *                 [--checkpoint-every SECONDS] [--checkpoint PATH] [--resume]
- *                 [--camera-plugin LIB.so]...
- *        lfrender merge PART.exr... -o OUT.exr
+ *   lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [options]   (`lfrender --help`)
+ *   lfrender merge PART.exr... -o OUT.exr
  *
  * Exit codes: 0 success; 1 the scene or the render failed (message names
  * file:line:column); 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
- * after writing a checkpoint that --resume continues from.  No output file is written on
- * failure, and outputs are replaced atomically.
+ * after writing a checkpoint that --resume continues from.  No output file is
+ * written on failure, and outputs are replaced atomically.
  */
 #include <errno.h>
 #include <math.h>
@@ -25,49 +21,19 @@
 #include <unistd.h>
 
 #include "camera/lf_camera.h"
+#include "cli.h"
 #include "image/lf_image.h"
 #include "render/lf_render.h"
 #include "render/lf_scene_desc.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f, "usage: lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [--spp N] [--threads N] [--seed S]\n"
-               "                [--crop x0 x1 y0 y1] [--quiet] [--explain] [--camera-plugin LIB.so]\n"
-               "\n"
-               "  -o PATH           output image; .exr is linear float with lensfield:* metadata,\n"
-               "                    .png/.jpg are tonemapped sRGB (default: the Film's \"filename\")\n"
-               "  --spp N           samples per pixel (default: the Sampler's \"pixelsamples\")\n"
-               "  --threads N       render threads (default: all cores); never changes the result\n"
-               "  --seed S          sampler seed (default: the Sampler's \"seed\", 0)\n"
-               "  --crop x0 x1 y0 y1  render only pixels [x0,x1) x [y0,y1) of the film\n"
-               "  --quiet           no progress bar or summary\n"
-               "  --explain         print the effect plan and exit without rendering\n"
-               "  --white           render the white image: same camera and film, a uniform\n"
-               "                    environment of radiance 1 and nothing else (flat field)\n"
-               "  --spp-range A B   render only sample indices [A, B) of every pixel (a mergeable part)\n"
-               "  --tile I/N        render only row band I of N (0-based; a mergeable part)\n"
-               "  --part            write a mergeable part even without a split\n"
-               "  --checkpoint-every S  save the film every S seconds (default path OUT.checkpoint.exr);\n"
-               "                    SIGINT/SIGTERM save a final checkpoint and exit 130\n"
-               "  --checkpoint PATH where checkpoints go\n"
-               "  --resume          continue from the checkpoint (same scene and settings)\n"
-               "  --camera-plugin L load camera types from the shared object L\n"
-               "  --aov disparity   light-field cameras: also write OUT.disparity.exr, the ground-truth\n"
-               "                    disparity (px per view step) of every pixel's view (docs/lightfield-format.md)\n"
-               "\n"
-               "       lfrender merge PART.exr... -o OUT.exr   sum parts into the unsplit image, bit for bit\n");
-}
-
-static int parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi)
-        return -1;
-    *out = v;
-    return 0;
-}
+enum { MAX_PLUGINS = 16 };
+static struct {
+    const char *out, *checkpoint, *tile, *aov, *tonemap, *plugins[MAX_PLUGINS];
+    int spp, threads, crop[4], spp_range[2], quiet, explain, white, part, resume, n_plugins;
+    int have_seed, have_crop, have_spp_range;
+    long long seed;
+    double checkpoint_every, exposure;
+} opt;
 
 typedef struct progress {
     double t0, last;
@@ -195,33 +161,12 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
-static int merge_main(int argc, char **argv)
+static int run_merge(int n, char **parts)
 {
-    const char *out = NULL;
-    const char **parts = calloc((size_t)argc, sizeof *parts);
-    int n = 0;
-    if (!parts)
-        return 1;
-    for (int i = 2; i < argc; i++) {
-        if (!strcmp(argv[i], "-o") && i + 1 < argc)
-            out = argv[++i];
-        else if (argv[i][0] == '-') {
-            fprintf(stderr, "lfrender merge: unknown option \"%s\"\nusage: lfrender merge PART.exr... -o OUT.exr\n",
-                    argv[i]);
-            free(parts);
-            return 2;
-        } else
-            parts[n++] = argv[i];
-    }
-    if (!out || !n) {
-        fprintf(stderr, "usage: lfrender merge PART.exr... -o OUT.exr\n");
-        free(parts);
-        return 2;
-    }
     lf_error err = {0};
     lf_image img;
     lf_attrs meta = {0};
-    int rc = lf_render_merge(parts, n, &img, &meta, &err);
+    int rc = lf_render_merge((const char **)parts, n, &img, &meta, &err);
     if (!rc) {
         /* write as the unsplit render would: Film "savefp16" travels in the parts */
         lf_write_opts wo = {0};
@@ -230,11 +175,10 @@ static int merge_main(int argc, char **argv)
         for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
             if (img.data[k] > 65504.f)
                 wo.half = 0;
-        rc = lf_image_write(out, &img, &meta, &wo, &err);
+        rc = lf_image_write(opt.out, &img, &meta, &wo, &err);
         lf_image_free(&img);
     }
     lf_attrs_free(&meta);
-    free(parts);
     if (rc) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
         return 1;
@@ -242,116 +186,60 @@ static int merge_main(int argc, char **argv)
     return 0;
 }
 
-int main(int argc, char **argv)
+/* The render options from the flags; 0, or 2 after a usage message. */
+static int render_opts_from_flags(lf_render_opts *o)
 {
-    if (argc > 1 && !strcmp(argv[1], "merge"))
-        return merge_main(argc, argv);
-    const char *scene = NULL, *out = NULL, *checkpoint = NULL;
-    lf_render_opts o = lf_render_opts_default();
-    int quiet = 0, explain = 0, aov_disparity = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        long v;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            usage(stdout);
-            return 0;
-        } else if (!strcmp(a, "-o") && i + 1 < argc) {
-            out = argv[++i];
-        } else if (!strcmp(a, "--spp") && i + 1 < argc) {
-            if (parse_int(argv[++i], 1, 1 << 24, &v)) {
-                fprintf(stderr, "lfrender: --spp expects an integer from 1 to 16777216, got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            o.spp = (int)v;
-        } else if (!strcmp(a, "--threads") && i + 1 < argc) {
-            if (parse_int(argv[++i], 1, 1024, &v)) {
-                fprintf(stderr, "lfrender: --threads expects an integer from 1 to 1024, got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            o.threads = (int)v;
-        } else if (!strcmp(a, "--seed") && i + 1 < argc) {
-            if (parse_int(argv[++i], 0, 4294967295L, &v)) {
-                fprintf(stderr, "lfrender: --seed expects a non-negative integer, got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            o.seed = (uint32_t)v;
-            o.has_seed = 1;
-        } else if (!strcmp(a, "--crop") && i + 4 < argc) {
-            for (int k = 0; k < 4; k++) {
-                if (parse_int(argv[i + 1 + k], 0, 65536, &v)) {
-                    fprintf(stderr, "lfrender: --crop expects 4 pixel coordinates x0 x1 y0 y1, got \"%s\"\n",
-                            argv[i + 1 + k]);
-                    return 2;
-                }
-                o.crop[k] = (int)v;
-            }
-            if (o.crop[1] <= o.crop[0] || o.crop[3] <= o.crop[2]) {
-                fprintf(stderr, "lfrender: --crop x0 x1 y0 y1 needs x0 < x1 and y0 < y1\n");
-                return 2;
-            }
-            i += 4;
-        } else if (!strcmp(a, "--aov") && i + 1 < argc) {
-            if (strcmp(argv[++i], "disparity")) {
-                fprintf(stderr, "lfrender: --aov expects \"disparity\" (the only AOV), got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            aov_disparity = 1;
-        } else if (!strcmp(a, "--quiet")) {
-            quiet = 1;
-        } else if (!strcmp(a, "--explain")) {
-            explain = 1;
-        } else if (!strcmp(a, "--white")) {
-            o.white = 1;
-        } else if (!strcmp(a, "--part")) {
-            o.part = 1;
-        } else if (!strcmp(a, "--resume")) {
-            o.resume = 1;
-        } else if (!strcmp(a, "--checkpoint") && i + 1 < argc) {
-            checkpoint = argv[++i];
-        } else if (!strcmp(a, "--checkpoint-every") && i + 1 < argc) {
-            char *end;
-            double v = strtod(argv[++i], &end);
-            if (*end || !(v > 0)) {
-                fprintf(stderr, "lfrender: --checkpoint-every expects seconds > 0, got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            o.checkpoint_every = v;
-        } else if (!strcmp(a, "--spp-range") && i + 2 < argc) {
-            long b0, b1;
-            if (parse_int(argv[i + 1], 0, 1 << 24, &b0) || parse_int(argv[i + 2], 1, 1 << 24, &b1) || b1 <= b0) {
-                fprintf(stderr, "lfrender: --spp-range expects A B with 0 <= A < B\n");
-                return 2;
-            }
-            o.spp_begin = (int)b0, o.spp_end = (int)b1, o.part = 1;
-            i += 2;
-        } else if (!strcmp(a, "--tile") && i + 1 < argc) {
-            int ti, tn;
-            char extra;
-            if (sscanf(argv[++i], "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn) {
-                fprintf(stderr, "lfrender: --tile expects I/N with 0 <= I < N, got \"%s\"\n", argv[i]);
-                return 2;
-            }
-            o.tile_index = ti, o.tile_count = tn, o.part = 1;
-        } else if (!strcmp(a, "--camera-plugin") && i + 1 < argc) {
-            char msg[1024];
-            if (lf_camera_load_plugin(argv[++i], msg, sizeof msg)) {
-                fprintf(stderr, "lfrender: %s\n", msg);
-                return 1;
-            }
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "lfrender: unknown or incomplete option \"%s\"\n", a);
-            usage(stderr);
-            return 2;
-        } else if (!scene) {
-            scene = a;
-        } else {
-            fprintf(stderr, "lfrender: more than one scene given (\"%s\" and \"%s\")\n", scene, a);
+    *o = lf_render_opts_default();
+    o->spp = opt.spp, o->threads = opt.threads;
+    o->seed = (uint32_t)opt.seed, o->has_seed = opt.have_seed;
+    o->white = opt.white, o->part = opt.part, o->resume = opt.resume;
+    o->checkpoint_every = opt.checkpoint_every;
+    if (opt.have_crop) {
+        if (opt.crop[1] <= opt.crop[0] || opt.crop[3] <= opt.crop[2]) {
+            fprintf(stderr, "lfrender: --crop x0 x1 y0 y1 needs x0 < x1 and y0 < y1\n");
             return 2;
         }
+        memcpy(o->crop, opt.crop, sizeof opt.crop);
     }
-    if (!scene) {
-        usage(stderr);
-        return 2;
+    if (opt.have_spp_range) {
+        if (opt.spp_range[1] <= opt.spp_range[0]) {
+            fprintf(stderr, "lfrender: --spp-range A B needs A < B\n");
+            return 2;
+        }
+        o->spp_begin = opt.spp_range[0], o->spp_end = opt.spp_range[1], o->part = 1;
+    }
+    if (opt.tile) {
+        int ti, tn;
+        char extra;
+        if (sscanf(opt.tile, "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn) {
+            fprintf(stderr, "lfrender: --tile wants I/N with 0 <= I < N, got \"%s\"\n", opt.tile);
+            return 2;
+        }
+        o->tile_index = ti, o->tile_count = tn, o->part = 1;
+    }
+    return 0;
+}
+
+static int has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && !strcasecmp(path + n - e, ext);
+}
+
+static int run_render(int n, char **pos)
+{
+    (void)n;
+    const char *scene = pos[0], *out = opt.out, *checkpoint = opt.checkpoint;
+    lf_render_opts o;
+    int rc = render_opts_from_flags(&o);
+    if (rc)
+        return rc;
+    for (int i = 0; i < opt.n_plugins; i++) {
+        char msg[1024];
+        if (lf_camera_load_plugin(opt.plugins[i], msg, sizeof msg)) {
+            fprintf(stderr, "lfrender: %s\n", msg);
+            return 1;
+        }
     }
     if (o.checkpoint_every > 0 || o.resume || checkpoint) {
         /* from here on, SIGINT/SIGTERM stop the render and save a checkpoint */
@@ -368,7 +256,7 @@ int main(int argc, char **argv)
         return 1;
     }
     o.scene_path = scene;
-    progress pr = {now(), 0, !quiet && isatty(2)};
+    progress pr = {now(), 0, !opt.quiet && isatty(2)};
     o.progress = on_progress;
     o.progress_ctx = &pr;
     lf_renderer *r;
@@ -379,77 +267,71 @@ int main(int argc, char **argv)
     }
     if (lf_renderer_warnings(r))
         fputs(lf_renderer_warnings(r), stderr);
-    if (explain) {
+    rc = -1;
+    if (opt.explain) {
         char *plan = lf_renderer_explain(r);
         fputs(plan ? plan : "", stdout);
         free(plan);
-        lf_renderer_free(r);
-        lf_scene_desc_free(&desc);
-        return 0;
+        rc = 0;
     }
     if (!out)
         out = lf_renderer_film_filename(r);
-    if (o.part && (strlen(out) < 4 || strcasecmp(out + strlen(out) - 4, ".exr"))) {
+    if (rc < 0 && o.part && !has_ext(out, ".exr")) {
         fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
-        lf_renderer_free(r);
-        lf_scene_desc_free(&desc);
-        return 2;
+        rc = 2;
     }
-    if (aov_disparity && (o.part || strlen(out) < 4 || strcasecmp(out + strlen(out) - 4, ".exr"))) {
+    if (rc < 0 && opt.aov && (o.part || !has_ext(out, ".exr"))) {
         fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
                         "--spp-range)\n");
-        lf_renderer_free(r);
-        lf_scene_desc_free(&desc);
-        return 2;
+        rc = 2;
     }
-    char ckpath[4200];
-    if (o.checkpoint_every > 0 || o.resume || checkpoint) {
+    char ckpath[4200], msg[1200];
+    if (rc < 0 && (o.checkpoint_every > 0 || o.resume || checkpoint)) {
         if (!checkpoint) {
             snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
             checkpoint = ckpath;
         }
         o.checkpoint_path = checkpoint;
         o.stop = &stop_requested;
-        /* the renderer copied the options at create: hand it the new ones */
-        lf_renderer_set_opts(r, &o);
+        lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
     }
-    char msg[1200];
-    if (check_writable(out, msg, sizeof msg)) {
+    if (rc < 0 && check_writable(out, msg, sizeof msg)) {
         fprintf(stderr, "lfrender: %s\n", msg);
+        rc = 1;
+    }
+    if (rc >= 0) {
         lf_renderer_free(r);
         lf_scene_desc_free(&desc);
-        return 1;
+        return rc;
     }
     lf_image img;
     lf_attrs meta = {0};
     pr.t0 = now();
-    int rc = lf_renderer_render(r, &img, &meta, &err);
+    rc = lf_renderer_render(r, &img, &meta, &err);
     if (!rc) {
         lf_render_stats st = lf_renderer_stats(r);
         if (st.nonfinite_samples)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
         lf_write_opts wo = {0};
+        wo.exposure = (float)opt.exposure;
+        if (opt.tonemap)
+            lf_tonemap_parse(opt.tonemap, &wo.tonemap);
         wo.half = o.part ? 0 : lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
-        if (wo.half) {
-            /* Half floats top out at 65504: keep bright renders exact in float. */
-            size_t n = (size_t)img.width * img.height * img.channels;
-            for (size_t k = 0; k < n; k++)
-                if (img.data[k] > 65504.f) {
-                    fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
-                                    "writing 32-bit float channels\n");
-                    wo.half = 0;
-                    break;
-                }
-        }
-        if (!quiet)
+        for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
+            if (img.data[k] > 65504.f) { /* half floats top out at 65504: keep bright renders exact */
+                fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
+                                "writing 32-bit float channels\n");
+                wo.half = 0;
+            }
+        if (!opt.quiet)
             fprintf(stderr, "lfrender: %lld camera paths in %.3f s: %.3f M paths/s, %.3f M rays/s\n",
                     st.camera_paths, st.seconds, st.camera_paths / st.seconds * 1e-6, st.rays / st.seconds * 1e-6);
-        if (aov_disparity)
-            rc = write_disparity(r, out, &meta, quiet, &err);
+        if (opt.aov)
+            rc = write_disparity(r, out, &meta, opt.quiet, &err);
         if (!rc)
             rc = lf_image_write(out, &img, &meta, &wo, &err);
-        if (!rc && !quiet)
+        if (!rc && !opt.quiet)
             fprintf(stderr, "lfrender: wrote %s\n", out);
         lf_image_free(&img);
     }
@@ -461,4 +343,63 @@ int main(int argc, char **argv)
     lf_renderer_free(r);
     lf_scene_desc_free(&desc);
     return rc == LF_ERR_INTERRUPTED ? 130 : (rc ? 1 : 0);
+}
+
+static const lf_arg render_args[] = {
+    {"--output", "-o", LF_ARG_STRING, &opt.out, "OUT",
+     "output image: .exr is linear float with lensfield:* metadata, .png/.jpg tonemapped sRGB (default: the "
+     "Film's \"filename\")"},
+    {"--spp", NULL, LF_ARG_INT, &opt.spp, "N", "samples per pixel (default: the Sampler's \"pixelsamples\")",
+     .min = 1, .max = 1 << 24, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
+    {"--threads", NULL, LF_ARG_INT, &opt.threads, "N", "render threads (default: all cores); never changes the result",
+     .min = 1, .max = 1024, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
+    {"--seed", NULL, LF_ARG_LONG, &opt.seed, "S", "sampler seed (default: the Sampler's \"seed\", 0)", .min = 0,
+     .max = 4294967295.0, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX, .given = &opt.have_seed},
+    {"--crop", NULL, LF_ARG_INT, opt.crop, "X0 X1 Y0 Y1", "render only pixels [X0,X1) x [Y0,Y1) of the film",
+     .min = 0, .max = 65536, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX, .count = 4, .given = &opt.have_crop},
+    {"--exposure", NULL, LF_ARG_DOUBLE, &opt.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",
+     .min = -64, .max = 64, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
+    {"--tonemap", NULL, LF_ARG_CHOICE, &opt.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)",
+     .choices = "clamp|filmic|aces"},
+    {"--quiet", NULL, LF_ARG_FLAG, &opt.quiet, NULL, "no progress bar or summary"},
+    {"--explain", NULL, LF_ARG_FLAG, &opt.explain, NULL, "print the effect plan and exit without rendering"},
+    {"--white", NULL, LF_ARG_FLAG, &opt.white, NULL,
+     "render the white image: same camera and film, a uniform environment of radiance 1 (flat field)"},
+    {"--spp-range", NULL, LF_ARG_INT, opt.spp_range, "A B", "render only sample indices [A, B) (a mergeable part)",
+     .min = 0, .max = 1 << 24, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX, .count = 2, .given = &opt.have_spp_range},
+    {"--tile", NULL, LF_ARG_STRING, &opt.tile, "I/N", "render only row band I of N (0-based; a mergeable part)"},
+    {"--part", NULL, LF_ARG_FLAG, &opt.part, NULL, "write a mergeable part even without a split"},
+    {"--checkpoint-every", NULL, LF_ARG_DOUBLE, &opt.checkpoint_every, "S",
+     "save the film every S seconds (default path OUT.checkpoint.exr); SIGINT/SIGTERM save one and exit 130",
+     .min = 0, .flags = LF_ARG_MIN_OPEN},
+    {"--checkpoint", NULL, LF_ARG_STRING, &opt.checkpoint, "PATH", "where checkpoints go"},
+    {"--resume", NULL, LF_ARG_FLAG, &opt.resume, NULL, "continue from the checkpoint (same scene and settings)"},
+    {"--camera-plugin", NULL, LF_ARG_LIST, opt.plugins, "LIB.so", "load camera types from a shared object",
+     .count = MAX_PLUGINS, .count_out = &opt.n_plugins},
+    {"--aov", NULL, LF_ARG_CHOICE, &opt.aov, "disparity",
+     "light-field cameras: also write OUT.disparity.exr, the ground-truth disparity (px per view step) of every "
+     "pixel's view (docs/lightfield-format.md)",
+     .choices = "disparity"},
+};
+static const lf_arg merge_args[] = {
+    {"--output", "-o", LF_ARG_STRING, &opt.out, "OUT.exr", "the merged image", .flags = LF_ARG_REQUIRED},
+};
+
+static const lf_command commands[] = {
+    {NULL, "SCENE.pbrt [-o OUT.exr|OUT.png] [options]", "render a pbrt-v4 scene", render_args,
+     LF_ARRAY_LEN(render_args), 1, 1, run_render,
+     "Renders SCENE through lensfield's camera pack. The same seed gives the same image, bit for bit, on any number "
+     "of threads; parts of a split render merge into exactly the unsplit image."},
+    {"merge", "PART.exr... -o OUT.exr", "sum parts (--spp-range, --tile, --part) into the unsplit image, bit for bit",
+     merge_args, LF_ARRAY_LEN(merge_args), 1, -1, run_merge, NULL},
+};
+
+static const lf_tool tool = {"lfrender", "render pbrt-v4 scenes through lensfield's camera pack", LF_VERSION, commands,
+                             LF_ARRAY_LEN(commands),
+                             "Exit status: 0 success; 1 the scene or the render failed (the message names "
+                             "file:line:column); 2 bad command line; 130 interrupted after saving a checkpoint."};
+
+int main(int argc, char **argv)
+{
+    return lf_cli_main(&tool, argc, argv);
 }

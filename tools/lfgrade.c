@@ -1,6 +1,7 @@
 /* lfgrade - grade assignment submissions (docs/grading.md).
  *
  *   lfgrade ASSIGNMENT SUBMISSION... [--report DIR] [--json] [--cache DIR] [--threads N]
+ *   (the flags are the table at the end; `lfgrade --help`)
  *
  * ASSIGNMENT is a folder with rubric.txt (or a name under assignments/).
  * Exit codes: 0 grading ran (whatever the scores), 1 grader-side error
@@ -12,25 +13,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "cli.h"
 #include "grade/lf_grade.h"
 
 enum { EXIT_OK = 0, EXIT_GRADER = 1, EXIT_USAGE = 2 };
 
-static int usage(const char *msg)
-{
-    if (msg)
-        fprintf(stderr, "lfgrade: %s\n", msg);
-    fprintf(msg ? stderr : stdout,
-            "usage: lfgrade ASSIGNMENT SUBMISSION... [--report DIR] [--json] [--cache DIR] [--threads N]\n"
-            "  ASSIGNMENT     assignment folder with rubric.txt, or a name under assignments/\n"
-            "  SUBMISSION     a student's folder: the requested images (PNG or EXR) and Submission.md\n"
-            "  --report DIR   per-student HTML reports DIR/<student>/index.html, DIR/gradebook.csv|json\n"
-            "  --json         print each result as JSON on stdout\n"
-            "  --cache DIR    reference renders (default ~/.cache/lensfield)\n"
-            "  --threads N    render threads (default: all cores)\n"
-            "Nothing in a submission is executed; its commands are read as data.\n");
-    return msg ? EXIT_USAGE : EXIT_OK;
-}
+static struct {
+    const char *report, *cache;
+    int json, threads;
+} opt;
 
 static int is_dir(const char *p)
 {
@@ -63,66 +54,26 @@ static int find_assignment(const char *a, char *out, size_t n)
     return -1;
 }
 
-int main(int argc, char **argv)
+static int run_grade(int n, char **pos)
 {
-    const char *assignment = NULL, *report = NULL;
-    const char **subs = calloc((size_t)argc, sizeof *subs);
-    int nsubs = 0, json = 0;
+    const char *assignment = pos[0];
+    char **subs = pos + 1;
+    int nsubs = n - 1;
     lf_grade_opts o = lf_grade_opts_default();
-    if (!subs)
-        return EXIT_GRADER;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help"))
-            return free(subs), usage(NULL);
-        else if (!strcmp(a, "--json"))
-            json = 1;
-        else if (!strcmp(a, "--report") || !strcmp(a, "--cache") || !strcmp(a, "--threads")) {
-            if (i + 1 >= argc) {
-                free(subs);
-                fprintf(stderr, "lfgrade: %s needs a value\n", a);
-                return usage("");
-            }
-            const char *v = argv[++i];
-            if (!strcmp(a, "--report"))
-                report = v;
-            else if (!strcmp(a, "--cache"))
-                o.cache_dir = v;
-            else {
-                char *end;
-                long t = strtol(v, &end, 10);
-                if (*end || t < 0 || t > 1024) {
-                    free(subs);
-                    return usage("--threads needs a number 0..1024");
-                }
-                o.threads = (int)t;
-            }
-        } else if (a[0] == '-' && a[1]) {
-            free(subs);
-            fprintf(stderr, "lfgrade: unknown option %s\n", a);
-            return usage("");
-        } else if (!assignment)
-            assignment = a;
-        else
-            subs[nsubs++] = a;
-    }
-    if (!assignment || !nsubs) {
-        free(subs);
-        return usage("need an assignment and at least one submission");
-    }
+    if (opt.cache)
+        o.cache_dir = opt.cache;
+    o.threads = opt.threads;
     char adir[PATH_MAX];
     if (find_assignment(assignment, adir, sizeof adir)) {
         fprintf(stderr, "lfgrade: %s: no such assignment (a folder with rubric.txt, or a name under assignments/)\n",
                 assignment);
-        free(subs);
         return EXIT_USAGE;
     }
-    o.report_dir = report;
+    o.report_dir = opt.report;
     lf_error err = {0};
     lf_grade_ctx *g;
     if (lf_grade_ctx_new(adir, &o, &g, &err)) {
         fprintf(stderr, "lfgrade: %s\n", err.msg);
-        free(subs);
         return EXIT_GRADER;
     }
     lf_grade_result *res = calloc((size_t)nsubs, sizeof *res);
@@ -146,25 +97,52 @@ int main(int argc, char **argv)
             if (r->checks[k].status == LF_GRADE_FAIL)
                 fprintf(stderr, "    %s -%d: %s\n", r->checks[k].id, r->checks[k].points - r->checks[k].earned,
                         r->checks[k].reason);
-        if (json) {
+        if (opt.json) {
             char *j = lf_grade_result_json(r);
             if (j)
                 printf("%s\n", j);
             free(j);
         }
     }
-    if (report && graded) {
-        if (lf_grade_write_gradebook(report, res, graded, &err)) {
+    if (opt.report && graded) {
+        if (lf_grade_write_gradebook(opt.report, res, graded, &err)) {
             fprintf(stderr, "lfgrade: %s\n", err.msg);
             rc = EXIT_GRADER;
         } else {
-            fprintf(stderr, "lfgrade: reports in %s (gradebook.csv, gradebook.json, <student>/index.html)\n", report);
+            fprintf(stderr, "lfgrade: reports in %s (gradebook.csv, gradebook.json, <student>/index.html)\n",
+                    opt.report);
         }
     }
     for (int i = 0; i < graded; i++)
         lf_grade_result_free(&res[i]);
     free(res);
-    free(subs);
     lf_grade_ctx_release(g);
     return rc;
+}
+
+static const lf_arg grade_args[] = {
+    {"--report", NULL, LF_ARG_STRING, &opt.report, "DIR",
+     "per-student HTML reports DIR/<student>/index.html, DIR/gradebook.csv|json"},
+    {"--json", NULL, LF_ARG_FLAG, &opt.json, NULL, "print each result as JSON on stdout"},
+    {"--cache", NULL, LF_ARG_STRING, &opt.cache, "DIR", "reference renders (default ~/.cache/lensfield)"},
+    {"--threads", NULL, LF_ARG_INT, &opt.threads, "N", "render threads (default 0: all cores)", .min = 0, .max = 1024,
+     .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
+};
+
+static const lf_command commands[] = {
+    {NULL, "ASSIGNMENT SUBMISSION... [--report DIR] [--json] [--cache DIR] [--threads N]",
+     "grade assignment submissions against reference renders", grade_args, LF_ARRAY_LEN(grade_args), 2, -1, run_grade,
+     "ASSIGNMENT is a folder with rubric.txt, or a name under assignments/; each SUBMISSION is a student's folder "
+     "with the requested images (PNG or EXR) and Submission.md. Nothing in a submission is executed; its commands "
+     "are read as data."},
+};
+
+static const lf_tool tool = {"lfgrade", "grade course assignments built on lensfield", LF_VERSION, commands,
+                             LF_ARRAY_LEN(commands),
+                             "Exit status: 0 grading ran (whatever the scores); 1 a grader-side error (bad rubric, "
+                             "reference failed to render, report unwritable); 2 bad command line."};
+
+int main(int argc, char **argv)
+{
+    return lf_cli_main(&tool, argc, argv);
 }

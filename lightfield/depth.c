@@ -378,11 +378,6 @@ typedef struct dw {
     float d, w;
 } dw;
 
-static int cmp_dw(const void *a, const void *b)
-{
-    float x = ((const dw *)a)->d, y = ((const dw *)b)->d;
-    return (x > y) - (x < y);
-}
 
 static void wm_rows(void *vctx, int y0, int y1, int tid)
 {
@@ -408,7 +403,15 @@ static void wm_rows(void *vctx, int y0, int y1, int tid)
                     wsum += wt, n++;
                 }
             }
-            qsort(buf, (size_t)n, sizeof *buf, cmp_dw);
+            for (int k = 1; k < n; k++) { /* insertion sort: n is small */
+                dw t = buf[k];
+                int j = k - 1;
+                while (j >= 0 && buf[j].d > t.d) {
+                    buf[j + 1] = buf[j];
+                    j--;
+                }
+                buf[j + 1] = t;
+            }
             float half = 0.5f * wsum, s = 0;
             float med = c->disp[i];
             for (int k = 0; k < n; k++) {
@@ -473,7 +476,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     clock_gettime(CLOCK_MONOTONIC, &T0);
 #define TICK(name) do { if (getenv("LFD_VERBOSE")) { clock_gettime(CLOCK_MONOTONIC, &T1); fprintf(stderr, "  %s %.3f s\n", name, (T1.tv_sec - T0.tv_sec) + 1e-9 * (T1.tv_nsec - T0.tv_nsec)); T0 = T1; } } while (0)
     cost_ctx cc = {lf, views, nv, ref, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 1.f, o->occlusion, cost, scratch, per_thread};
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.f, o->occlusion, cost, scratch, per_thread};
     lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
     TICK("cost");
 
@@ -493,7 +496,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     int r = o->radius > 0 ? o->radius : (ns < nt ? ns : nt) / 128;
     if (r < 2)
         r = 2;
-    float eps = o->eps > 0 ? (float)o->eps : 1e-4f;
+    float eps = o->eps > 0 ? (float)o->eps : 1e-3f;
     for (int ch = 0; ch < 3; ch++)
         box_mean(I + ch * np, mI + ch * np, tmp, ns, nt, r);
     {
@@ -529,7 +532,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         rc = err ? err->code : LF_ERR_NOMEM;
         goto done;
     }
-    int mr = o->median_radius < 0 ? r : o->median_radius;
+    int mr = o->median_radius < 0 ? 3 : o->median_radius;
     if (mr > 0) {
         for (size_t i = 0; i < np; i++) {
             float g = ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2];
@@ -636,7 +639,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     double lim = (lf->ns < lf->nt ? lf->ns : lf->nt) / 4.0 / (m > 0 ? m : 1);
     if (lim > 8)
         lim = 8;
-    double step = 0.5 / m; /* 0.5 px at the outermost view, at quarter resolution */
+    double step = 0.25 / m; /* 0.25 px at the outermost view, at quarter resolution */
     lf_lf_depth_opts o = lf_lf_depth_defaults();
     o.threads = threads;
     o.occlusion = 0;
@@ -665,7 +668,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     double lo = vals[(size_t)(0.01 * (n - 1))] * f, hi = vals[(size_t)(0.99 * (n - 1))] * f;
     free(vals);
     lf_image_free(&disp), lf_image_free(&conf), lf_lf_free(&small);
-    double pad = 0.1 * (hi - lo) + 2 * step * f;
+    double pad = 0.05 * (hi - lo) + step * f;
     *d0 = lo - pad, *d1 = hi + pad;
     if (*d0 < -lim)
         *d0 = -lim;

@@ -34,11 +34,11 @@ extern "C" {
 typedef struct lf_lf_depth_opts {
     double d0, d1;       /* disparity search range (px per view); d0 >= d1: estimate from the data */
     double step;         /* label spacing (px per view); <= 0: auto (about 0.05 px shift at the widest view) */
-    int radius;          /* guided-filter radius (px); <= 0: auto (ns / 64, at least 3) */
-    double eps;          /* guided-filter regulariser on the [0,1] grey guide; <= 0: 1e-4 */
+    int radius;          /* guided-filter radius (px); <= 0: auto (shorter side / 128, at least 2) */
+    double eps;          /* guided-filter regulariser (colour guide in [0,1]); <= 0: 1e-3 */
     int occlusion;       /* 0: full aperture only; 1 (default): best of 8 half apertures too */
-    double defocus_weight; /* weight of the defocus cue against correspondence; < 0: 1 */
-    int median_radius;   /* weighted-median radius; 0: off; < 0: auto (= radius) */
+    double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
+    int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
     int threads;         /* <= 0: 2 */
 } lf_lf_depth_opts;
 lf_lf_depth_opts lf_lf_depth_defaults(void);
@@ -51,8 +51,8 @@ int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *di
 /* The disparity range the scene occupies, estimated by a coarse sweep at
  * quarter resolution over the widest range the views allow (shifts up to a
  * quarter of the view size at the outermost view, at most 8 px per view),
- * kept to the confident pixels' 1st..99th percentile and padded by 10% and
- * two coarse steps.  *d0 < *d1 on success. */
+ * kept to the confident pixels' 1st..99th percentile and padded by 5% and
+ * one coarse step.  *d0 < *d1 on success. */
 int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
 
 /* A view at centred view coordinates (u, v) inside the captured aperture

@@ -270,7 +270,7 @@ int main(int argc, char **argv)
             write_pfm(save, &disp);
             /* previews: disparity, |error| (x5, clipped), confidence */
             lf_image pv;
-            lf_image_alloc(&pv, disp.width * 3, disp.height, 1, &err);
+            lf_image_alloc(&pv, disp.width * 4, disp.height, 1, &err);
             for (int y = 0; y < disp.height; y++)
                 for (int x = 0; x < disp.width; x++) {
                     size_t i = (size_t)y * disp.width + x;
@@ -279,6 +279,7 @@ int main(int argc, char **argv)
                     row[x] = powf(fminf(fmaxf(a, 0.f), 1.f), 2.2f);
                     row[x + disp.width] = powf(fminf(b, 1.f), 2.2f);
                     row[x + 2 * disp.width] = powf(fminf(fmaxf(c, 0.f), 1.f), 2.2f);
+                    row[x + 3 * disp.width] = powf(fminf(fmaxf((gt.data[i] + 2.f) / 3.f, 0.f), 1.f), 2.2f);
                 }
             char pp[4096];
             snprintf(pp, sizeof pp, "%s.png", save);

@@ -31,7 +31,7 @@ lf_lf_depth_opts lf_lf_depth_defaults(void)
 {
     lf_lf_depth_opts o;
     memset(&o, 0, sizeof o);
-    o.occlusion = 1;
+    o.occlusion = 2;
     o.defocus_weight = -1;
     o.median_radius = -1;
     return o;
@@ -134,8 +134,25 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
             c = w4[x] > 0.f ? c : worst;
             out[x] = c < out[x] ? c : out[x];
         }
-        if (h == 7)
+        if (h == 7) {
+            if (occlusion < 2)
+                break;
+            /* lines through the reference (two opposite rays): a pixel between
+             * two occluders is seen by the views along their direction */
+            for (int k = 0; k < 4; k++) {
+                const float *a = acc + (size_t)(2 * k) * NFIELDS * ns, *b = acc + (size_t)(2 * k + 8) * NFIELDS * ns;
+                for (int x = 0; x < ns; x++) {
+                    float nn = a[4 * ns + x] + b[4 * ns + x];
+                    float n = nn > 0.f ? nn : 1.f;
+                    float c = (a[x] + b[x] +
+                               alpha * (fabsf(a[ns + x] + b[ns + x]) + fabsf(a[2 * ns + x] + b[2 * ns + x]) +
+                                        fabsf(a[3 * ns + x] + b[3 * ns + x]))) / n;
+                    c = nn > 0.f ? c : worst;
+                    out[x] = c < out[x] ? c : out[x];
+                }
+            }
             break;
+        }
         /* slide: groups 2h-4, 2h-3 leave, 2h+5, 2h+6 enter */
         for (int q = 0; q < 2; q++) {
             const float *o = acc + (size_t)((2 * h - 4 + q + NGROUPS) % NGROUPS) * NFIELDS * ns;
@@ -476,7 +493,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     clock_gettime(CLOCK_MONOTONIC, &T0);
 #define TICK(name) do { if (getenv("LFD_VERBOSE")) { clock_gettime(CLOCK_MONOTONIC, &T1); fprintf(stderr, "  %s %.3f s\n", name, (T1.tv_sec - T0.tv_sec) + 1e-9 * (T1.tv_nsec - T0.tv_nsec)); T0 = T1; } } while (0)
     cost_ctx cc = {lf, views, nv, ref, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.f, o->occlusion, cost, scratch, per_thread};
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
     lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
     TICK("cost");
 

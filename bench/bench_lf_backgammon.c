@@ -300,6 +300,27 @@ int main(int argc, char **argv)
         for (int j = 0; j < n5; j++)
             for (int i = 0; i < n5; i++)
                 memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
+        lf_image sd = {0}, sc = {0};
+        {
+            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            o.threads = threads;
+            double s = now();
+            if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
+                fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                return 1;
+            }
+            printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            if (getenv("LFD_GTVIEW")) { /* diagnostic: ground-truth geometry */
+                char gtp[4096];
+                snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
+                lf_image gt;
+                if (!read_pfm(gtp, &gt)) {
+                    for (size_t i = 0; i < (size_t)gt.width * gt.height; i++)
+                        sd.data[i] = 2 * gt.data[i], sc.data[i] = 1;
+                    lf_image_free(&gt);
+                }
+            }
+        }
         for (int method = baseline ? 0 : 1; method < 2; method++) {
             double sum = 0, worst = INFINITY, secs = 0;
             int count = 0;
@@ -314,6 +335,7 @@ int main(int argc, char **argv)
                     } else {
                         lf_lf_view_opts vo = lf_lf_view_defaults();
                         vo.threads = threads;
+                        vo.disparity = &sd, vo.confidence = &sc;
                         rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
                     }
                     secs += now() - s;
@@ -322,6 +344,14 @@ int main(int argc, char **argv)
                         return 1;
                     }
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
+                    if (getenv("LFD_VERBOSE"))
+                        printf("  view r%d c%d: %.2f dB\n", r, c, p);
+                    if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
+                        lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);
+                        for (size_t i = 0; i < (size_t)out.width * out.height * 3; i++)
+                            out.data[i] = 0.5f + 4 * (out.data[i] - lf_lf_view(&lf, c, r)[i]);
+                        lf_image_write("/tmp/lfd_v33_err.png", &out, NULL, NULL, &err);
+                    }
                     sum += p, count++;
                     worst = p < worst ? p : worst;
                     lf_image_free(&out);
@@ -331,6 +361,7 @@ int main(int argc, char **argv)
                    secs / count);
         }
         lf_lf_free(&sub);
+        lf_image_free(&sd), lf_image_free(&sc);
     }
     lf_lf_free(&lf);
     return 0;

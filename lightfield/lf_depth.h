@@ -68,7 +68,7 @@ typedef struct lf_lf_view_opts {
     const lf_image *confidence; /* NULL with a given disparity: all 1 */
     lf_lf_depth_opts depth;
     double plane_disparity;     /* fallback plane */
-    int views;                  /* nearest views blended; <= 0: 4 */
+    double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
     int threads;
 } lf_lf_view_opts;
 lf_lf_view_opts lf_lf_view_defaults(void);

@@ -344,8 +344,29 @@ int main(int argc, char **argv)
                         return 1;
                     }
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
-                    if (getenv("LFD_VERBOSE"))
-                        printf("  view r%d c%d: %.2f dB\n", r, c, p);
+                    if (getenv("LFD_VERBOSE")) {
+                        /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
+                        double se[2] = {0, 0};
+                        size_t nn[2] = {0, 0};
+                        const float *tv = lf_lf_view(&lf, c, r);
+                        for (int y = 15; y < out.height - 15; y++)
+                            for (int x = 15; x < out.width - 15; x++) {
+                                float g = sd.data[(size_t)y * out.width + x];
+                                int edge = 0;
+                                for (int j = -4; j <= 4 && !edge; j++)
+                                    for (int i = -4; i <= 4; i++)
+                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f)
+                                            edge = 1;
+                                for (int ch = 0; ch < 3; ch++) {
+                                    size_t q = ((size_t)y * out.width + x) * 3 + ch;
+                                    double e = (double)lf_srgb_encode(out.data[q]) - lf_srgb_encode(tv[q]);
+                                    se[edge] += e * e, nn[edge]++;
+                                }
+                            }
+                        printf("  view r%d c%d: %.2f dB (away from edges %.2f dB, near edges %.2f dB, %.1f %% of pixels)\n",
+                               r, c, p, 10 * log10(65025.0 * nn[0] / se[0]), 10 * log10(65025.0 * nn[1] / se[1]),
+                               100.0 * nn[1] / (nn[0] + nn[1]));
+                    }
                     if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
                         lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);
                         for (size_t i = 0; i < (size_t)out.width * out.height * 3; i++)

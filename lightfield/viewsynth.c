@@ -141,6 +141,49 @@ typedef struct vs_ctx {
     float *out;
 } vs_ctx;
 
+/* Colour of target pixel (x, y) at disparity d from the sources: visible
+ * sources (their own warped disparity is not clearly nearer) weighted by
+ * angular distance; returns the weighted colour variance across them (a
+ * photo-consistency score), or -1 when no source sees the point. */
+static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], float all[3], double *seen)
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    double acc[3] = {0, 0, 0}, sq = 0, wsum = 0, acc_all[3] = {0, 0, 0}, wall = 0;
+    for (int k = 0; k < c->nsrc; k++) {
+        /* I_target(x, y) = I_k(x - d (u_k - u), y - d (v_k - v)) */
+        double sx = x - d * c->du[k], sy = y - d * c->dv[k];
+        float col[3];
+        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
+        float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
+        double vis = dk > d + 0.25f + 0.05f * fabsf(d) ? 0.0 : 1.0;
+        double inside = (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1) ? 0.1 : 1.0;
+        double wk = c->wv[k] * inside;
+        for (int ch = 0; ch < 3; ch++)
+            acc_all[ch] += wk * col[ch];
+        wall += wk;
+        wk *= vis;
+        for (int ch = 0; ch < 3; ch++)
+            acc[ch] += wk * col[ch];
+        sq += wk * ((double)col[0] * col[0] + (double)col[1] * col[1] + (double)col[2] * col[2]);
+        wsum += wk;
+    }
+    for (int ch = 0; ch < 3; ch++)
+        all[ch] = (float)(wall > 0 ? acc_all[ch] / wall : 0);
+    *seen = wsum;
+    if (wsum <= 1e-6) {
+        for (int ch = 0; ch < 3; ch++)
+            rgb[ch] = all[ch];
+        return -1;
+    }
+    double m2 = 0;
+    for (int ch = 0; ch < 3; ch++) {
+        rgb[ch] = (float)(acc[ch] / wsum);
+        m2 += (double)rgb[ch] * rgb[ch];
+    }
+    double var = sq / wsum - m2;
+    return var > 0 ? var : 0;
+}
+
 static void vs_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
@@ -150,29 +193,34 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             float d = c->dt[i];
-            double acc[3] = {0, 0, 0}, wsum = 0, acc_all[3] = {0, 0, 0}, wall = 0;
-            for (int k = 0; k < c->nsrc; k++) {
-                /* I_target(x, y) = I_k(x - d (u_k - u), y - d (v_k - v)) */
-                double sx = x - d * c->du[k], sy = y - d * c->dv[k];
-                float rgb[3];
-                sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, rgb);
-                float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
-                /* visible unless view k sees something clearly nearer there */
-                double vis = getenv("LFD_NOVIS") ? 1.0 : (dk > d + 0.25f + 0.05f * fabsf(d) ? 0.0 : 1.0);
-                double out_of = (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1) ? 0.1 : 1.0;
-                double wk = c->wv[k] * out_of;
-                for (int ch = 0; ch < 3; ch++)
-                    acc_all[ch] += wk * rgb[ch];
-                wall += wk;
-                wk *= vis;
-                for (int ch = 0; ch < 3; ch++)
-                    acc[ch] += wk * rgb[ch];
-                wsum += wk;
+            /* near a depth edge the splatted map is only pixel-accurate:
+             * the nearest and farthest disparity around are candidates too,
+             * the one the sources agree on best wins */
+            float dmin = d, dmax = d;
+            for (int j = -1; j <= 1; j++)
+                for (int k = -1; k <= 1; k++) {
+                    int xx = clampi(x + k, 0, w - 1), yy = clampi(y + j, 0, h - 1);
+                    float v = c->dt[(size_t)yy * w + xx];
+                    dmin = v < dmin ? v : dmin, dmax = v > dmax ? v : dmax;
+                }
+            float px[3], all[3];
+            double seen, seen2;
+            double best = blend_at(c, x, y, d, px, all, &seen);
+            if (dmax - dmin > 0.25f) {
+                float cand[2] = {dmin, dmax};
+                for (int q = 0; q < 2; q++) {
+                    if (cand[q] == d)
+                        continue;
+                    float p2[3], a2[3];
+                    double v = blend_at(c, x, y, cand[q], p2, a2, &seen2);
+                    /* a candidate fewer sources see would win by seeing less */
+                    if (v >= 0 && seen2 >= seen - 1e-6 && (best < 0 || v < 0.5 * best)) {
+                        best = v;
+                        memcpy(px, p2, sizeof px);
+                    }
+                }
             }
             float *o = c->out + 3 * i;
-            float px[3];
-            for (int ch = 0; ch < 3; ch++)
-                px[ch] = (float)(wsum > 1e-6 ? acc[ch] / wsum : (wall > 0 ? acc_all[ch] / wall : 0));
             float a = c->cmin > 0 ? c->ct[i] / c->cmin : 1.f;
             a = a > 1.f ? 1.f : a;
             for (int ch = 0; ch < 3; ch++)

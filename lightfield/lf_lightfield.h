@@ -182,7 +182,8 @@ typedef struct lf_lf_synth_opts {
     double rot_deg[3];       /* camerarot: R = Rz * Ry * Rx (x applied first) */
     double lens_radius;      /* 0: pinhole */
     double focal_distance;   /* <= 0: infinity (pinhole only) */
-    int spp;                 /* 1: pixel and lens centre; else stratified jitter */
+    int spp;                 /* 1: pixel and lens centre; else stratified jitter (a pinhole whose
+                              * pixels are no larger than the data pixels samples pixel centres) */
     uint32_t seed;
     int threads;             /* <= 0: 2 */
 } lf_lf_synth_opts;

@@ -401,6 +401,22 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
     synth_ctx c;
     memset(&c, 0, sizeof c);
     c.lf = lf, c.o = o;
+    /* The views are already integrated over their pixels.  A pinhole
+     * virtual camera whose pixels subtend no more than a data pixel gets
+     * each pixel from the reconstruction at its centre: jittering over the
+     * pixel would integrate a second time and blur (at a data camera's own
+     * position, fov and size this reproduces the view exactly).  Larger
+     * virtual pixels (minification) and lenses keep their samples. */
+    lf_lf_synth_opts centred;
+    {
+        double out_px = tan(o->fov_deg * M_PI / 360) / (0.5 * (o->width < o->height ? o->width : o->height));
+        double in_px = tan(l->fov_deg * M_PI / 360) / (0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt));
+        if (o->lens_radius == 0 && o->spp > 1 && out_px <= in_px * (1 + 1e-9)) {
+            centred = *o;
+            centred.spp = 1;
+            c.o = o = &centred;
+        }
+    }
     double ax = o->rot_deg[0] * M_PI / 180, ay = o->rot_deg[1] * M_PI / 180, az = o->rot_deg[2] * M_PI / 180;
     double Rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
     double Ry[9] = {cos(ay), 0, sin(ay), 0, 1, 0, -sin(ay), 0, cos(ay)};

@@ -10,8 +10,6 @@
  * then per pixel the minimum, parabola refinement and confidence, then the
  * weighted median. */
 #include <float.h>
-#include <stdio.h>
-#include <time.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -489,13 +487,9 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     msum /= (double)np;
     float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 
-    struct timespec T0, T1;
-    clock_gettime(CLOCK_MONOTONIC, &T0);
-#define TICK(name) do { if (getenv("LFD_VERBOSE")) { clock_gettime(CLOCK_MONOTONIC, &T1); fprintf(stderr, "  %s %.3f s\n", name, (T1.tv_sec - T0.tv_sec) + 1e-9 * (T1.tv_nsec - T0.tv_nsec)); T0 = T1; } } while (0)
     cost_ctx cc = {lf, views, nv, ref, nl, d0, step, 0.5f, scale,
                    o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
     lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
-    TICK("cost");
 
     /* guide: the reference colour, square-root encoded (closer to perceptual
      * steps than linear) and normalised to [0, 1] */
@@ -538,12 +532,10 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     }
     gf_ctx gc = {ns, nt, r, I, mI, Sinv, cost, scratch, per_thread};
     lf_lf_parallel_for(nl, threads, 1, gf_slices, &gc);
-    TICK("guided filter");
 
     float *conf = disp + np;
     wta_ctx wc = {ns, nt, nl, d0, step, cost, disp, conf};
     lf_lf_parallel_for(nt, threads, 8, wta_rows, &wc);
-    TICK("wta");
 
     if (lf_image_alloc(disparity, ns, nt, 1, err)) {
         rc = err ? err->code : LF_ERR_NOMEM;
@@ -568,7 +560,6 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         }
         wm_ctx wm = {ns, nt, mr, disp, conf, refs, disparity->data, 0.02f, wscr, wpt};
         lf_lf_parallel_for(nt, threads, 4, wm_rows, &wm);
-        TICK("median");
     } else {
         memcpy(disparity->data, disp, sizeof(float) * np);
     }

@@ -15,7 +15,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #include "lf_depth.h"
 #include "parallel_internal.h"
@@ -284,9 +283,6 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     }
     float *dt = buf, *ct = buf + np;
     splat(D, C, w, h, fu - iu0, (fv - iv0) * rv, dt, ct);
-    if (getenv("LFD_NOSPLAT"))
-        for (size_t i = 0; i < np; i++)
-            dt[i] = D[i], ct[i] = 1;
     for (int k = 0; k < c.nsrc; k++) {
         float *dk = buf + (2 + (size_t)k) * np;
         splat(D, NULL, w, h, c.iu[k] - iu0, (c.iv[k] - iv0) * rv, dk, NULL);

@@ -889,15 +889,35 @@ static int cmd_synth(const opts *o)
     }
     if (!o->have_focal && (y->have & LF_LF_HAVE_CAM_LENS) && y->focal_distance > 0)
         s.focal_distance = y->focal_distance;
-    lf_image out, cov;
+    lf_image out, cov, dm = {0};
     size_t uncovered = 0;
     lf_error err = {0};
+    if (o->geometry && !strcmp(o->geometry, "depth")) { /* per-pixel geometry (docs/depth.md) */
+        lf_lf_depth_opts dop = lf_lf_depth_defaults();
+        dop.threads = o->threads;
+        if (o->dispmap)
+            rc = read_map(o->dispmap, &l.lf, &dm);
+        else if (lf_lf_depth(&l.lf, &dop, &dm, NULL, &err)) {
+            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+            rc = EXIT_INPUT;
+        }
+        if (rc) {
+            unload(&l);
+            return rc;
+        }
+        s.disparity = &dm;
+    } else if (o->dispmap) {
+        unload(&l);
+        return usage("%s", "--disparity-map needs --geometry depth");
+    }
     clock_t c0 = clock();
     if (lf_lf_synth(&l.lf, &s, &out, &cov, &uncovered, &err)) {
         fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+        lf_image_free(&dm);
         unload(&l);
         return EXIT_INPUT;
     }
+    lf_image_free(&dm);
     (void)c0;
     rc = write_image(o->output, &out, NULL);
     if (!rc && o->coverage)

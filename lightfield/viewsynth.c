@@ -205,7 +205,11 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
             float px[3], all[3];
             double seen, seen2;
             double best = blend_at(c, x, y, d, px, all, &seen);
-            if (dmax - dmin > 0.25f) {
+            if (dmax - dmin > 0.25f && best >= 0) {
+                /* soft choice: candidates weighted by 1 / (variance + floor);
+                 * a mixed (antialiased) edge pixel then gets a mix too */
+                const double floor_v = 1e-4;
+                double wsum = 1.0 / (best + floor_v), acc[3] = {px[0] * wsum, px[1] * wsum, px[2] * wsum};
                 float cand[2] = {dmin, dmax};
                 for (int q = 0; q < 2; q++) {
                     if (cand[q] == d)
@@ -213,11 +217,15 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
                     float p2[3], a2[3];
                     double v = blend_at(c, x, y, cand[q], p2, a2, &seen2);
                     /* a candidate fewer sources see would win by seeing less */
-                    if (v >= 0 && seen2 >= seen - 1e-6 && (best < 0 || v < 0.5 * best)) {
-                        best = v;
-                        memcpy(px, p2, sizeof px);
-                    }
+                    if (v < 0 || seen2 < seen - 1e-6)
+                        continue;
+                    double wq = 1.0 / (v + floor_v);
+                    for (int ch = 0; ch < 3; ch++)
+                        acc[ch] += wq * p2[ch];
+                    wsum += wq;
                 }
+                for (int ch = 0; ch < 3; ch++)
+                    px[ch] = (float)(acc[ch] / wsum);
             }
             float *o = c->out + 3 * i;
             float a = c->cmin > 0 ? c->ct[i] / c->cmin : 1.f;

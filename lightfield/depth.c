@@ -40,6 +40,7 @@ static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ?
 /* One non-reference view: its data, offset from the reference and angular group. */
 typedef struct dview {
     const float *data;
+    const float *valid; /* NULL: every sample valid */
     double du, dv; /* view steps from the reference (dv already scaled by disp_v_per_u) */
     int group;     /* 2k: on the ray at k*45 degrees; 2k+1: strictly inside octant k */
 } dview;
@@ -49,6 +50,7 @@ typedef struct cost_ctx {
     const dview *views;
     int nviews;
     const float *ref;    /* reference view, RGB */
+    const float *ref_valid; /* its validity (when lf->valid) */
     int nlabels;
     double d0, step;
     float tau;           /* truncation of the per-view colour difference (after scaling) */
@@ -90,6 +92,30 @@ LF_HOT_LOOP static void view_row(float *restrict acc, int ns, const float *restr
         sad[x] += ad < tau ? ad : tau;
         s0[x] += e0, s1[x] += e1, s2[x] += e2;
         n[x] += 1.f;
+    }
+}
+
+/* The same where the light field marks missing samples (lf->valid): a
+ * view counts at a pixel only when every texel it interpolates is valid. */
+LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float *restrict a0, const float *restrict a1,
+                                        const float *restrict b0, const float *restrict b1, const float *restrict ma0,
+                                        const float *restrict ma1, const float *restrict mb0, const float *restrict mb1,
+                                        const float *restrict c, const float *restrict mc, float w00, float w01,
+                                        float w10, float w11, float scale, float tau, int xa, int xb)
+{
+    float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
+                    *restrict n = acc + 4 * ns;
+    for (int x = xa; x <= xb; x++) {
+        int k = 3 * x;
+        float m = w00 * ma0[x] + w01 * ma1[x] + w10 * mb0[x] + w11 * mb1[x];
+        float ok = m > 0.999f && mc[x] > 0.5f ? 1.f : 0.f;
+        float e0 = (w00 * a0[k] + w01 * a1[k] + w10 * b0[k] + w11 * b1[k] - c[k]) * scale * ok;
+        float e1 = (w00 * a0[k + 1] + w01 * a1[k + 1] + w10 * b0[k + 1] + w11 * b1[k + 1] - c[k + 1]) * scale * ok;
+        float e2 = (w00 * a0[k + 2] + w01 * a1[k + 2] + w10 * b0[k + 2] + w11 * b1[k + 2] - c[k + 2]) * scale * ok;
+        float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
+        sad[x] += ad < tau ? ad : tau;
+        s0[x] += e0, s1[x] += e1, s2[x] += e2;
+        n[x] += ok;
     }
 }
 
@@ -195,8 +221,18 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                 const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
                 const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
                 int dx1 = fx > 0.f ? 3 : 0;
-                view_row(acc + (size_t)v->group * NFIELDS * ns, ns, row0, row0 + dx1, row1, row1 + dx1, cref,
-                         (1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy, c->scale, c->tau, xa, xb);
+                float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+                float *a = acc + (size_t)v->group * NFIELDS * ns;
+                if (v->valid) {
+                    /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
+                    const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
+                    int mx1 = fx > 0.f ? 1 : 0;
+                    view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
+                                    c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+                } else {
+                    view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa,
+                             xb);
+                }
             }
             combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion);
         }
@@ -223,9 +259,7 @@ LF_HOT_LOOP static void box_mean(const float *restrict in, float *restrict out, 
                 s -= a[x - r];
         }
     }
-    /* vertical sums, a row at a time (vectorises across x) */
-    float *acc = out; /* row 0 of out as the running column sums, then rows written in order */
-    (void)acc;
+    /* vertical running sums: each output row from the previous one (vectorises across x) */
     for (int y = 0; y < h; y++) {
         int ya = y - r < 0 ? 0 : y - r, yb = y + r > h - 1 ? h - 1 : y + r;
         float *o = out + (size_t)y * w;
@@ -477,6 +511,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
                 continue;
             dview *v = &views[nv++];
             v->data = lf_lf_view(lf, iu, iv);
+            v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
             v->du = iu - iu0, v->dv = (iv - iv0) * rv;
             v->group = view_group(v->du, v->dv);
         }
@@ -487,8 +522,10 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     msum /= (double)np;
     float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 
-    cost_ctx cc = {lf, views, nv, ref, nl, d0, step, 0.5f, scale,
+    cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
                    o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
+    if (lf->valid)
+        cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
     lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
 
     /* guide: the reference colour, square-root encoded (closer to perceptual
@@ -544,8 +581,6 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     int mr = o->median_radius < 0 ? 3 : o->median_radius;
     if (mr > 0) {
         for (size_t i = 0; i < np; i++) {
-            float g = ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2];
-            (void)g;
             for (int ch = 0; ch < 3; ch++) {
                 float v = ref[3 * i + ch] * scale;
                 refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;

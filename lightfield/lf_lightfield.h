@@ -188,9 +188,16 @@ typedef struct lf_lf_synth_opts {
     double rot_deg[3];       /* camerarot: R = Rz * Ry * Rx (x applied first) */
     double lens_radius;      /* 0: pinhole */
     double focal_distance;   /* <= 0: infinity (pinhole only) */
-    int spp;                 /* 1: pixel and lens centre; else stratified jitter */
+    int spp;                 /* 1: pixel and lens centre; else stratified jitter (a pinhole whose
+                              * pixels are no larger than the data pixels samples pixel centres) */
     uint32_t seed;
     int threads;             /* <= 0: 2 */
+    /* Per-pixel geometry (NULL: the focal plane, as above): the centre
+     * view's disparity map (ns x nt, 1 channel; lf_lf_depth).  Each ray is
+     * intersected with that surface (marched in disparity steps of 0.05
+     * px/view from near to far) and the data cameras are looked up where
+     * they see the hit point instead of the focal point. */
+    const lf_image *disparity;
 } lf_lf_synth_opts;
 lf_lf_synth_opts lf_lf_synth_defaults(void);
 /* coverage may be NULL; else a 1-channel image: fraction of samples whose ray

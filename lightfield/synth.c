@@ -10,6 +10,7 @@
  * numbers are counter-based (splitmix64 of the pixel's key), rows are handed
  * to the threads one at a time, and texels are read from the views in place
  * (RGB interleaved per row) with 4-float loads. */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -54,6 +55,10 @@ typedef struct synth_ctx {
     size_t cam_texel[4];           /* the same in texels */
     lf_image *out, *cov;
     atomic_int *next_row;          /* rows are handed out one at a time */
+    /* per-pixel geometry (o->disparity): reference camera, map range */
+    const float *disp;
+    double ref_x, ref_y;           /* reference camera, grid-relative */
+    float dmin, dmax;
     size_t uncovered;
 } synth_ctx;
 
@@ -103,6 +108,60 @@ typedef struct synth_group {
     v4i view; /* index of view (i0, j0) */
 } synth_group;
 
+/* Disparity of the reference view at pixel position (px, py) (0..ns edges),
+ * bilinear between texel centres; < 0 outside the view. */
+static inline float ref_disparity(const synth_ctx *c, float px, float py)
+{
+    const int ns = c->lf->ns, nt = c->lf->nt;
+    if (!(px >= 0 && py >= 0 && px <= (float)ns && py <= (float)nt))
+        return -1.f;
+    float xi = fminf(fmaxf(px - 0.5f, 0), (float)(ns - 1)), yi = fminf(fmaxf(py - 0.5f, 0), (float)(nt - 1));
+    int x0 = (int)xi, y0 = (int)yi, x1 = x0 + 1 < ns ? x0 + 1 : x0, y1 = y0 + 1 < nt ? y0 + 1 : y0;
+    float fx = xi - (float)x0, fy = yi - (float)y0;
+    const float *d = c->disp;
+    return (1 - fy) * ((1 - fx) * d[(size_t)y0 * ns + x0] + fx * d[(size_t)y0 * ns + x1]) +
+           fy * ((1 - fx) * d[(size_t)y1 * ns + x0] + fx * d[(size_t)y1 * ns + x1]);
+}
+
+/* First hit of the line o + t dir (t > 0) with the surface of the reference
+ * disparity map (grid-relative space; disparity d <-> depth fscale bx / d):
+ * marched from the nearest to the farthest disparity of the map, the
+ * crossing interpolated linearly.  Returns 0 when the ray meets no surface
+ * (then *hit is untouched). */
+static int depth_hit(const synth_ctx *c, const double o[3], const double dir[3], double hit[3])
+{
+    if (!(fabs(dir[2]) > 1e-12))
+        return 0;
+    const double k = c->in_scale * c->bx; /* d = k / z */
+    const double step = 0.05;
+    double prev_gap = 0, prev_d = 0;
+    int have_prev = 0;
+    for (double d = c->dmax + step; d >= c->dmin - step; d -= step) {
+        double dd = d > 1e-3 ? d : 1e-3, z = k / dd, t = (z - o[2]) / dir[2];
+        if (t <= 0) {
+            have_prev = 0;
+            continue;
+        }
+        double x = o[0] + t * dir[0], y = o[1] + t * dir[1];
+        float ds = ref_disparity(c, (float)(c->lf->ns * 0.5 + (x - c->ref_x) * c->in_scale / z),
+                                 (float)(c->lf->nt * 0.5 + (y - c->ref_y) * c->in_scale / z));
+        if (ds < -0.5f) { /* outside the reference view */
+            have_prev = 0;
+            continue;
+        }
+        double gap = d - ds; /* > 0: the ray point is in front of the surface */
+        if (gap <= 0) {
+            double dh = have_prev ? prev_d - prev_gap * (d - prev_d) / (gap - prev_gap) : d;
+            dh = dh > 1e-3 ? dh : 1e-3;
+            double zh = k / dh, th = (zh - o[2]) / dir[2];
+            hit[0] = o[0] + th * dir[0], hit[1] = o[1] + th * dir[1], hit[2] = zh;
+            return 1;
+        }
+        prev_gap = gap, prev_d = d, have_prev = 1;
+    }
+    return 0;
+}
+
 /* Geometry of 4 samples: film offsets (jx, jy) px from pixel (x, y), whose
  * focal point (or direction) Fp is given; lens points (lx, ly) on the unit
  * disk; lanes with live == 0 are not samples. */
@@ -116,6 +175,26 @@ static inline void group_setup(const synth_ctx *c, int finite_focus, const float
     v4f f2 = Fp[2] + jx * c->fFX[2] + jy * c->fFY[2];
     v4f cx, cy, A;
     v4i hit;
+    if (c->disp) {
+        /* per-pixel geometry: the surface point replaces the focal point */
+        for (int s = 0; s < 4; s++) {
+            double o[3], dir[3], h[3];
+            for (int a = 0; a < 3; a++) {
+                float fa = a == 0 ? f0[s] : (a == 1 ? f1[s] : f2[s]);
+                float la = a == 0 ? c->fLX[0] * lx[s] + c->fLY[0] * ly[s]
+                                  : (a == 1 ? c->fLX[1] * lx[s] + c->fLY[1] * ly[s] : c->fLX[2] * lx[s] + c->fLY[2] * ly[s]);
+                o[a] = c->fpos[a] + la;
+                dir[a] = finite_focus ? fa - o[a] : fa;
+            }
+            if (live[s] && depth_hit(c, o, dir, h)) {
+                f0[s] = (float)h[0], f1[s] = (float)h[1], f2[s] = (float)h[2];
+            } else if (!finite_focus && fabs(dir[2]) > 1e-12) { /* no surface: the far end of the map */
+                double z = c->in_scale * c->bx / (c->dmin > 1e-3 ? c->dmin : 1e-3), t = (z - o[2]) / dir[2];
+                f0[s] = (float)(o[0] + t * dir[0]), f1[s] = (float)(o[1] + t * dir[1]), f2[s] = (float)z;
+            }
+        }
+        finite_focus = 1;
+    }
     if (finite_focus) {
         /* origin on the lens, through the focal point f */
         v4f o0 = c->fpos[0] + lx * c->fLX[0] + ly * c->fLY[0];
@@ -166,6 +245,34 @@ static inline void group_setup(const synth_ctx *c, int finite_focus, const float
     g->w[0] = vsel(hit, bx * by, zero), g->w[1] = vsel(hit, ax * by, zero);
     g->w[2] = vsel(hit, bx * ay, zero), g->w[3] = vsel(hit, ax * ay, zero);
     g->view = __builtin_convertvector(j0 * (float)lf->nu + i0, v4i); /* exact below 2^24 views */
+    if (c->disp) {
+        /* visibility: a data camera whose line of sight to the surface point
+         * meets a clearly nearer surface first sees an occluder there; it
+         * drops out and the others' weights are renormalised */
+        const double k = c->in_scale * c->bx;
+        for (int s = 0; s < 4; s++) {
+            if (!hit[s])
+                continue;
+            double S[3] = {f0[s], f1[s], f2[s]}, dS = k / S[2], wsum = 0, wvis = 0;
+            float keep[4];
+            for (int q = 0; q < 4; q++) {
+                keep[q] = 1.f;
+                float wq = g->w[q][s];
+                wsum += wq;
+                if (!(wq > 0))
+                    continue;
+                double C[3] = {(lf->nu > 1 ? i0[s] * c->bx : cx[s]) + ((q & 1) && lf->nu > 1 ? c->bx : 0),
+                               (lf->nv > 1 ? j0[s] * c->by : cy[s]) + ((q & 2) && lf->nv > 1 ? c->by : 0), 0};
+                double dir[3] = {S[0] - C[0], S[1] - C[1], S[2] - C[2]}, h[3];
+                if (depth_hit(c, C, dir, h) && k / h[2] > dS + 0.15 + 0.05 * fabs(dS))
+                    keep[q] = 0.f;
+                wvis += wq * keep[q];
+            }
+            if (wvis > 0 && wvis < wsum)
+                for (int q = 0; q < 4; q++)
+                    g->w[q][s] = g->w[q][s] * keep[q] * (float)(wsum / wvis);
+        }
+    }
 }
 
 /* Data camera view `view` (mask m) at pixel (px, py), 0 <= px <= ns and
@@ -401,6 +508,22 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
     synth_ctx c;
     memset(&c, 0, sizeof c);
     c.lf = lf, c.o = o;
+    /* The views are already integrated over their pixels.  A pinhole
+     * virtual camera whose pixels subtend no more than a data pixel gets
+     * each pixel from the reconstruction at its centre: jittering over the
+     * pixel would integrate a second time and blur (at a data camera's own
+     * position, fov and size this reproduces the view exactly).  Larger
+     * virtual pixels (minification) and lenses keep their samples. */
+    lf_lf_synth_opts centred;
+    {
+        double out_px = tan(o->fov_deg * M_PI / 360) / (0.5 * (o->width < o->height ? o->width : o->height));
+        double in_px = tan(l->fov_deg * M_PI / 360) / (0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt));
+        if (o->lens_radius == 0 && o->spp > 1 && out_px <= in_px * (1 + 1e-9)) {
+            centred = *o;
+            centred.spp = 1;
+            c.o = o = &centred;
+        }
+    }
     double ax = o->rot_deg[0] * M_PI / 180, ay = o->rot_deg[1] * M_PI / 180, az = o->rot_deg[2] * M_PI / 180;
     double Rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
     double Ry[9] = {cos(ay), 0, sin(ay), 0, 1, 0, -sin(ay), 0, cos(ay)};
@@ -448,6 +571,32 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
         c.fLX[a] = (float)(o->lens_radius * r0), c.fLY[a] = (float)(o->lens_radius * r1);
     }
     c.fns = (float)lf->ns, c.fnt = (float)lf->nt, c.fbx = (float)c.bx, c.fby = (float)c.by;
+    if (o->disparity) {
+        const lf_image *dm = o->disparity;
+        if (dm->width != lf->ns || dm->height != lf->nt || dm->channels != 1 || !dm->data) {
+            lf_image_free(out);
+            if (coverage)
+                lf_image_free(coverage);
+            return lf_error_set(err, LF_ERR_PARAM, "synth: the disparity map must be 1 channel, %dx%d like the views",
+                                lf->ns, lf->nt);
+        }
+        c.disp = dm->data;
+        c.dmin = FLT_MAX, c.dmax = -FLT_MAX;
+        for (size_t i = 0; i < (size_t)lf->ns * lf->nt; i++) {
+            if (!isfinite(dm->data[i])) {
+                lf_image_free(out);
+                if (coverage)
+                    lf_image_free(coverage);
+                return lf_error_set(err, LF_ERR_NUMERIC, "synth: non-finite value in the disparity map");
+            }
+            c.dmin = fminf(c.dmin, dm->data[i]), c.dmax = fmaxf(c.dmax, dm->data[i]);
+        }
+        c.ref_x = ((lf->nu - 1) / 2) * c.bx, c.ref_y = ((lf->nv - 1) / 2) * c.by;
+        if (lf->nu == 1)
+            c.ref_x = 0;
+        if (lf->nv == 1)
+            c.ref_y = 0;
+    }
     c.finv_bx = (float)c.inv_bx, c.finv_by = (float)c.inv_by, c.fscale = (float)c.in_scale;
     c.view_texels = (size_t)lf->ns * lf->nt;
     c.last_texel = (size_t)lf->nu * lf->nv * c.view_texels - 1;

@@ -154,6 +154,20 @@ int main(void)
     CHECK(run("%s allfocus %s --from 0 --to 1 --steps 3 -o %s/af.exr", LFTOOL, raw_path, dir) == 0);
     CHECK(run("%s depth %s --from 0 --to 1 --steps 3 -o %s/dm.exr", LFTOOL, raw_path, dir) == 0);
     CHECK(run("%s view %s --u 0.5 --v -0.5 -o %s/view.exr", LFTOOL, raw_path, dir) == 0);
+    /* depth with no range (estimated), confidence beside it */
+    CHECK(run("%s depth %s -o %s/dm2.exr --confidence %s/conf.exr", LFTOOL, raw_path, dir, dir) == 0);
+    CHECK(strstr(out_text, "estimated") != NULL);
+    snprintf(path, sizeof path, "%s/conf.exr", dir);
+    CHECK(exists(path));
+    CHECK(run("%s depth %s --from 0 -o %s/dm3.exr", LFTOOL, raw_path, dir) == 2); /* --to missing */
+    CHECK(run("%s depth %s --method stack --from 0 --to 1 --steps 3 -o %s/dm4.exr", LFTOOL, raw_path, dir) == 0);
+    /* view: the plane blend on request, a given disparity map, a map of the wrong size */
+    CHECK(run("%s view %s --u 0.5 --v -0.5 --geometry plane --disparity 0.5 -o %s/viewp.exr", LFTOOL, raw_path, dir) == 0);
+    CHECK(run("%s view %s --u 0.5 --v -0.5 --disparity-map %s/dm2.exr -o %s/viewd.exr", LFTOOL, raw_path, dir, dir) == 0);
+    CHECK(run("%s view %s --u 0.5 --v -0.5 --disparity-map %s -o %s/viewd.exr", LFTOOL, raw_path, raw_path, dir) == 1);
+    CHECK(strstr(out_text, "views are") != NULL);
+    CHECK(run("%s view %s --u 0.5 --v 0 --geometry plane --disparity-map %s/dm2.exr -o %s/v.exr", LFTOOL, raw_path, dir,
+              dir) == 2);
     CHECK(run("%s view %s --u 3 --v 0 -o %s/view.exr", LFTOOL, raw_path, dir) == 1);
     CHECK(strstr(out_text, "outside") != NULL);
 
@@ -168,6 +182,10 @@ int main(void)
                 maxd = fmax(maxd, fabs(lf_image_px(&v, x, y)[c] - lf_image_px(&raw, TW + x, TH + y)[c]));
     CHECK_MSG(maxd < 1e-5, "synth at the centre camera differs from its tile by %g", maxd);
     lf_image_free(&v);
+    /* synth with per-pixel geometry (estimated, or a given map) */
+    CHECK(run("%s synth %s %s/synd.exr --geometry depth --camerapos 0.01 0.01 0", LFTOOL, raw_path, dir) == 0);
+    CHECK(run("%s synth %s %s/synd.exr --geometry depth --disparity-map %s/dm2.exr", LFTOOL, raw_path, dir, dir) == 0);
+    CHECK(run("%s synth %s %s/synd.exr --disparity-map %s/dm2.exr", LFTOOL, raw_path, dir, dir) == 2);
     /* all the CS348B flags, on a raw without attributes */
     CHECK(run("%s synth %s %s/syn2.exr --camsperdim 3 3 --griddim -0.04 0.04 -0.04 0.04 --inputfov 40 --outputfov 30 "
               "--outputdim 40 30 --camerapos 0.01 0.02 -0.1 --camerarot 0 5 0 --lensradius 0.01 --focaldistance 1.5 "

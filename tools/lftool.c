@@ -5,8 +5,9 @@
  *   lftool calibrate WHITE.exr -o LAYOUT.exr [--grid square|hex]
  *   lftool refocus RAW.exr (--alpha A | --depth M | --disparity PX) [--aperture R | --views u0 u1 v0 v1]
  *                  [--method shift|fourier] -o OUT
- *   lftool stack|allfocus|depth RAW.exr --from D0 --to D1 [--steps N] -o OUT
- *   lftool view RAW.exr --u U --v V [--disparity PX] -o OUT
+ *   lftool stack|allfocus RAW.exr --from D0 --to D1 [--steps N] -o OUT
+ *   lftool depth RAW.exr [--from D0 --to D1] [--confidence C.exr] -o OUT.exr|.pfm
+ *   lftool view RAW.exr --u U --v V [--geometry plane --disparity PX | --disparity-map D.exr] -o OUT
  *   lftool synth LF.exr OUT.exr [CS348B flags]
  *   lftool export-web RAW.exr -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]
  *   lftool serve DIR [--port P]
@@ -29,6 +30,7 @@
 #include <unistd.h>
 
 #include "image/lf_image.h"
+#include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
 #include "web/lf_web.h"
 
@@ -45,9 +47,13 @@ static const char *usage_text =
     "                                        [--views u0 u1 v0 v1] [--method shift|fourier] [--oversample S]\n"
     "  stack RAW.exr -o DIR                  focal stack --from D0 --to D1 [--steps N] (disparities)\n"
     "  allfocus RAW.exr -o OUT               all-in-focus image from a stack (same flags)\n"
-    "  depth RAW.exr -o OUT                  disparity map from a stack (same flags)\n"
-    "  view RAW.exr --u U --v V -o OUT       view from (U, V) in view units from the centre [--disparity PX]\n"
+    "  depth RAW.exr -o OUT.exr|.pfm         disparity map of the centre view (docs/depth.md) [--from D0 --to D1]\n"
+    "                                        [--confidence CONF.exr] [--method stack: focal-stack contrast]\n"
+    "  view RAW.exr --u U --v V -o OUT       view from (U, V) in view units from the centre, per-pixel depth\n"
+    "                                        [--disparity-map D.exr [--confidence C.exr]]; plane blend:\n"
+    "                                        --geometry plane [--disparity PX]\n"
     "  synth LF.exr OUT.exr                  CS348B virtual camera: --samplesperpixel N --focaldistance D\n"
+    "                                        [--geometry depth [--disparity-map D.exr]]\n"
     "                                        --camerapos x y z --camerarot x y z --inputfov DEG --outputfov DEG\n"
     "                                        --lensradius R --griddim minx maxx miny maxy --camsperdim nx ny\n"
     "                                        --outputdim w h [--coverage COV.exr] [--seed S]\n"
@@ -67,6 +73,7 @@ static const char *usage_text =
 
 typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
+    const char *confidence, *dispmap, *geometry; /* depth, view, synth */
     lf_lf_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
@@ -150,10 +157,19 @@ static int parse(int argc, char **argv, opts *o)
                 return usage("--layout %s: only hci is known", o->hci);
         } else if (!strcmp(a, "--method")) {
             STR(o->method);
-            if (strcmp(o->method, "shift") && strcmp(o->method, "fourier"))
-                return usage("--method %s: expected shift or fourier", o->method);
+            if (strcmp(o->method, "shift") && strcmp(o->method, "fourier") && strcmp(o->method, "stack"))
+                return usage("--method %s: expected shift or fourier (refocus) or stack (depth)", o->method);
         } else if (!strcmp(a, "--coverage"))
             STR(o->coverage);
+        else if (!strcmp(a, "--confidence"))
+            STR(o->confidence);
+        else if (!strcmp(a, "--disparity-map"))
+            STR(o->dispmap);
+        else if (!strcmp(a, "--geometry")) {
+            STR(o->geometry);
+            if (strcmp(o->geometry, "plane") && strcmp(o->geometry, "depth"))
+                return usage("--geometry %s: expected plane or depth", o->geometry);
+        }
         else if (!strcmp(a, "--alpha"))
             {
             NUMS(1);
@@ -761,7 +777,113 @@ static int cmd_allfocus_depth(const opts *o, int want_depth)
 }
 
 static int cmd_allfocus(const opts *o) { return cmd_allfocus_depth(o, 0); }
-static int cmd_depth(const opts *o) { return cmd_allfocus_depth(o, 1); }
+/* Disparity range for depth: --from/--to, else lensfield:disp_min/max of
+ * the input (a benchmark folder's [meta] disp_min/disp_max), else 0 0
+ * (estimated from the data).  Returns the source's name. */
+static const char *depth_range(const opts *o, const lf_attrs *attrs, double *d0, double *d1)
+{
+    *d0 = *d1 = 0;
+    if (o->have_from && o->have_to) {
+        *d0 = o->from, *d1 = o->to;
+        return "--from/--to";
+    }
+    const lf_attr *a = lf_attrs_get(attrs, "lensfield:disp_min"), *b = lf_attrs_get(attrs, "lensfield:disp_max");
+    if (a && b) {
+        double x = a->type == LF_ATTR_INT ? a->i : a->d, y = b->type == LF_ATTR_INT ? b->i : b->d;
+        if (isfinite(x) && isfinite(y) && x < y) {
+            *d0 = x, *d1 = y;
+            return "lensfield:disp_min/max";
+        }
+    }
+    return "estimated";
+}
+
+static int cmd_depth(const opts *o)
+{
+    if (o->method && !strcmp(o->method, "stack"))
+        return cmd_allfocus_depth(o, 1);
+    int rc = need_output(o);
+    if (rc)
+        return rc;
+    if (o->have_from != o->have_to)
+        return usage("%s", "depth: give both --from and --to, or neither (range from the file or the data)");
+    if (o->have_from && !(o->from < o->to))
+        return usage("%s", "depth: --from must be below --to");
+    loaded l;
+    if ((rc = load(o, &l, 0)))
+        return rc;
+    lf_lf_depth_opts d = lf_lf_depth_defaults();
+    d.threads = o->threads;
+    const char *src = depth_range(o, &l.attrs, &d.d0, &d.d1);
+    lf_error err = {0};
+    if (d.d0 >= d.d1 && lf_lf_depth_range(&l.lf, o->threads, &d.d0, &d.d1, &err)) {
+        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+        unload(&l);
+        return EXIT_INPUT;
+    }
+    if (o->have_steps) {
+        if (o->steps < 3) {
+            unload(&l);
+            return usage("%s", "--steps must be >= 3");
+        }
+        d.step = (d.d1 - d.d0) / (o->steps - 1);
+    }
+    lf_image disp, conf;
+    if (lf_lf_depth(&l.lf, &d, &disp, o->confidence ? &conf : NULL, &err)) {
+        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+        unload(&l);
+        return EXIT_INPUT;
+    }
+    lf_attrs a = {0};
+    float range[2] = {(float)d.d0, (float)d.d1};
+    lf_attrs_set_floats(&a, "lensfield:disparity_search_range", range, 2);
+    lf_attrs_set_string(&a, "lensfield:disparity_convention",
+                        "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step");
+    rc = write_image(o->output, &disp, &a);
+    if (!rc && o->confidence)
+        rc = write_image(o->confidence, &conf, NULL);
+    if (!rc)
+        printf("%s: disparity map (range %.4g .. %.4g px/view, %s) -> %s%s%s\n", o->input, d.d0, d.d1, src, o->output,
+               o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
+    if (rc) /* no half-written result: the disparity map goes with its confidence */
+        remove(o->output);
+    lf_attrs_free(&a);
+    lf_image_free(&disp);
+    if (o->confidence)
+        lf_image_free(&conf);
+    unload(&l);
+    return rc;
+}
+
+/* A 1-channel map of the views' size (first channel of a colour image). */
+static int read_map(const char *path, const lf_lightfield *lf, lf_image *m)
+{
+    lf_image img;
+    lf_error err = {0};
+    if (lf_image_read(path, &img, NULL, &err)) {
+        fprintf(stderr, "lftool: %s\n", err.msg);
+        return EXIT_INPUT;
+    }
+    if (img.width != lf->ns || img.height != lf->nt) {
+        fprintf(stderr, "lftool: %s: map is %dx%d, the views are %dx%d\n", path, img.width, img.height, lf->ns, lf->nt);
+        lf_image_free(&img);
+        return EXIT_INPUT;
+    }
+    if (lf_image_alloc(m, img.width, img.height, 1, &err)) {
+        lf_image_free(&img);
+        fprintf(stderr, "lftool: %s\n", err.msg);
+        return EXIT_INPUT;
+    }
+    for (size_t i = 0; i < (size_t)img.width * img.height; i++)
+        m->data[i] = img.data[i * img.channels];
+    lf_image_free(&img);
+    if (lf_image_count_nonfinite(m)) {
+        fprintf(stderr, "lftool: %s: non-finite values in the map\n", path);
+        lf_image_free(m);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
 
 static int cmd_view(const opts *o)
 {
@@ -770,6 +892,11 @@ static int cmd_view(const opts *o)
         return rc;
     if (!o->have_u || !o->have_v)
         return usage("%s", "view needs --u U --v V");
+    /* per-pixel geometry by default; the plane blend with --geometry plane
+     * (or, as before, when a focus plane is given without --geometry) */
+    int plane = o->geometry ? !strcmp(o->geometry, "plane") : (o->have_alpha + o->have_depth + o->have_disp) > 0;
+    if (plane && o->dispmap)
+        return usage("%s", "--disparity-map needs --geometry depth");
     loaded l;
     if ((rc = load(o, &l, 0)))
         return rc;
@@ -778,9 +905,26 @@ static int cmd_view(const opts *o)
         unload(&l);
         return rc;
     }
-    lf_image out;
+    lf_image out, dm = {0}, cm = {0};
     lf_error err = {0};
-    if (lf_lf_view_at(&l.lf, o->u, o->v, d, &out, &err)) {
+    if (!plane && o->dispmap &&
+        ((rc = read_map(o->dispmap, &l.lf, &dm)) || (o->confidence && (rc = read_map(o->confidence, &l.lf, &cm))))) {
+        lf_image_free(&dm);
+        unload(&l);
+        return rc;
+    }
+    if (plane)
+        rc = lf_lf_view_at(&l.lf, o->u, o->v, d, &out, &err);
+    else {
+        lf_lf_view_opts vo = lf_lf_view_defaults();
+        vo.threads = o->threads;
+        vo.plane_disparity = d;
+        vo.disparity = o->dispmap ? &dm : NULL;
+        vo.confidence = o->dispmap && o->confidence ? &cm : NULL;
+        rc = lf_lf_view_depth(&l.lf, o->u, o->v, &vo, &out, &err);
+    }
+    lf_image_free(&dm), lf_image_free(&cm);
+    if (rc) {
         fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
         unload(&l);
         return EXIT_INPUT;
@@ -827,15 +971,35 @@ static int cmd_synth(const opts *o)
     }
     if (!o->have_focal && (y->have & LF_LF_HAVE_CAM_LENS) && y->focal_distance > 0)
         s.focal_distance = y->focal_distance;
-    lf_image out, cov;
+    lf_image out, cov, dm = {0};
     size_t uncovered = 0;
     lf_error err = {0};
+    if (o->geometry && !strcmp(o->geometry, "depth")) { /* per-pixel geometry (docs/depth.md) */
+        lf_lf_depth_opts dop = lf_lf_depth_defaults();
+        dop.threads = o->threads;
+        if (o->dispmap)
+            rc = read_map(o->dispmap, &l.lf, &dm);
+        else if (lf_lf_depth(&l.lf, &dop, &dm, NULL, &err)) {
+            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+            rc = EXIT_INPUT;
+        }
+        if (rc) {
+            unload(&l);
+            return rc;
+        }
+        s.disparity = &dm;
+    } else if (o->dispmap) {
+        unload(&l);
+        return usage("%s", "--disparity-map needs --geometry depth");
+    }
     clock_t c0 = clock();
     if (lf_lf_synth(&l.lf, &s, &out, &cov, &uncovered, &err)) {
         fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+        lf_image_free(&dm);
         unload(&l);
         return EXIT_INPUT;
     }
+    lf_image_free(&dm);
     (void)c0;
     rc = write_image(o->output, &out, NULL);
     if (!rc && o->coverage)

@@ -1,0 +1,399 @@
+/* bench_lf_backgammon - depth and view synthesis on an HCI 4D light-field
+ * benchmark scene (default ../shared/lfdata/hci/backgammon beside the repo).
+ *
+ *   bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only | --views-only]
+ *                       [--save-disp FILE.pfm] [--baseline]
+ *
+ * Depth: lf_lf_depth on the 9x9 views with no range given (estimated from
+ * the data), median wall time of --runs (3) runs; scored as the benchmark
+ * toolkit does against gt_disp_lowres.pfm: 15-px border excluded,
+ * BadPix(t) = % of pixels with |d - gt| > t for t = 0.07, 0.03, 0.01 and
+ * MSE x 100.  Views: from the 5x5 views with even indices, the 16 views
+ * with both indices odd, synthesised with per-pixel geometry; mean PSNR in
+ * 8-bit sRGB, 15-px border excluded.  --baseline also scores the previous
+ * methods (82-slice focal-stack depth, plane blending at disparity 0). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../image/lf_image.h"
+#include "../lightfield/lf_depth.h"
+#include "../lightfield/lf_lightfield.h"
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* TEMPORARY (until the light-field folder reader lands in lightfield/):
+ * reads DIR/input_CamNNN.png, n = 0 .. N*N-1, row-major from the top-left
+ * view, into an N x N light field. */
+static int load_hci_views(const char *dir, lf_lightfield *lf)
+{
+    int n = 0;
+    char path[4096];
+    for (;;) {
+        snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, n);
+        FILE *f = fopen(path, "rb");
+        if (!f)
+            break;
+        fclose(f);
+        n++;
+    }
+    int side = (int)floor(sqrt((double)n) + 0.5);
+    if (n == 0 || side * side != n) {
+        fprintf(stderr, "bench_lf_backgammon: %s: expected N*N input_CamNNN.png views, found %d\n", dir, n);
+        return 1;
+    }
+    lf_error err = {0};
+    for (int k = 0; k < n; k++) {
+        snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, k);
+        lf_image img;
+        if (lf_image_read(path, &img, NULL, &err)) {
+            fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+            return 1;
+        }
+        if (k == 0 && lf_lf_alloc(lf, side, side, img.width, img.height, &err)) {
+            fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+            return 1;
+        }
+        if (img.width != lf->ns || img.height != lf->nt || img.channels < 3) {
+            fprintf(stderr, "bench_lf_backgammon: %s: size or channels differ from view 0\n", path);
+            return 1;
+        }
+        float *dst = lf_lf_view(lf, k % side, k / side);
+        for (size_t i = 0; i < (size_t)img.width * img.height; i++)
+            for (int c = 0; c < 3; c++)
+                dst[i * 3 + c] = img.data[i * img.channels + c];
+        lf_image_free(&img);
+    }
+    lf->disp_v_per_u = 1.0;
+    return 0;
+}
+
+/* TEMPORARY (until image/ reads PFM): little-endian 1-channel PFM, rows bottom-up. */
+static int read_pfm(const char *path, lf_image *img)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 1;
+    char magic[3] = {0};
+    int w, h;
+    double scale;
+    if (fscanf(f, "%2s %d %d %lf", magic, &w, &h, &scale) != 4 || strcmp(magic, "Pf") || scale >= 0 || w <= 0 ||
+        h <= 0) {
+        fclose(f);
+        return 1;
+    }
+    fgetc(f);
+    lf_error err = {0};
+    if (lf_image_alloc(img, w, h, 1, &err)) {
+        fclose(f);
+        return 1;
+    }
+    for (int y = h - 1; y >= 0; y--)
+        if (fread(img->data + (size_t)y * w, sizeof(float), (size_t)w, f) != (size_t)w) {
+            fclose(f);
+            lf_image_free(img);
+            return 1;
+        }
+    fclose(f);
+    return 0;
+}
+
+static void write_pfm(const char *path, const lf_image *img)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return;
+    fprintf(f, "Pf\n%d %d\n-1.0\n", img->width, img->height);
+    for (int y = img->height - 1; y >= 0; y--)
+        fwrite(img->data + (size_t)y * img->width, sizeof(float), (size_t)img->width, f);
+    fclose(f);
+}
+
+static void score(const char *name, const lf_image *d, const lf_image *gt, double secs)
+{
+    const int border = 15;
+    double se = 0;
+    size_t n = 0, bad[3] = {0, 0, 0};
+    const double t[3] = {0.07, 0.03, 0.01};
+    for (int y = border; y < gt->height - border; y++)
+        for (int x = border; x < gt->width - border; x++) {
+            double e = d->data[(size_t)y * d->width + x] - gt->data[(size_t)y * gt->width + x];
+            se += e * e;
+            for (int k = 0; k < 3; k++)
+                bad[k] += fabs(e) > t[k];
+            n++;
+        }
+    double sum_e = 0;
+    for (int y = border; y < gt->height - border; y++)
+        for (int x = border; x < gt->width - border; x++)
+            sum_e += d->data[(size_t)y * d->width + x] - gt->data[(size_t)y * gt->width + x];
+    if (getenv("LFD_VERBOSE")) {
+        printf("  mean signed error %.4f\n", sum_e / n);
+        double bs[16] = {0}, ba[16] = {0};
+        size_t bn[16] = {0}, bb[16] = {0};
+        for (int y = border; y < gt->height - border; y++)
+            for (int x = border; x < gt->width - border; x++) {
+                double g = gt->data[(size_t)y * gt->width + x];
+                double e = d->data[(size_t)y * d->width + x] - g;
+                int k = (int)floor((g + 2) / 0.25);
+                k = k < 0 ? 0 : (k > 15 ? 15 : k);
+                bs[k] += e, ba[k] += fabs(e), bn[k]++, bb[k] += fabs(e) > 0.07;
+            }
+        for (int k = 0; k < 16; k++)
+            if (bn[k])
+                printf("  gt %5.2f..%5.2f: n %6zu mean err %+.4f mean |err| %.4f bad0.07 %5.1f %%\n", -2 + 0.25 * k,
+                       -2 + 0.25 * (k + 1), bn[k], bs[k] / bn[k], ba[k] / bn[k], 100.0 * bb[k] / bn[k]);
+    }
+    printf("%-28s BadPix0.07 %6.2f %%  BadPix0.03 %6.2f %%  BadPix0.01 %6.2f %%  MSEx100 %7.3f", name,
+           100.0 * bad[0] / n, 100.0 * bad[1] / n, 100.0 * bad[2] / n, 100.0 * se / n);
+    if (secs > 0)
+        printf("  time %.2f s", secs);
+    printf("\n");
+}
+
+static double psnr8(const lf_image *a, const float *b, int border)
+{
+    double se = 0;
+    size_t n = 0;
+    for (int y = border; y < a->height - border; y++)
+        for (int x = border; x < a->width - border; x++)
+            for (int c = 0; c < 3; c++) {
+                double e = (double)lf_srgb_encode(a->data[((size_t)y * a->width + x) * 3 + c]) -
+                           (double)lf_srgb_encode(b[((size_t)y * a->width + x) * 3 + c]);
+                se += e * e;
+                n++;
+            }
+    return se > 0 ? 10 * log10(255.0 * 255.0 / (se / n)) : INFINITY;
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = LF_SOURCE_DIR "/../shared/lfdata/hci/backgammon", *save = NULL;
+    int threads = 2, runs = 3, do_depth = 1, do_views = 1, baseline = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--runs") && i + 1 < argc)
+            runs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--depth-only"))
+            do_views = 0;
+        else if (!strcmp(argv[i], "--views-only"))
+            do_depth = 0;
+        else if (!strcmp(argv[i], "--baseline"))
+            baseline = 1;
+        else if (!strcmp(argv[i], "--save-disp") && i + 1 < argc)
+            save = argv[++i];
+        else if (argv[i][0] != '-')
+            dir = argv[i];
+        else {
+            fprintf(stderr, "usage: bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only|--views-only] "
+                            "[--save-disp FILE.pfm] [--baseline]\n");
+            return 2;
+        }
+    }
+    lf_lightfield lf = {0};
+    double t0 = now();
+    if (load_hci_views(dir, &lf))
+        return 1;
+    printf("%s: %dx%d views of %dx%d (loaded in %.2f s), %d threads\n", dir, lf.nu, lf.nv, lf.ns, lf.nt, now() - t0,
+           threads);
+    lf_error err = {0};
+    if (do_depth) {
+        char gtp[4096];
+        snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
+        lf_image gt;
+        if (read_pfm(gtp, &gt)) {
+            fprintf(stderr, "bench_lf_backgammon: cannot read %s\n", gtp);
+            return 1;
+        }
+        if (baseline) {
+            lf_image af, dm;
+            lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+            ro.threads = threads;
+            double s = now();
+            if (lf_lf_allfocus(&lf, &ro, -1.7, 0.7, 82, &af, &dm, &err)) {
+                fprintf(stderr, "%s\n", err.msg);
+                return 1;
+            }
+            score("focal stack (82 slices)", &dm, &gt, now() - s);
+            lf_image_free(&af), lf_image_free(&dm);
+        }
+        double times[16], cpus[16];
+        if (runs > 16)
+            runs = 16;
+        lf_image disp = {0}, conf = {0};
+        double r0 = 0, r1 = 0;
+        if (!getenv("LFD_RANGE"))
+            lf_lf_depth_range(&lf, threads, &r0, &r1, &err);
+        printf("estimated disparity range %.3f .. %.3f px/view\n", r0, r1);
+        for (int r = 0; r < runs; r++) {
+            lf_image_free(&disp), lf_image_free(&conf);
+            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            o.threads = threads;
+            if (getenv("LFD_RANGE"))
+                sscanf(getenv("LFD_RANGE"), "%lf %lf", &o.d0, &o.d1);
+            if (getenv("LFD_STEP"))
+                o.step = atof(getenv("LFD_STEP"));
+            if (getenv("LFD_RADIUS"))
+                o.radius = atoi(getenv("LFD_RADIUS"));
+            if (getenv("LFD_EPS"))
+                o.eps = atof(getenv("LFD_EPS"));
+            if (getenv("LFD_MR"))
+                o.median_radius = atoi(getenv("LFD_MR"));
+            if (getenv("LFD_ALPHA"))
+                o.defocus_weight = atof(getenv("LFD_ALPHA"));
+            if (getenv("LFD_OCC"))
+                o.occlusion = atoi(getenv("LFD_OCC"));
+            double s = now(), sc = cpu_now();
+            if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
+                fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                return 1;
+            }
+            times[r] = now() - s, cpus[r] = cpu_now() - sc;
+        }
+        qsort(times, (size_t)runs, sizeof(double), cmpd);
+        qsort(cpus, (size_t)runs, sizeof(double), cmpd);
+        score("lf_lf_depth (range auto)", &disp, &gt, times[runs / 2]);
+        printf("  depth: median of %d runs: wall %.2f s, CPU %.2f s (all threads)\n", runs, times[runs / 2],
+               cpus[runs / 2]);
+        if (save) {
+            write_pfm(save, &disp);
+            /* previews: disparity, |error| (x5, clipped), confidence */
+            lf_image pv;
+            lf_image_alloc(&pv, disp.width * 4, disp.height, 1, &err);
+            for (int y = 0; y < disp.height; y++)
+                for (int x = 0; x < disp.width; x++) {
+                    size_t i = (size_t)y * disp.width + x;
+                    float a = (disp.data[i] + 2.f) / 3.f, b = fabsf(disp.data[i] - gt.data[i]) * 5.f, c = conf.data[i];
+                    float *row = pv.data + (size_t)y * pv.width;
+                    row[x] = powf(fminf(fmaxf(a, 0.f), 1.f), 2.2f);
+                    row[x + disp.width] = powf(fminf(b, 1.f), 2.2f);
+                    row[x + 2 * disp.width] = powf(fminf(fmaxf(c, 0.f), 1.f), 2.2f);
+                    row[x + 3 * disp.width] = powf(fminf(fmaxf((gt.data[i] + 2.f) / 3.f, 0.f), 1.f), 2.2f);
+                }
+            char pp[4096];
+            snprintf(pp, sizeof pp, "%s.png", save);
+            lf_image_write(pp, &pv, NULL, NULL, &err);
+            lf_image_free(&pv);
+        }
+        lf_image_free(&disp), lf_image_free(&conf), lf_image_free(&gt);
+    }
+    if (do_views) {
+        /* 5x5 light field of the views with even indices */
+        int n5 = (lf.nu + 1) / 2;
+        lf_lightfield sub = {0};
+        if (lf_lf_alloc(&sub, n5, n5, lf.ns, lf.nt, &err)) {
+            fprintf(stderr, "%s\n", err.msg);
+            return 1;
+        }
+        sub.disp_v_per_u = 1.0;
+        for (int j = 0; j < n5; j++)
+            for (int i = 0; i < n5; i++)
+                memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
+        lf_image sd = {0}, sc = {0};
+        {
+            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            o.threads = threads;
+            double s = now();
+            if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
+                fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                return 1;
+            }
+            printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            if (getenv("LFD_GTVIEW")) { /* diagnostic: ground-truth geometry */
+                char gtp[4096];
+                snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
+                lf_image gt;
+                if (!read_pfm(gtp, &gt)) {
+                    for (size_t i = 0; i < (size_t)gt.width * gt.height; i++)
+                        sd.data[i] = 2 * gt.data[i], sc.data[i] = 1;
+                    lf_image_free(&gt);
+                }
+            }
+        }
+        for (int method = baseline ? 0 : 1; method < 2; method++) {
+            double sum = 0, worst = INFINITY, secs = 0;
+            int count = 0;
+            for (int r = 1; r < lf.nv; r += 2)
+                for (int c = 1; c < lf.nu; c += 2) {
+                    double u = c / 2.0 - (n5 - 1) / 2.0, v = r / 2.0 - (n5 - 1) / 2.0;
+                    lf_image out;
+                    double s = now();
+                    int rc;
+                    if (method == 0) {
+                        rc = lf_lf_view_at(&sub, u, v, 0.0, &out, &err);
+                    } else {
+                        lf_lf_view_opts vo = lf_lf_view_defaults();
+                        vo.threads = threads;
+                        vo.disparity = &sd, vo.confidence = &sc;
+                        rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
+                    }
+                    secs += now() - s;
+                    if (rc) {
+                        fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                        return 1;
+                    }
+                    double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
+                    if (getenv("LFD_VERBOSE")) {
+                        /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
+                        double se[2] = {0, 0};
+                        size_t nn[2] = {0, 0};
+                        const float *tv = lf_lf_view(&lf, c, r);
+                        for (int y = 15; y < out.height - 15; y++)
+                            for (int x = 15; x < out.width - 15; x++) {
+                                float g = sd.data[(size_t)y * out.width + x];
+                                int edge = 0;
+                                for (int j = -4; j <= 4 && !edge; j++)
+                                    for (int i = -4; i <= 4; i++)
+                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f)
+                                            edge = 1;
+                                for (int ch = 0; ch < 3; ch++) {
+                                    size_t q = ((size_t)y * out.width + x) * 3 + ch;
+                                    double e = (double)lf_srgb_encode(out.data[q]) - lf_srgb_encode(tv[q]);
+                                    se[edge] += e * e, nn[edge]++;
+                                }
+                            }
+                        printf("  view r%d c%d: %.2f dB (away from edges %.2f dB, near edges %.2f dB, %.1f %% of pixels)\n",
+                               r, c, p, 10 * log10(65025.0 * nn[0] / se[0]), 10 * log10(65025.0 * nn[1] / se[1]),
+                               100.0 * nn[1] / (nn[0] + nn[1]));
+                    }
+                    if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
+                        lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);
+                        for (size_t i = 0; i < (size_t)out.width * out.height * 3; i++)
+                            out.data[i] = 0.5f + 4 * (out.data[i] - lf_lf_view(&lf, c, r)[i]);
+                        lf_image_write("/tmp/lfd_v33_err.png", &out, NULL, NULL, &err);
+                    }
+                    sum += p, count++;
+                    worst = p < worst ? p : worst;
+                    lf_image_free(&out);
+                }
+            printf("%-28s mean PSNR %.2f dB (worst %.2f) over %d views, %.2f s per view\n",
+                   method == 0 ? "views: plane d=0 (4 nearest)" : "views: per-pixel depth", sum / count, worst, count,
+                   secs / count);
+        }
+        lf_lf_free(&sub);
+        lf_image_free(&sd), lf_image_free(&sc);
+    }
+    lf_lf_free(&lf);
+    return 0;
+}

@@ -1,0 +1,724 @@
+/* Disparity from a 4D light field (lf_depth.h; docs/depth.md has the
+ * method, its references and measurements).
+ *
+ * Layout of the work: the cost volume cost[label][pixel] is built in bands
+ * of rows (threads take bands), views read in place (RGB interleaved);
+ * for one label every view is shifted by a constant sub-pixel offset, so
+ * the bilinear weights are constant along a row and the inner loops are
+ * plain multiply-adds over contiguous floats (vectorised, AVX2 clone).
+ * Then each cost slice is filtered (guided filter, threads take slices),
+ * then per pixel the minimum, parabola refinement and confidence, then the
+ * weighted median. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lf_depth.h"
+#include "parallel_internal.h"
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))
+#else
+#define LF_HOT_LOOP
+#endif
+
+enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
+
+lf_lf_depth_opts lf_lf_depth_defaults(void)
+{
+    lf_lf_depth_opts o;
+    memset(&o, 0, sizeof o);
+    o.occlusion = 2;
+    o.defocus_weight = -1;
+    o.median_radius = -1;
+    return o;
+}
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/* One non-reference view: its data, offset from the reference and angular group. */
+typedef struct dview {
+    const float *data;
+    const float *valid; /* NULL: every sample valid */
+    double du, dv; /* view steps from the reference (dv already scaled by disp_v_per_u) */
+    int group;     /* 2k: on the ray at k*45 degrees; 2k+1: strictly inside octant k */
+} dview;
+
+typedef struct cost_ctx {
+    const lf_lightfield *lf;
+    const dview *views;
+    int nviews;
+    const float *ref;    /* reference view, RGB */
+    const float *ref_valid; /* its validity (when lf->valid) */
+    int nlabels;
+    double d0, step;
+    float tau;           /* truncation of the per-view colour difference (after scaling) */
+    float scale;         /* colour scale: 1 / mean channel sum of the reference */
+    float alpha;         /* defocus weight */
+    int occlusion;
+    float *cost;         /* [label][pixel] */
+    float *scratch;      /* per thread: NGROUPS * NFIELDS * ns + 5 * ns floats */
+    size_t scratch_per_thread;
+} cost_ctx;
+
+/* Group of offset (du, dv): rays at multiples of 45 degrees and the open
+ * octants between them, numbered counter-clockwise from +u. */
+static int view_group(double du, double dv)
+{
+    double a = atan2(dv, du);
+    if (a < 0)
+        a += 2 * M_PI;
+    double q = a / (M_PI / 4);
+    double k = floor(q + 0.5);
+    if (fabs(q - k) < 1e-9)
+        return (2 * ((int)k % 8));
+    return 2 * ((int)floor(q) % 8) + 1;
+}
+
+/* acc fields: 0 truncated |diff| sum, 1..3 signed diff per channel, 4 count. */
+LF_HOT_LOOP static void view_row(float *restrict acc, int ns, const float *restrict a0, const float *restrict a1,
+                                 const float *restrict b0, const float *restrict b1, const float *restrict c, float w00,
+                                 float w01, float w10, float w11, float scale, float tau, int xa, int xb)
+{
+    float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
+                    *restrict n = acc + 4 * ns;
+    for (int x = xa; x <= xb; x++) {
+        int k = 3 * x;
+        float e0 = (w00 * a0[k] + w01 * a1[k] + w10 * b0[k] + w11 * b1[k] - c[k]) * scale;
+        float e1 = (w00 * a0[k + 1] + w01 * a1[k + 1] + w10 * b0[k + 1] + w11 * b1[k + 1] - c[k + 1]) * scale;
+        float e2 = (w00 * a0[k + 2] + w01 * a1[k + 2] + w10 * b0[k + 2] + w11 * b1[k + 2] - c[k + 2]) * scale;
+        float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
+        sad[x] += ad < tau ? ad : tau;
+        s0[x] += e0, s1[x] += e1, s2[x] += e2;
+        n[x] += 1.f;
+    }
+}
+
+/* The same where the light field marks missing samples (lf->valid): a
+ * view counts at a pixel only when every texel it interpolates is valid. */
+LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float *restrict a0, const float *restrict a1,
+                                        const float *restrict b0, const float *restrict b1, const float *restrict ma0,
+                                        const float *restrict ma1, const float *restrict mb0, const float *restrict mb1,
+                                        const float *restrict c, const float *restrict mc, float w00, float w01,
+                                        float w10, float w11, float scale, float tau, int xa, int xb)
+{
+    float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
+                    *restrict n = acc + 4 * ns;
+    for (int x = xa; x <= xb; x++) {
+        int k = 3 * x;
+        float m = w00 * ma0[x] + w01 * ma1[x] + w10 * mb0[x] + w11 * mb1[x];
+        float ok = m > 0.999f && mc[x] > 0.5f ? 1.f : 0.f;
+        float e0 = (w00 * a0[k] + w01 * a1[k] + w10 * b0[k] + w11 * b1[k] - c[k]) * scale * ok;
+        float e1 = (w00 * a0[k + 1] + w01 * a1[k + 1] + w10 * b0[k + 1] + w11 * b1[k + 1] - c[k + 1]) * scale * ok;
+        float e2 = (w00 * a0[k + 2] + w01 * a1[k + 2] + w10 * b0[k + 2] + w11 * b1[k + 2] - c[k + 2]) * scale * ok;
+        float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
+        sad[x] += ad < tau ? ad : tau;
+        s0[x] += e0, s1[x] += e1, s2[x] += e2;
+        n[x] += ok;
+    }
+}
+
+/* cost = min over half apertures h of  sad/n + alpha * |sum diff| / n, a
+ * half being 9 consecutive groups (rays h-2..h+2 and the octants between);
+ * w: 5 * ns scratch. */
+LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w, float *restrict out, int ns,
+                                    float alpha, float worst, int occlusion)
+{
+    float *restrict w0 = w, *restrict w1 = w + ns, *restrict w2 = w + 2 * ns, *restrict w3 = w + 3 * ns,
+                    *restrict w4 = w + 4 * ns;
+    for (int x = 0; x < ns; x++)
+        out[x] = worst, w0[x] = w1[x] = w2[x] = w3[x] = w4[x] = 0.f;
+    if (!occlusion) {
+        for (int g = 0; g < NGROUPS; g++) {
+            const float *a = acc + (size_t)g * NFIELDS * ns;
+            for (int x = 0; x < ns; x++) {
+                w0[x] += a[x], w1[x] += a[ns + x], w2[x] += a[2 * ns + x], w3[x] += a[3 * ns + x];
+                w4[x] += a[4 * ns + x];
+            }
+        }
+        for (int x = 0; x < ns; x++) {
+            float n = w4[x] > 0.f ? w4[x] : 1.f;
+            float c = (w0[x] + alpha * (fabsf(w1[x]) + fabsf(w2[x]) + fabsf(w3[x]))) / n;
+            out[x] = w4[x] > 0.f ? c : worst;
+        }
+        return;
+    }
+    for (int j = -4; j <= 4; j++) {
+        const float *a = acc + (size_t)((j + NGROUPS) % NGROUPS) * NFIELDS * ns;
+        for (int x = 0; x < ns; x++) {
+            w0[x] += a[x], w1[x] += a[ns + x], w2[x] += a[2 * ns + x], w3[x] += a[3 * ns + x];
+            w4[x] += a[4 * ns + x];
+        }
+    }
+    for (int h = 0; h < 8; h++) {
+        for (int x = 0; x < ns; x++) {
+            float n = w4[x] > 0.f ? w4[x] : 1.f;
+            float c = (w0[x] + alpha * (fabsf(w1[x]) + fabsf(w2[x]) + fabsf(w3[x]))) / n;
+            c = w4[x] > 0.f ? c : worst;
+            out[x] = c < out[x] ? c : out[x];
+        }
+        if (h == 7) {
+            if (occlusion < 2)
+                break;
+            /* lines through the reference (two opposite rays): a pixel between
+             * two occluders is seen by the views along their direction */
+            for (int k = 0; k < 4; k++) {
+                const float *a = acc + (size_t)(2 * k) * NFIELDS * ns, *b = acc + (size_t)(2 * k + 8) * NFIELDS * ns;
+                for (int x = 0; x < ns; x++) {
+                    float nn = a[4 * ns + x] + b[4 * ns + x];
+                    float n = nn > 0.f ? nn : 1.f;
+                    float c = (a[x] + b[x] +
+                               alpha * (fabsf(a[ns + x] + b[ns + x]) + fabsf(a[2 * ns + x] + b[2 * ns + x]) +
+                                        fabsf(a[3 * ns + x] + b[3 * ns + x]))) / n;
+                    c = nn > 0.f ? c : worst;
+                    out[x] = c < out[x] ? c : out[x];
+                }
+            }
+            break;
+        }
+        /* slide: groups 2h-4, 2h-3 leave, 2h+5, 2h+6 enter */
+        for (int q = 0; q < 2; q++) {
+            const float *o = acc + (size_t)((2 * h - 4 + q + NGROUPS) % NGROUPS) * NFIELDS * ns;
+            const float *i = acc + (size_t)((2 * h + 5 + q) % NGROUPS) * NFIELDS * ns;
+            for (int x = 0; x < ns; x++) {
+                w0[x] += i[x] - o[x], w1[x] += i[ns + x] - o[ns + x], w2[x] += i[2 * ns + x] - o[2 * ns + x];
+                w3[x] += i[3 * ns + x] - o[3 * ns + x], w4[x] += i[4 * ns + x] - o[4 * ns + x];
+            }
+        }
+    }
+}
+
+static void cost_rows(void *vctx, int y0, int y1, int tid)
+{
+    cost_ctx *c = vctx;
+    const lf_lightfield *lf = c->lf;
+    int ns = lf->ns, nt = lf->nt;
+    size_t np = (size_t)ns * nt;
+    float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
+    float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
+    float worst = c->tau * (1 + c->alpha);
+    for (int y = y0; y < y1; y++) {
+        const float *cref = c->ref + (size_t)y * ns * 3;
+        for (int l = 0; l < c->nlabels; l++) {
+            double d = c->d0 + c->step * l;
+            memset(acc, 0, sizeof(float) * NGROUPS * NFIELDS * ns);
+            for (int k = 0; k < c->nviews; k++) {
+                const dview *v = &c->views[k];
+                /* I_ref(x, y) = I_v(x - d du, y - d dv) */
+                double sx = -d * v->du, sy = -d * v->dv;
+                int ix = (int)floor(sx), iy = (int)floor(sy);
+                float fx = (float)(sx - ix), fy = (float)(sy - iy);
+                int r0 = y + iy, r1 = fy > 0.f ? r0 + 1 : r0;
+                if (r0 < 0 || r1 > nt - 1)
+                    continue;
+                int xa = ix < 0 ? -ix : 0;
+                int xb = ns - 1 - (fx > 0.f ? ix + 1 : ix);
+                if (xb > ns - 1)
+                    xb = ns - 1;
+                if (xa > xb)
+                    continue;
+                const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
+                const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
+                int dx1 = fx > 0.f ? 3 : 0;
+                float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+                float *a = acc + (size_t)v->group * NFIELDS * ns;
+                if (v->valid) {
+                    /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
+                    const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
+                    int mx1 = fx > 0.f ? 1 : 0;
+                    view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
+                                    c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+                } else {
+                    view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa,
+                             xb);
+                }
+            }
+            combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion);
+        }
+    }
+}
+
+/* ---------- guided filter (He, Sun, Tang 2010) ---------- */
+
+/* Mean over the (2r+1)^2 window clipped to the image; tmp: w*h floats. */
+LF_HOT_LOOP static void box_mean(const float *restrict in, float *restrict out, float *restrict tmp, int w, int h, int r)
+{
+    /* horizontal sums */
+    for (int y = 0; y < h; y++) {
+        const float *a = in + (size_t)y * w;
+        float *t = tmp + (size_t)y * w;
+        float s = 0;
+        for (int x = 0; x <= r && x < w; x++)
+            s += a[x];
+        for (int x = 0; x < w; x++) {
+            t[x] = s;
+            if (x + r + 1 < w)
+                s += a[x + r + 1];
+            if (x - r >= 0)
+                s -= a[x - r];
+        }
+    }
+    /* vertical running sums: each output row from the previous one (vectorises across x) */
+    for (int y = 0; y < h; y++) {
+        int ya = y - r < 0 ? 0 : y - r, yb = y + r > h - 1 ? h - 1 : y + r;
+        float *o = out + (size_t)y * w;
+        if (y == 0) {
+            for (int x = 0; x < w; x++)
+                o[x] = 0;
+            for (int yy = ya; yy <= yb; yy++) {
+                const float *t = tmp + (size_t)yy * w;
+                for (int x = 0; x < w; x++)
+                    o[x] += t[x];
+            }
+        } else {
+            const float *p = out + (size_t)(y - 1) * w;
+            int yin = y + r, yout = y - r - 1;
+            const float *ti = yin <= h - 1 ? tmp + (size_t)yin * w : NULL;
+            const float *to = yout >= 0 ? tmp + (size_t)yout * w : NULL;
+            if (ti && to)
+                for (int x = 0; x < w; x++)
+                    o[x] = p[x] + ti[x] - to[x];
+            else if (ti)
+                for (int x = 0; x < w; x++)
+                    o[x] = p[x] + ti[x];
+            else if (to)
+                for (int x = 0; x < w; x++)
+                    o[x] = p[x] - to[x];
+            else
+                for (int x = 0; x < w; x++)
+                    o[x] = p[x];
+        }
+    }
+    /* normalise: count = (columns in window) * (rows in window) */
+    for (int y = 0; y < h; y++) {
+        int ny = (y + r > h - 1 ? h - 1 : y + r) - (y - r < 0 ? 0 : y - r) + 1;
+        float *o = out + (size_t)y * w;
+        for (int x = 0; x < w; x++) {
+            int nx = (x + r > w - 1 ? w - 1 : x + r) - (x - r < 0 ? 0 : x - r) + 1;
+            o[x] /= (float)(nx * ny);
+        }
+    }
+}
+
+typedef struct gf_ctx {
+    int w, h, r;
+    const float *I;    /* guide, 3 planes */
+    const float *mI;   /* its window means, 3 planes */
+    const float *Sinv; /* (Sigma + eps U)^-1 per pixel, 6 planes: xx xy xz yy yz zz */
+    float *cost;       /* slices filtered in place */
+    float *scratch;    /* per thread: 10 * w * h */
+    size_t per_thread;
+} gf_ctx;
+
+LF_HOT_LOOP static void mul_arr(const float *restrict x, const float *restrict y, float *restrict o, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        o[i] = x[i] * y[i];
+}
+
+LF_HOT_LOOP static void gf_coeffs(const float *restrict mp, float *restrict m0, float *restrict m1,
+                                  float *restrict m2, const float *restrict mI, const float *restrict S,
+                                  float *restrict b, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        float c0 = m0[i] - mI[i] * mp[i], c1 = m1[i] - mI[n + i] * mp[i], c2 = m2[i] - mI[2 * n + i] * mp[i];
+        float a0 = S[i] * c0 + S[n + i] * c1 + S[2 * n + i] * c2;
+        float a1 = S[n + i] * c0 + S[3 * n + i] * c1 + S[4 * n + i] * c2;
+        float a2 = S[2 * n + i] * c0 + S[4 * n + i] * c1 + S[5 * n + i] * c2;
+        m0[i] = a0, m1[i] = a1, m2[i] = a2;
+        b[i] = mp[i] - a0 * mI[i] - a1 * mI[n + i] - a2 * mI[2 * n + i];
+    }
+}
+
+LF_HOT_LOOP static void gf_out(const float *restrict a0, const float *restrict a1, const float *restrict a2,
+                               const float *restrict b, const float *restrict I, float *restrict q, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        q[i] = a0[i] * I[i] + a1[i] * I[n + i] + a2[i] * I[2 * n + i] + b[i];
+}
+
+/* Colour guided filter of each cost slice (He, Sun, Tang 2010, eqs. for a
+ * colour guide): q = mean(a) . I + mean(b), a = (Sigma + eps U)^-1 cov(I, p). */
+static void gf_slices(void *vctx, int l0, int l1, int tid)
+{
+    gf_ctx *g = vctx;
+    size_t np = (size_t)g->w * g->h;
+    float *s = g->scratch + (size_t)tid * g->per_thread;
+    float *mp = s, *m0 = s + np, *m1 = s + 2 * np, *m2 = s + 3 * np, *b = s + 4 * np, *t = s + 5 * np,
+          *tmp = s + 6 * np, *o0 = s + 7 * np, *o1 = s + 8 * np, *o2 = s + 9 * np;
+    for (int l = l0; l < l1; l++) {
+        float *p = g->cost + (size_t)l * np;
+        box_mean(p, mp, tmp, g->w, g->h, g->r);
+        float *mc[3] = {m0, m1, m2};
+        for (int c = 0; c < 3; c++) {
+            mul_arr(g->I + c * np, p, t, np);
+            box_mean(t, mc[c], tmp, g->w, g->h, g->r);
+        }
+        gf_coeffs(mp, m0, m1, m2, g->mI, g->Sinv, b, np);
+        box_mean(m0, o0, tmp, g->w, g->h, g->r);
+        box_mean(m1, o1, tmp, g->w, g->h, g->r);
+        box_mean(m2, o2, tmp, g->w, g->h, g->r);
+        box_mean(b, mp, tmp, g->w, g->h, g->r);
+        gf_out(o0, o1, o2, mp, g->I, p, np);
+    }
+}
+
+/* ---------- winner-take-all, sub-label, confidence ---------- */
+
+typedef struct wta_ctx {
+    int w, h, nlabels;
+    double d0, step;
+    const float *cost;
+    float *disp, *conf;
+} wta_ctx;
+
+static void wta_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    wta_ctx *c = vctx;
+    size_t np = (size_t)c->w * c->h;
+    int L = c->nlabels;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < c->w; x++) {
+            size_t i = (size_t)y * c->w + x;
+            int best = 0;
+            float cb = FLT_MAX, sum = 0;
+            for (int l = 0; l < L; l++) {
+                float v = c->cost[(size_t)l * np + i];
+                sum += v;
+                if (v < cb)
+                    cb = v, best = l;
+            }
+            double off = 0;
+            if (best > 0 && best < L - 1) {
+                double cm = c->cost[(size_t)(best - 1) * np + i], cp = c->cost[(size_t)(best + 1) * np + i];
+                double den = cm - 2.0 * cb + cp;
+                if (den > 1e-12)
+                    off = 0.5 * (cm - cp) / den;
+                off = off < -0.5 ? -0.5 : (off > 0.5 ? 0.5 : off);
+            }
+            c->disp[i] = (float)(c->d0 + c->step * (best + off));
+            /* confidence: the minimum against the best cost away from it
+             * (more than 2 labels off), relative to the curve's mean */
+            float c2 = FLT_MAX;
+            for (int l = 0; l < L; l++)
+                if (abs(l - best) > 2 && c->cost[(size_t)l * np + i] < c2)
+                    c2 = c->cost[(size_t)l * np + i];
+            float mean = sum / L;
+            float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
+            conf = conf * 4.f;
+            c->conf[i] = conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
+        }
+}
+
+/* ---------- weighted median (guided by the reference colour) ---------- */
+
+typedef struct wm_ctx {
+    int w, h, r;
+    const float *disp, *conf, *ref; /* ref: RGB in the working scale */
+    float *out;
+    float sigma2;
+    float *scratch; /* per thread: 2 * (2r+1)^2 */
+    size_t per_thread;
+} wm_ctx;
+
+typedef struct dw {
+    float d, w;
+} dw;
+
+
+static void wm_rows(void *vctx, int y0, int y1, int tid)
+{
+    wm_ctx *c = vctx;
+    dw *buf = (dw *)(c->scratch + (size_t)tid * c->per_thread);
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < c->w; x++) {
+            size_t i = (size_t)y * c->w + x;
+            const float *p = c->ref + 3 * i;
+            int n = 0;
+            float wsum = 0;
+            for (int yy = y - c->r; yy <= y + c->r; yy++) {
+                if (yy < 0 || yy >= c->h)
+                    continue;
+                for (int xx = x - c->r; xx <= x + c->r; xx++) {
+                    if (xx < 0 || xx >= c->w)
+                        continue;
+                    size_t j = (size_t)yy * c->w + xx;
+                    const float *q = c->ref + 3 * j;
+                    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
+                    float wt = expf(-(e0 * e0 + e1 * e1 + e2 * e2) / c->sigma2) * (c->conf[j] + 1e-3f);
+                    buf[n].d = c->disp[j], buf[n].w = wt;
+                    wsum += wt, n++;
+                }
+            }
+            for (int k = 1; k < n; k++) { /* insertion sort: n is small */
+                dw t = buf[k];
+                int j = k - 1;
+                while (j >= 0 && buf[j].d > t.d) {
+                    buf[j + 1] = buf[j];
+                    j--;
+                }
+                buf[j + 1] = t;
+            }
+            float half = 0.5f * wsum, s = 0;
+            float med = c->disp[i];
+            for (int k = 0; k < n; k++) {
+                s += buf[k].w;
+                if (s >= half) {
+                    med = buf[k].d;
+                    break;
+                }
+            }
+            c->out[i] = med;
+        }
+}
+
+/* ---------- driver ---------- */
+
+static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double d0, double d1, double step,
+                      lf_image *disparity, lf_image *confidence, lf_error *err)
+{
+    int ns = lf->ns, nt = lf->nt, threads = o->threads > 0 ? o->threads : 2;
+    size_t np = (size_t)ns * nt;
+    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    int nl = (int)floor((d1 - d0) / step + 0.5) + 1;
+    if (nl < 3)
+        nl = 3;
+    if (nl > MAX_LABELS)
+        return lf_error_set(err, LF_ERR_PARAM, "disparity range %g .. %g in steps of %g gives %d labels (at most %d)",
+                            d0, d1, step, nl, MAX_LABELS);
+    step = (d1 - d0) / (nl - 1);
+    const float *ref = lf_lf_view(lf, iu0, iv0);
+    dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
+    float *cost = malloc(sizeof(float) * np * (size_t)nl);
+    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 5) * ns;
+    size_t gf_scratch = 10 * np;
+    size_t per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch;
+    float *scratch = malloc(sizeof(float) * per_thread * (size_t)threads);
+    float *guide = malloc(sizeof(float) * np * 14), *disp = malloc(sizeof(float) * np * 2);
+    float *refs = malloc(sizeof(float) * np * 3);
+    int rc = LF_OK;
+    if (!views || !cost || !scratch || !guide || !disp || !refs) {
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %d-label cost volume of %dx%d", nl, ns, nt);
+        goto done;
+    }
+    int nv = 0;
+    for (int iv = 0; iv < lf->nv; iv++)
+        for (int iu = 0; iu < lf->nu; iu++) {
+            if (iu == iu0 && iv == iv0)
+                continue;
+            dview *v = &views[nv++];
+            v->data = lf_lf_view(lf, iu, iv);
+            v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
+            v->du = iu - iu0, v->dv = (iv - iv0) * rv;
+            v->group = view_group(v->du, v->dv);
+        }
+    /* colour scale: costs in units of the reference's mean channel sum */
+    double msum = 0;
+    for (size_t i = 0; i < np * 3; i++)
+        msum += ref[i];
+    msum /= (double)np;
+    float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
+
+    cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
+    if (lf->valid)
+        cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
+    lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
+
+    /* guide: the reference colour, square-root encoded (closer to perceptual
+     * steps than linear) and normalised to [0, 1] */
+    float *I = guide, *mI = guide + 3 * np, *Sinv = guide + 6 * np, *tmp = guide + 12 * np, *t2 = guide + 13 * np;
+    float gmax = 0;
+    for (size_t i = 0; i < np; i++)
+        for (int ch = 0; ch < 3; ch++) {
+            float v = ref[3 * i + ch];
+            v = v > 0 ? sqrtf(v) : 0.f;
+            I[ch * np + i] = v;
+            gmax = v > gmax ? v : gmax;
+        }
+    for (size_t i = 0; i < 3 * np; i++)
+        I[i] = gmax > 0 ? I[i] / gmax : 0.f;
+    int r = o->radius > 0 ? o->radius : (ns < nt ? ns : nt) / 128;
+    if (r < 2)
+        r = 2;
+    float eps = o->eps > 0 ? (float)o->eps : 1e-3f;
+    for (int ch = 0; ch < 3; ch++)
+        box_mean(I + ch * np, mI + ch * np, tmp, ns, nt, r);
+    {
+        static const int pa[6] = {0, 0, 0, 1, 1, 2}, pb[6] = {0, 1, 2, 1, 2, 2};
+        for (int k = 0; k < 6; k++) {
+            mul_arr(I + pa[k] * np, I + pb[k] * np, t2, np);
+            box_mean(t2, Sinv + k * np, tmp, ns, nt, r);
+        }
+        for (size_t i = 0; i < np; i++) {
+            double m0 = mI[i], m1 = mI[np + i], m2 = mI[2 * np + i];
+            double xx = Sinv[i] - m0 * m0 + eps, xy = Sinv[np + i] - m0 * m1, xz = Sinv[2 * np + i] - m0 * m2;
+            double yy = Sinv[3 * np + i] - m1 * m1 + eps, yz = Sinv[4 * np + i] - m1 * m2;
+            double zz = Sinv[5 * np + i] - m2 * m2 + eps;
+            double c00 = yy * zz - yz * yz, c01 = xz * yz - xy * zz, c02 = xy * yz - xz * yy;
+            double c11 = xx * zz - xz * xz, c12 = xy * xz - xx * yz, c22 = xx * yy - xy * xy;
+            double det = xx * c00 + xy * c01 + xz * c02;
+            double id = det > 1e-30 ? 1.0 / det : 0.0;
+            Sinv[i] = (float)(c00 * id), Sinv[np + i] = (float)(c01 * id), Sinv[2 * np + i] = (float)(c02 * id);
+            Sinv[3 * np + i] = (float)(c11 * id), Sinv[4 * np + i] = (float)(c12 * id);
+            Sinv[5 * np + i] = (float)(c22 * id);
+        }
+    }
+    gf_ctx gc = {ns, nt, r, I, mI, Sinv, cost, scratch, per_thread};
+    lf_lf_parallel_for(nl, threads, 1, gf_slices, &gc);
+
+    float *conf = disp + np;
+    wta_ctx wc = {ns, nt, nl, d0, step, cost, disp, conf};
+    lf_lf_parallel_for(nt, threads, 8, wta_rows, &wc);
+
+    if (lf_image_alloc(disparity, ns, nt, 1, err)) {
+        rc = err ? err->code : LF_ERR_NOMEM;
+        goto done;
+    }
+    int mr = o->median_radius < 0 ? 3 : o->median_radius;
+    if (mr > 0) {
+        for (size_t i = 0; i < np; i++) {
+            for (int ch = 0; ch < 3; ch++) {
+                float v = ref[3 * i + ch] * scale;
+                refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
+            }
+        }
+        size_t wpt = 2 * (size_t)(2 * mr + 1) * (2 * mr + 1);
+        float *wscr = wpt * threads <= per_thread * threads ? scratch : NULL;
+        if (!wscr) {
+            rc = lf_error_set(err, LF_ERR_NOMEM, "median radius %d too large", mr);
+            lf_image_free(disparity);
+            goto done;
+        }
+        wm_ctx wm = {ns, nt, mr, disp, conf, refs, disparity->data, 0.02f, wscr, wpt};
+        lf_lf_parallel_for(nt, threads, 4, wm_rows, &wm);
+    } else {
+        memcpy(disparity->data, disp, sizeof(float) * np);
+    }
+    if (confidence) {
+        if (lf_image_alloc(confidence, ns, nt, 1, err)) {
+            rc = err ? err->code : LF_ERR_NOMEM;
+            lf_image_free(disparity);
+            goto done;
+        }
+        memcpy(confidence->data, conf, sizeof(float) * np);
+    }
+done:
+    free(views), free(cost), free(scratch), free(guide), free(disp), free(refs);
+    return rc;
+}
+
+static int cmpf(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+static double widest_view(const lf_lightfield *lf)
+{
+    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    double m = iu0 > lf->nu - 1 - iu0 ? iu0 : lf->nu - 1 - iu0;
+    double mv = (iv0 > lf->nv - 1 - iv0 ? iv0 : lf->nv - 1 - iv0) * rv;
+    return m > mv ? m : mv;
+}
+
+static int check_lf(const lf_lightfield *lf, lf_error *err)
+{
+    if (!lf || !lf->data || lf->nu * lf->nv < 2 || lf->ns < 8 || lf->nt < 8)
+        return lf_error_set(err, LF_ERR_PARAM, "depth needs at least 2 views of at least 8x8 pixels");
+    return LF_OK;
+}
+
+int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *disparity, lf_image *confidence,
+                lf_error *err)
+{
+    lf_lf_depth_opts def = lf_lf_depth_defaults();
+    if (!o)
+        o = &def;
+    int rc = check_lf(lf, err);
+    if (rc)
+        return rc;
+    double d0 = o->d0, d1 = o->d1;
+    if (!isfinite(d0) || !isfinite(d1))
+        return lf_error_set(err, LF_ERR_PARAM, "disparity range must be finite");
+    if (d0 >= d1 && (rc = lf_lf_depth_range(lf, o->threads, &d0, &d1, err)))
+        return rc;
+    double m = widest_view(lf);
+    double step = o->step > 0 ? o->step : 0.2 / m;
+    return depth_core(lf, o, d0, d1, step, disparity, confidence, err);
+}
+
+int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err)
+{
+    int rc = check_lf(lf, err);
+    if (rc)
+        return rc;
+    /* quarter resolution by 4x4 box averaging: disparities shrink by 4 */
+    int f = (lf->ns >= 64 && lf->nt >= 64) ? 4 : 1;
+    lf_lightfield small = {0};
+    if ((rc = lf_lf_alloc(&small, lf->nu, lf->nv, lf->ns / f, lf->nt / f, err)))
+        return rc;
+    small.disp_v_per_u = lf->disp_v_per_u;
+    for (int iv = 0; iv < lf->nv; iv++)
+        for (int iu = 0; iu < lf->nu; iu++) {
+            const float *src = lf_lf_view(lf, iu, iv);
+            float *dst = lf_lf_view(&small, iu, iv);
+            for (int y = 0; y < small.nt; y++)
+                for (int x = 0; x < small.ns; x++)
+                    for (int c = 0; c < 3; c++) {
+                        float s = 0;
+                        for (int j = 0; j < f; j++)
+                            for (int i = 0; i < f; i++)
+                                s += src[((size_t)(y * f + j) * lf->ns + (x * f + i)) * 3 + c];
+                        dst[((size_t)y * small.ns + x) * 3 + c] = s / (float)(f * f);
+                    }
+        }
+    double m = widest_view(lf);
+    /* widest search: shifts up to a quarter of the view at the outermost view, at most 8 px/view */
+    double lim = (lf->ns < lf->nt ? lf->ns : lf->nt) / 4.0 / (m > 0 ? m : 1);
+    if (lim > 8)
+        lim = 8;
+    double step = 0.25 / m; /* 0.25 px at the outermost view, at quarter resolution */
+    lf_lf_depth_opts o = lf_lf_depth_defaults();
+    o.threads = threads;
+    o.occlusion = 0;
+    o.median_radius = 0;
+    o.radius = 2;
+    lf_image disp = {0}, conf = {0};
+    double s0 = -lim / f, s1 = lim / f;
+    if ((rc = depth_core(&small, &o, s0, s1, step, &disp, &conf, err))) {
+        lf_lf_free(&small);
+        return rc;
+    }
+    size_t np = (size_t)small.ns * small.nt, n = 0;
+    float *vals = malloc(sizeof(float) * np);
+    if (!vals) {
+        lf_image_free(&disp), lf_image_free(&conf), lf_lf_free(&small);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    for (int pass = 0; pass < 2 && n < np / 20; pass++) {
+        n = 0;
+        float thr = pass == 0 ? 0.3f : 0.f;
+        for (size_t i = 0; i < np; i++)
+            if (conf.data[i] > thr || pass == 1)
+                vals[n++] = disp.data[i];
+    }
+    qsort(vals, n, sizeof(float), cmpf);
+    double lo = vals[(size_t)(0.01 * (n - 1))] * f, hi = vals[(size_t)(0.99 * (n - 1))] * f;
+    free(vals);
+    lf_image_free(&disp), lf_image_free(&conf), lf_lf_free(&small);
+    double pad = 0.05 * (hi - lo) + step * f;
+    *d0 = lo - pad, *d1 = hi + pad;
+    if (*d0 < -lim)
+        *d0 = -lim;
+    if (*d1 > lim)
+        *d1 = lim;
+    if (!(*d0 < *d1))
+        *d0 = -lim, *d1 = lim;
+    return LF_OK;
+}
+

@@ -1,0 +1,81 @@
+/* lf_depth.h - disparity from a 4D light field and depth-based view synthesis.
+ *
+ *   lf_lf_depth_opts o = lf_lf_depth_defaults();   // range from the data
+ *   o.d0 = -1.7, o.d1 = 0.7;                        // or a known range
+ *   lf_image disp, conf; lf_error err = {0};
+ *   if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) fail(err.msg);
+ *
+ * Disparity d of the reference view (iu, iv) = ((nu-1)/2, (nv-1)/2) (integer
+ * division: the centre view of an odd grid) in pixels per view step, as in
+ * lf_lightfield.h: I_ref(x, y) = I_(iu,iv)(x - d (iu - iu_ref),
+ * y - d r (iv - iv_ref)), r = lf->disp_v_per_u.  The method (docs/depth.md):
+ *   1. cost volume over disparity labels: per view a truncated absolute
+ *      colour difference to the reference pixel (correspondence) and the
+ *      difference between the views' mean and the reference pixel
+ *      (defocus cue); for occlusions the cost of a label is the smallest over
+ *      the 8 half apertures (views on one side of a line through the
+ *      reference, 45 degree steps) and the full aperture (Wang et al. 2015);
+ *   2. edge-aware aggregation: every cost slice filtered by a guided filter
+ *      guided by the reference view (He et al. 2010; Hosni et al. 2013);
+ *   3. winner-take-all, sub-label refinement by a parabola through the
+ *      cost minimum and its neighbours;
+ *   4. confidence from the aggregated cost curve, and a confidence- and
+ *      colour-weighted median filter guided by the reference view.
+ * No learned parts.  Runs in rows bands on o.threads threads. */
+#ifndef LF_DEPTH_H
+#define LF_DEPTH_H
+
+#include "lf_lightfield.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lf_lf_depth_opts {
+    double d0, d1;       /* disparity search range (px per view); d0 >= d1: estimate from the data */
+    double step;         /* label spacing (px per view); <= 0: auto (about 0.05 px shift at the widest view) */
+    int radius;          /* guided-filter radius (px); <= 0: auto (shorter side / 128, at least 2) */
+    double eps;          /* guided-filter regulariser (colour guide in [0,1]); <= 0: 1e-3 */
+    int occlusion;       /* 0: full aperture only; 1 (default): best of 8 half apertures too */
+    double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
+    int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
+    int threads;         /* <= 0: 2 */
+} lf_lf_depth_opts;
+lf_lf_depth_opts lf_lf_depth_defaults(void);
+
+/* Disparity map (1 channel) and, when confidence is non-NULL, a confidence
+ * map in [0, 1] (1: a single sharp cost minimum).  Needs at least 2 views. */
+int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *disparity, lf_image *confidence,
+                lf_error *err);
+
+/* The disparity range the scene occupies, estimated by a coarse sweep at
+ * quarter resolution over the widest range the views allow (shifts up to a
+ * quarter of the view size at the outermost view, at most 8 px per view),
+ * kept to the confident pixels' 1st..99th percentile and padded by 5% and
+ * one coarse step.  *d0 < *d1 on success. */
+int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
+
+/* A view at centred view coordinates (u, v) inside the captured aperture
+ * with per-pixel geometry: a disparity map of the reference view (given, or
+ * estimated with lf_lf_depth) is forward-warped to (u, v) with a z-buffer
+ * (nearer disparities win), then the nearest views are backward-warped
+ * through it and blended with weights by angular distance, visibility (the
+ * view's own warped depth agrees) and confidence; where confidence is low
+ * or no view sees the point the plane at plane_disparity is used.  At a
+ * view position it returns that view exactly. */
+typedef struct lf_lf_view_opts {
+    const lf_image *disparity;  /* NULL: estimated (lf_lf_depth with depth) */
+    const lf_image *confidence; /* NULL with a given disparity: all 1 */
+    lf_lf_depth_opts depth;
+    double plane_disparity;     /* fallback plane */
+    double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
+    int threads;
+} lf_lf_view_opts;
+lf_lf_view_opts lf_lf_view_defaults(void);
+int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_view_opts *o, lf_image *out,
+                     lf_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,18 +1,86 @@
 #!/usr/bin/env bash
-# The Slurm job script: its task and merge steps run by hand (as Slurm would
-# run them) must reproduce the single-machine render bit for bit; on a
-# machine with a working single-node Slurm (sinfo answers) the real
-# submission is tested too, otherwise that part is skipped with a message.
+# tools/slurm/lfrender-slurm.sh, by hand and on a real single-node Slurm.
+#
+# 1. By hand (runs everywhere): the task and merge steps as Slurm would run
+#    them reproduce the single-machine render bit for bit; status reports
+#    the parts; a missing part makes merge fail naming the part and its log.
+# 2. On Slurm: the test starts its own munged, slurmctld and slurmd (its own
+#    key, socket, ports, state, spool and slurm.conf in a temporary
+#    directory; SLURM_CONF points the clients there, so a system-wide
+#    Slurm or munge is neither used nor disturbed), submits from another
+#    directory with an empty environment, requeues one task mid-render with
+#    `scontrol requeue`, and checks that the task resumed from its checkpoint,
+#    that status showed its progress, and that the merged image equals the
+#    local render bit for bit; then a task forced to fail (its part path is a
+#    directory) must make the merge job fail naming the part and its log.
+#    Every daemon it started is stopped by pid on exit, jobs first.
+# Where the daemons cannot start (not root, Slurm or munge not installed) the
+# Slurm part is skipped with the reason (exit 77, ctest "Skipped"), except
+# with CI=true, where that is a failure.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-bin=${1:?usage: test_slurm.sh BUILD_BIN_DIR}
-export LFRENDER=$bin/lfrender
+bin=$(cd "${1:?usage: test_slurm.sh BUILD_BIN_DIR}" && pwd)
+script=$root/tools/slurm/lfrender-slurm.sh
+unset LFRENDER SLURM_CONF
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+chmod 755 "$tmp" # munged wants every directory above its socket searchable
+daemon_pids=() # munged slurmctld slurmd, in start order
+host=$(hostname -s)
+fail() {
+  echo "FAIL: $*" >&2
+  exit 1
+}
+say() { echo "test_slurm: $*"; }
+
+# Stop what this test started: cancel its jobs and wait for their steps to
+# end (slurmstepd outlives slurmd otherwise), then the daemons, newest first.
+stop_pid() {
+  local p=$1 k
+  kill -0 "$p" 2>/dev/null || return 0
+  kill -TERM "$p" 2>/dev/null || true
+  for k in $(seq 100); do
+    kill -0 "$p" 2>/dev/null || return 0
+    sleep 0.1
+  done
+  kill -KILL "$p" 2>/dev/null || true
+}
+cleanup() {
+  local rc=$? k i p
+  set +e
+  if [ ${#daemon_pids[@]} -ge 3 ] && kill -0 "${daemon_pids[1]}" 2>/dev/null; then
+    scancel --quiet $(squeue -h -o %A 2>/dev/null) 2>/dev/null
+    for k in $(seq 150); do
+      ls "$tmp/slurm/spool/${host}_"[0-9]* > /dev/null 2>&1 || break # a socket per running step
+      sleep 0.2
+    done
+  fi
+  # last resort for steps that would not end: processes whose working
+  # directory is in this test's directory (slurmstepd and the job's lfrender)
+  for p in /proc/[0-9]*; do
+    i=${p#/proc/}
+    [ "$i" != $$ ] || continue
+    case "$(readlink "$p/cwd" 2>/dev/null)" in "$tmp" | "$tmp"/*) ;; *) continue ;; esac
+    case "$(cat "$p/comm" 2>/dev/null)" in slurmstepd | lfrender | lfrender-slurm*) kill -KILL "$i" 2>/dev/null ;; esac
+  done
+  for ((i = ${#daemon_pids[@]} - 1; i >= 0; i--)); do stop_pid "${daemon_pids[i]}"; done
+  if [ $rc -ne 0 ] && [ $rc -ne 77 ] && [ -d "$tmp/slurm/log" ]; then
+    for f in "$tmp"/slurm/log/*; do
+      echo "--- last lines of $f" >&2
+      tail -n 15 "$f" >&2
+    done
+  fi
+  rm -rf "$tmp"
+  exit $rc
+}
+trap cleanup EXIT
+trap 'exit 143' TERM
+trap 'exit 130' INT
+
+# A small scene; --spp sets the cost. 96x64 in 4 bands of 96x16: 6 tiles a band.
 cat > "$tmp/s.pbrt" <<'SCENE'
 LookAt 0 1 -5 0 0.5 0 0 1 0
 Camera "perspective" "float fov" [40]
-Film "rgb" "integer xresolution" [64] "integer yresolution" [48] "bool savefp16" false
+Film "rgb" "integer xresolution" [96] "integer yresolution" [64] "bool savefp16" false
 Sampler "zsobol" "integer pixelsamples" [16]
 WorldBegin
 LightSource "infinite" "rgb L" [0.5 0.6 0.7]
@@ -21,19 +89,237 @@ Shape "bilinearmesh" "point3 P" [-5 0 -5 5 0 -5 -5 0 5 5 0 5]
 Translate 0 0.5 0
 Shape "sphere" "float radius" [0.5]
 SCENE
-"$LFRENDER" "$tmp/s.pbrt" -o "$tmp/ref.exr" --seed 4 --quiet
+identical() { idiff -fail 0 -warn 0 "$1" "$2" > /dev/null || fail "$2 differs from the single-machine render $1"; }
+passed=0
+
+# ---- 1. by hand ----
+"$bin/lfrender" "$tmp/s.pbrt" -o "$tmp/ref16.exr" --seed 4 --quiet
+mkdir "$tmp/hand"
 for i in 0 1 2; do
-  SLURM_ARRAY_TASK_ID=$i "$root/tools/slurm/lfrender-slurm.sh" task "$tmp/s.pbrt" "$tmp/out.exr" 3 --seed 4
+  SLURM_ARRAY_TASK_ID=$i "$script" task --lfrender "$bin/lfrender" "$tmp/s.pbrt" "$tmp/hand/out.exr" 3 --seed 4 \
+    > "$tmp/hand/task-$i.out"
 done
-"$root/tools/slurm/lfrender-slurm.sh" merge "$tmp/out.exr" 3
-idiff -fail 0 -warn 0 "$tmp/ref.exr" "$tmp/out.exr" > /dev/null
-passed=1
-if command -v sbatch > /dev/null && sinfo > /dev/null 2>&1; then
-  "$root/tools/slurm/lfrender-slurm.sh" submit "$tmp/s.pbrt" "$tmp/cl.exr" 3 --seed 4
-  for _ in $(seq 600); do [ -f "$tmp/cl.exr" ] && break; sleep 1; done
-  idiff -fail 0 -warn 0 "$tmp/ref.exr" "$tmp/cl.exr" > /dev/null
-  passed=2
-else
-  echo "skipped: no working Slurm here (sbatch/sinfo); the task and merge steps were run by hand"
-fi
+grep -q "task 1 of 3: $tmp/hand/out.exr.parts/part-1.exr" "$tmp/hand/task-1.out" || fail "task did not say what it renders"
+"$script" merge --lfrender "$bin/lfrender" "$tmp/hand/out.exr" 3 > /dev/null
+identical "$tmp/ref16.exr" "$tmp/hand/out.exr"
+"$script" status "$tmp/hand/out.exr" > "$tmp/hand/status"
+[ "$(grep -c '^part [0-2] .* 100%' "$tmp/hand/status")" = 3 ] || fail "status of finished parts: $(cat "$tmp/hand/status")"
+# a missing part: merge fails naming it and its log, and writes nothing
+mv "$tmp/hand/out.exr.parts/part-1.exr" "$tmp/hand/part-1.exr"
+rm "$tmp/hand/out.exr"
+if PATH=$bin:$PATH "$script" merge "$tmp/hand/out.exr" 3 2> "$tmp/hand/merge.err"; then fail "merge with a missing part succeeded"; fi
+grep -q "part 1 is missing.*see $tmp/hand/out.exr.parts/task-1.log" "$tmp/hand/merge.err" ||
+  fail "merge message does not name part 1 and its log: $(cat "$tmp/hand/merge.err")"
+[ ! -e "$tmp/hand/out.exr" ] || fail "merge with a missing part wrote $tmp/hand/out.exr"
+# paths: a relative scene and output from another directory, lfrender found on PATH
+mkdir "$tmp/hand/elsewhere"
+(cd "$tmp/hand/elsewhere" && SLURM_ARRAY_TASK_ID=0 PATH=$bin:$PATH "$script" task ../../s.pbrt ../rel.exr 1 --seed 4 > /dev/null &&
+  PATH=$bin:$PATH "$script" merge ../rel.exr 1 > /dev/null)
+identical "$tmp/ref16.exr" "$tmp/hand/rel.exr"
+passed=$((passed + 1))
+say "by hand: 3 tasks + merge identical to the local render; status; missing part refused; relative paths"
+
+# ---- 2. on a single-node Slurm started here ----
+skip() {
+  if [ "${CI:-}" = true ]; then fail "CI=true but the Slurm part cannot run: $*"; fi
+  echo "skipped: the Slurm part: $* ($passed passed: the by-hand steps)"
+  exit 77
+}
+for c in munged slurmctld slurmd sbatch scontrol squeue scancel sinfo; do
+  command -v "$c" > /dev/null || skip "$c not found (Debian: apt-get install slurm-wlm munge)"
+done
+[ "$(id -u)" = 0 ] || skip "slurmd must run as root to start jobs (run as root, as CI does)"
+
+# Free TCP ports: none bound or in use on this machine (/proc/net/tcp*).
+used_ports() {
+  local f a
+  for f in /proc/net/tcp /proc/net/tcp6; do
+    [ -r "$f" ] || continue
+    while read -r _ a _; do [[ $a != *:* ]] || echo $((16#${a##*:})); done < "$f"
+  done | sort -u
+}
+free_port() {
+  local p used
+  used=$(used_ports)
+  for _ in $(seq 200); do
+    p=$((20000 + RANDOM % 30000))
+    grep -qx "$p" <<< "$used" || [ "$p" = "${1:-}" ] || {
+      echo "$p"
+      return
+    }
+  done
+  return 1
+}
+up() { # is the node idle, i.e. both daemons answer
+  [ "$(sinfo -h -o %T 2>/dev/null)" = idle ]
+}
+
+S=$tmp/slurm
+mkdir -p "$S/state" "$S/spool" "$S/log" "$S/munge"
+chmod 755 "$S" "$S/munge"
+head -c 1024 /dev/urandom > "$S/munge/munge.key"
+chmod 400 "$S/munge/munge.key"
+(cd "$S" && exec munged -F --socket="$S/munge/socket" --key-file="$S/munge/munge.key" \
+  --pid-file="$S/munge/munged.pid" --seed-file="$S/munge/seed" --log-file="$S/log/munged.log" \
+  > "$S/log/munged.log" 2>&1) &
+daemon_pids+=($!)
+for _ in $(seq 100); do [ -S "$S/munge/socket" ] && break; sleep 0.1; done
+[ -S "$S/munge/socket" ] || skip "munged did not start: $(tail -n 2 "$S/log/munged.log" | tr '\n' ' ')"
+
+# this machine as slurmd sees it (CPUs, sockets, cores, threads, memory)
+hw=$(slurmd -C 2>/dev/null | head -n 1 | sed 's/^NodeName=[^ ]* //')
+[ -n "$hw" ] || hw="CPUs=$(nproc)"
+export SLURM_CONF=$S/slurm.conf
+started=0
+for attempt in 1 2 3; do
+  p1=$(free_port) && p2=$(free_port "$p1") || skip "no free TCP port found"
+  cat > "$SLURM_CONF" <<EOF
+# single-node cluster of tests/test_slurm.sh (removed with its directory)
+ClusterName=lftest
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$p1
+SlurmdPort=$p2
+SlurmUser=$(id -un)
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+# own munge socket; cred_expire also sets how long a requeued job waits (+1 s)
+AuthInfo=socket=$S/munge/socket,cred_expire=10
+StateSaveLocation=$S/state
+SlurmdSpoolDir=$S/spool
+SlurmctldPidFile=$S/slurmctld.pid
+SlurmdPidFile=$S/slurmd.pid
+SlurmctldLogFile=$S/log/slurmctld.log
+SlurmdLogFile=$S/log/slurmd.log
+PlugStackConfig=$S/plugstack.conf
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+JobCompType=jobcomp/none
+MpiDefault=none
+SwitchType=switch/none
+SchedulerType=sched/builtin
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+ReturnToService=2
+KillWait=10
+MinJobAge=600
+NodeName=$host NodeAddr=127.0.0.1 $hw State=UNKNOWN
+PartitionName=lftest Nodes=$host Default=YES MaxTime=INFINITE State=UP
+EOF
+  : > "$S/plugstack.conf"
+  (cd "$S" && exec slurmctld -D -i -f "$SLURM_CONF" > "$S/log/slurmctld.out" 2>&1) &
+  ctld=$!
+  (cd "$S" && exec slurmd -D -f "$SLURM_CONF" > "$S/log/slurmd.out" 2>&1) &
+  sd=$!
+  daemon_pids+=("$ctld" "$sd")
+  for _ in $(seq 150); do
+    up && break
+    kill -0 "$ctld" 2>/dev/null && kill -0 "$sd" 2>/dev/null || break
+    sleep 0.2
+  done
+  if up; then
+    started=1
+    break
+  fi
+  why=$(cat "$S/log/slurmctld.out" "$S/log/slurmd.out" "$S/log/"*.log 2>/dev/null | grep -i -m 3 'error\|fatal' | tr '\n' ' ')
+  stop_pid "$sd"
+  stop_pid "$ctld"
+  unset 'daemon_pids[2]' 'daemon_pids[1]'
+  daemon_pids=("${daemon_pids[@]}")
+  say "attempt $attempt: slurmctld/slurmd on ports $p1/$p2 did not come up: $why"
+done
+[ $started = 1 ] || skip "slurmctld and slurmd did not come up (logs: $why)"
+say "single-node Slurm up: $host, $hw, ports $p1/$p2, conf $SLURM_CONF"
+
+# cost: 4096 samples a pixel (1024 with LF_QUICK, for sanitizer builds), so
+# each task takes seconds on one thread and is requeued well before it ends
+spp=4096
+[ -z "${LF_QUICK:-}" ] || spp=1024
+"$bin/lfrender" "$tmp/s.pbrt" -o "$tmp/ref.exr" --seed 4 --spp "$spp" --quiet
+
+# submit from another directory, with relative paths and an empty environment
+# (only PATH and SLURM_CONF; sanitizer options when set): nothing from here
+# may leak into the jobs except through the script's arguments
+envs=(HOME=/ PATH=/usr/local/bin:/usr/bin:/bin SLURM_CONF="$SLURM_CONF")
+[ "$bin" -ef "$root/build/bin" ] || envs[1]=PATH=$bin:/usr/local/bin:/usr/bin:/bin # else the script finds the checkout's build
+for v in ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS; do [ -z "${!v:-}" ] || envs+=("$v=${!v}"); done
+mkdir -p "$tmp/submit" "$tmp/cluster"
+(cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../cluster/out.exr 4 \
+  --time 10 --partition lftest --sbatch --comment=lftest --checkpoint-every 0.2 --seed 4 --spp "$spp") > "$tmp/submit.out"
+cat "$tmp/submit.out"
+read -r array merge < <(sed -n 's/^submitted array job \([0-9]*\) .* merge job \([0-9]*\)$/\1 \2/p' "$tmp/submit.out")
+[ -n "${merge:-}" ] || fail "submit did not report its jobs"
+P=$tmp/cluster/out.exr.parts
+state() { scontrol -o show job "$1" | grep -o 'JobState=[A-Z_]*' | head -n 1 | cut -d= -f2; }
+scontrol -o show job "${array}_0" | grep -q 'TimeLimit=00:10:00 .*Partition=lftest\|Partition=lftest .*TimeLimit=00:10:00' ||
+  fail "--time/--partition did not reach sbatch: $(scontrol -o show job "${array}_0")"
+scontrol -o show job "$merge" | grep -q 'Comment=lftest' || fail "--sbatch did not reach the merge job"
+
+# requeue task 1 once its checkpoint holds a finished tile
+ck=$P/part-1.exr.checkpoint.exr
+for _ in $(seq 600); do
+  if [ -f "$ck" ] && [ "$(iinfo -v "$ck" 2>/dev/null | sed -n 's/^ *lensfield:done_tiles: "\(.*\)"/\1/p' | tr -d 0)" != "" ]; then break; fi
+  [ "$(state "${array}_1")" != COMPLETED ] || fail "task 1 completed before it could be requeued (too fast a render?)"
+  sleep 0.1
+done
+[ -f "$ck" ] || fail "task 1 wrote no checkpoint in 60 s: $(cat "$P/task-1.log" 2>/dev/null)"
+scontrol requeue "${array}_1"
+say "requeued task ${array}_1 mid-render"
+# while it waits to run again, status shows its progress from the checkpoint
+for _ in $(seq 100); do
+  grep -q 'interrupted with' "$P/task-1.log" 2>/dev/null && break
+  sleep 0.1
+done
+"$script" status "$tmp/cluster/out.exr" > "$tmp/status1"
+cat "$tmp/status1"
+line=$(grep '^part 1 ' "$tmp/status1")
+[[ $line =~ PENDING.*\ ([0-9]+)%\ +requeued\ 1\ times\;\ ([0-9]+)\ of\ 6\ tiles ]] ||
+  fail "status of the requeued task: $line"
+k_status=${BASH_REMATCH[2]}
+[ "$k_status" -ge 1 ] && [ "$k_status" -lt 6 ] || fail "requeued task's checkpoint has $k_status of 6 tiles"
+
+for _ in $(seq 900); do
+  s=$(state "$merge")
+  case $s in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) break ;; esac
+  sleep 0.2
+done
+[ "$s" = COMPLETED ] || fail "merge job $merge ended $s: $(cat "$P/merge.log" 2>/dev/null)"
+identical "$tmp/ref.exr" "$tmp/cluster/out.exr"
+grep -q "attempt 2" "$P/task-1.log" || fail "task 1 did not run twice: $(cat "$P/task-1.log")"
+grep -q "resuming from $P/part-1.exr.checkpoint.exr: $k_status of 6 tiles done" "$P/task-1.log" ||
+  fail "task 1 did not resume from its checkpoint ($k_status of 6 tiles): $(cat "$P/task-1.log")"
+"$script" status "$tmp/cluster/out.exr" > "$tmp/status2"
+cat "$tmp/status2"
+[ "$(grep -c '^part [0-3] *COMPLETED *100%' "$tmp/status2")" = 4 ] || fail "status after the merge"
+grep -q '^part 1 .*requeued 1 times' "$tmp/status2" || fail "status does not show the requeue"
+grep -q '^merge *COMPLETED' "$tmp/status2" || fail "status does not show the merge"
+passed=$((passed + 1))
+say "array of 4 tasks, task 1 requeued with $k_status of 6 tiles done and resumed: merged image identical"
+
+# a task that fails: its part cannot be written (a directory is in the way)
+mkdir -p "$tmp/cluster/bad.exr.parts/part-1.exr"
+(cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../cluster/bad.exr 2 --seed 4 --spp 4) > "$tmp/submit2.out"
+read -r array2 merge2 < <(sed -n 's/^submitted array job \([0-9]*\) .* merge job \([0-9]*\)$/\1 \2/p' "$tmp/submit2.out")
+[ -n "${merge2:-}" ] || fail "second submit did not report its jobs"
+for _ in $(seq 600); do
+  s=$(state "$merge2")
+  case $s in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) break ;; esac
+  [ "$s" != PENDING ] || ! scontrol -o show job "$merge2" | grep -q 'Reason=DependencyNeverSatisfied' ||
+    fail "merge job stuck on DependencyNeverSatisfied"
+  sleep 0.2
+done
+[ "$s" = FAILED ] || fail "merge after a failed task ended $s, not FAILED"
+[ "$(state "${array2}_1")" = FAILED ] || fail "task ${array2}_1 did not fail: $(state "${array2}_1")"
+B=$tmp/cluster/bad.exr.parts
+grep -q "part 1 is missing: task 1 (job ${array2}_1) ended FAILED (exit code 1:0); $B/part-1.exr not written; see $B/task-1.log" \
+  "$B/merge.log" || fail "merge message: $(cat "$B/merge.log")"
+[ ! -e "$tmp/cluster/bad.exr" ] || fail "a failed merge wrote its output"
+"$script" status "$tmp/cluster/bad.exr" > "$tmp/status3"
+cat "$tmp/status3"
+grep -q '^part 1 *FAILED .*exit code 1:0.*log '"$B/task-1.log" "$tmp/status3" || fail "status of the failed task"
+grep -q "^merge *FAILED see $B/merge.log" "$tmp/status3" || fail "status of the failed merge"
+passed=$((passed + 1))
+say "a failed task: the merge job failed naming part 1 and $B/task-1.log"
 echo "$passed passed, 0 failed"

@@ -246,25 +246,55 @@ envs=(HOME=/ PATH=/usr/local/bin:/usr/bin:/bin SLURM_CONF="$SLURM_CONF")
 [ "$bin" -ef "$root/build/bin" ] || envs[1]=PATH=$bin:/usr/local/bin:/usr/bin:/bin # else the script finds the checkout's build
 for v in ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS; do [ -z "${!v:-}" ] || envs+=("$v=${!v}"); done
 mkdir -p "$tmp/submit" "$tmp/cluster"
-(cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../cluster/out.exr 4 \
-  --time 10 --partition lftest --sbatch --comment=lftest --checkpoint-every 0.2 --seed 4 --spp "$spp") > "$tmp/submit.out"
-cat "$tmp/submit.out"
-read -r array merge < <(sed -n 's/^submitted array job \([0-9]*\) .* merge job \([0-9]*\)$/\1 \2/p' "$tmp/submit.out")
-[ -n "${merge:-}" ] || fail "submit did not report its jobs"
-P=$tmp/cluster/out.exr.parts
+submit() { # OUT TASKS [options]: submits from $tmp/submit; sets $array and $merge
+  local out=$1
+  shift
+  (cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt "../cluster/$out" "$@") > "$tmp/submit.out" ||
+    fail "submit failed: $(cat "$tmp/submit.out")"
+  cat "$tmp/submit.out"
+  array='' merge=''
+  read -r array merge < <(sed -n 's/^submitted array job \([0-9]*\) .* merge job \([0-9]*\)$/\1 \2/p' "$tmp/submit.out")
+  [ -n "$merge" ] || fail "submit did not report its jobs"
+}
 state() { scontrol -o show job "$1" | grep -o 'JobState=[A-Z_]*' | head -n 1 | cut -d= -f2; }
+wait_end() { # JOB: its final state (a merge job must never wait forever)
+  local s
+  for _ in $(seq 1500); do
+    s=$(state "$1")
+    case $s in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY | PREEMPTED | BOOT_FAIL | DEADLINE)
+      echo "$s"
+      return
+      ;;
+    esac
+    ! scontrol -o show job "$1" | grep -q 'Reason=DependencyNeverSatisfied' || fail "job $1 stuck on DependencyNeverSatisfied"
+    sleep 0.2
+  done
+  fail "job $1 still $s after 300 s"
+}
+tiles_done() { # CHECKPOINT: finished tiles (16x16) it lists
+  local hex n=0 k
+  hex=$(iinfo -v "$1" 2>/dev/null | sed -n 's/^ *lensfield:done_tiles: "\(.*\)"/\1/p')
+  for ((k = 0; k < ${#hex}; k++)); do
+    for b in 1 2 4 8; do (((16#${hex:k:1} & b) == 0)) || n=$((n + 1)); done
+  done
+  echo $n
+}
+wait_checkpoint() { # CHECKPOINT JOB: until it lists a finished tile while JOB runs
+  for _ in $(seq 600); do
+    [ ! -f "$1" ] || [ "$(tiles_done "$1")" = 0 ] || return 0
+    [ "$(state "$2")" != COMPLETED ] || fail "$2 completed before it could be interrupted (too fast a render?)"
+    sleep 0.1
+  done
+  fail "$2 wrote no checkpoint with a finished tile in 60 s"
+}
+
+# 4 tasks; task 1 requeued once its checkpoint holds a finished tile
+submit out.exr 4 --time 10 --partition lftest --sbatch --comment=lftest --checkpoint-every 0.2 --seed 4 --spp "$spp"
+P=$tmp/cluster/out.exr.parts
 scontrol -o show job "${array}_0" | grep -q 'TimeLimit=00:10:00 .*Partition=lftest\|Partition=lftest .*TimeLimit=00:10:00' ||
   fail "--time/--partition did not reach sbatch: $(scontrol -o show job "${array}_0")"
 scontrol -o show job "$merge" | grep -q 'Comment=lftest' || fail "--sbatch did not reach the merge job"
-
-# requeue task 1 once its checkpoint holds a finished tile
-ck=$P/part-1.exr.checkpoint.exr
-for _ in $(seq 600); do
-  if [ -f "$ck" ] && [ "$(iinfo -v "$ck" 2>/dev/null | sed -n 's/^ *lensfield:done_tiles: "\(.*\)"/\1/p' | tr -d 0)" != "" ]; then break; fi
-  [ "$(state "${array}_1")" != COMPLETED ] || fail "task 1 completed before it could be requeued (too fast a render?)"
-  sleep 0.1
-done
-[ -f "$ck" ] || fail "task 1 wrote no checkpoint in 60 s: $(cat "$P/task-1.log" 2>/dev/null)"
+wait_checkpoint "$P/part-1.exr.checkpoint.exr" "${array}_1"
 scontrol requeue "${array}_1"
 say "requeued task ${array}_1 mid-render"
 # while it waits to run again, status shows its progress from the checkpoint
@@ -275,51 +305,64 @@ done
 "$script" status "$tmp/cluster/out.exr" > "$tmp/status1"
 cat "$tmp/status1"
 line=$(grep '^part 1 ' "$tmp/status1")
-[[ $line =~ PENDING.*\ ([0-9]+)%\ +requeued\ 1\ times\;\ ([0-9]+)\ of\ 6\ tiles ]] ||
+[[ $line =~ PENDING.*\ ([0-9]+)%\ +([0-9]+)\ of\ 6\ tiles\ at\ the\ last\ checkpoint.*requeued\ once ]] ||
   fail "status of the requeued task: $line"
-k_status=${BASH_REMATCH[2]}
-[ "$k_status" -ge 1 ] && [ "$k_status" -lt 6 ] || fail "requeued task's checkpoint has $k_status of 6 tiles"
-
-for _ in $(seq 900); do
-  s=$(state "$merge")
-  case $s in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) break ;; esac
-  sleep 0.2
-done
+k=${BASH_REMATCH[2]}
+[ "$k" -ge 1 ] && [ "$k" -lt 6 ] || fail "requeued task's checkpoint has $k of 6 tiles"
+[ "$k" = "$(tiles_done "$P/part-1.exr.checkpoint.exr")" ] && [ "${BASH_REMATCH[1]}" = $((100 * k / 6)) ] ||
+  fail "status progress does not match the checkpoint: $line"
+s=$(wait_end "$merge")
 [ "$s" = COMPLETED ] || fail "merge job $merge ended $s: $(cat "$P/merge.log" 2>/dev/null)"
 identical "$tmp/ref.exr" "$tmp/cluster/out.exr"
 grep -q "attempt 2" "$P/task-1.log" || fail "task 1 did not run twice: $(cat "$P/task-1.log")"
-grep -q "resuming from $P/part-1.exr.checkpoint.exr: $k_status of 6 tiles done" "$P/task-1.log" ||
-  fail "task 1 did not resume from its checkpoint ($k_status of 6 tiles): $(cat "$P/task-1.log")"
+grep -q "resuming from $P/part-1.exr.checkpoint.exr: $k of 6 tiles done" "$P/task-1.log" ||
+  fail "task 1 did not resume from its checkpoint ($k of 6 tiles): $(cat "$P/task-1.log")"
 "$script" status "$tmp/cluster/out.exr" > "$tmp/status2"
 cat "$tmp/status2"
 [ "$(grep -c '^part [0-3] *COMPLETED *100%' "$tmp/status2")" = 4 ] || fail "status after the merge"
-grep -q '^part 1 .*requeued 1 times' "$tmp/status2" || fail "status does not show the requeue"
+grep -q '^part 1 .*requeued once' "$tmp/status2" || fail "status does not show the requeue"
 grep -q '^merge *COMPLETED' "$tmp/status2" || fail "status does not show the merge"
+sed 's/^/  task-1.log: /' "$P/task-1.log"
 passed=$((passed + 1))
-say "array of 4 tasks, task 1 requeued with $k_status of 6 tiles done and resumed: merged image identical"
+say "array of 4 tasks, task 1 requeued with $k of 6 tiles done and resumed: merged image identical"
+
+# cancelled mid-render (as a time limit stops tasks), then the same submit
+# again: the merge of the cancelled run fails, the new tasks resume
+submit again.exr 2 --checkpoint-every 0.2 --seed 4 --spp "$spp"
+A=$tmp/cluster/again.exr.parts
+wait_checkpoint "$A/part-0.exr.checkpoint.exr" "${array}_0"
+wait_checkpoint "$A/part-1.exr.checkpoint.exr" "${array}_1"
+scancel "$array"
+s=$(wait_end "$merge")
+[ "$s" = FAILED ] || fail "merge after cancelled tasks ended $s, not FAILED"
+grep -q "part 0 is missing: task 0 (job ${array}_0) ended CANCELLED" "$A/merge.log" || fail "merge message: $(cat "$A/merge.log")"
+k0=$(tiles_done "$A/part-0.exr.checkpoint.exr") k1=$(tiles_done "$A/part-1.exr.checkpoint.exr")
+submit again.exr 2 --checkpoint-every 0.2 --seed 4 --spp "$spp"
+grep -q "2 resuming from their checkpoints" "$tmp/submit.out" || fail "resubmission does not resume"
+s=$(wait_end "$merge")
+[ "$s" = COMPLETED ] || fail "merge of the resubmission ended $s: $(cat "$A/merge.log" 2>/dev/null)"
+grep -q "resuming from $A/part-0.exr.checkpoint.exr: $k0 of 12 tiles done" "$A/task-0.log" &&
+  grep -q "resuming from $A/part-1.exr.checkpoint.exr: $k1 of 12 tiles done" "$A/task-1.log" ||
+  fail "resubmitted tasks did not resume ($k0, $k1 of 12 tiles): $(cat "$A/task-0.log" "$A/task-1.log")"
+identical "$tmp/ref.exr" "$tmp/cluster/again.exr"
+passed=$((passed + 1))
+say "cancelled with $k0 and $k1 of 12 tiles done, resubmitted, resumed: merged image identical"
 
 # a task that fails: its part cannot be written (a directory is in the way)
 mkdir -p "$tmp/cluster/bad.exr.parts/part-1.exr"
-(cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../cluster/bad.exr 2 --seed 4 --spp 4) > "$tmp/submit2.out"
-read -r array2 merge2 < <(sed -n 's/^submitted array job \([0-9]*\) .* merge job \([0-9]*\)$/\1 \2/p' "$tmp/submit2.out")
-[ -n "${merge2:-}" ] || fail "second submit did not report its jobs"
-for _ in $(seq 600); do
-  s=$(state "$merge2")
-  case $s in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) break ;; esac
-  [ "$s" != PENDING ] || ! scontrol -o show job "$merge2" | grep -q 'Reason=DependencyNeverSatisfied' ||
-    fail "merge job stuck on DependencyNeverSatisfied"
-  sleep 0.2
-done
+submit bad.exr 2 --seed 4 --spp 4
+s=$(wait_end "$merge")
 [ "$s" = FAILED ] || fail "merge after a failed task ended $s, not FAILED"
-[ "$(state "${array2}_1")" = FAILED ] || fail "task ${array2}_1 did not fail: $(state "${array2}_1")"
+[ "$(state "${array}_1")" = FAILED ] || fail "task ${array}_1 did not fail: $(state "${array}_1")"
 B=$tmp/cluster/bad.exr.parts
-grep -q "part 1 is missing: task 1 (job ${array2}_1) ended FAILED (exit code 1:0); $B/part-1.exr not written; see $B/task-1.log" \
+grep -q "part 1 is missing: task 1 (job ${array}_1) ended FAILED (exit code 1:0); $B/part-1.exr not written; see $B/task-1.log" \
   "$B/merge.log" || fail "merge message: $(cat "$B/merge.log")"
 [ ! -e "$tmp/cluster/bad.exr" ] || fail "a failed merge wrote its output"
 "$script" status "$tmp/cluster/bad.exr" > "$tmp/status3"
 cat "$tmp/status3"
 grep -q '^part 1 *FAILED .*exit code 1:0.*log '"$B/task-1.log" "$tmp/status3" || fail "status of the failed task"
-grep -q "^merge *FAILED see $B/merge.log" "$tmp/status3" || fail "status of the failed merge"
+grep -q "^merge *FAILED *log $B/merge.log" "$tmp/status3" || fail "status of the failed merge"
+sed 's/^/  merge.log: /' "$B/merge.log"
 passed=$((passed + 1))
 say "a failed task: the merge job failed naming part 1 and $B/task-1.log"
 echo "$passed passed, 0 failed"

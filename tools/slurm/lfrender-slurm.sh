@@ -267,36 +267,41 @@ status)
   echo "$out: ${array:+array job $array, merge job $merge, }$tasks tasks"
   now=$(date +%s)
   for ((i = 0; i < tasks; i++)); do
-    p=$parts/part-$i.exr st=-- extra=''
+    p=$parts/part-$i.exr st=-- notes=()
     if [ -n "$array" ] && s=$(job_state "${array}_$i") && [ -n "$s" ]; then
       read -r st ec rs <<< "$s"
-      [ "$rs" = 0 ] || [ "$rs" = '?' ] || extra=" requeued $rs times;"
-      case $st in COMPLETED | RUNNING | PENDING* | REQUEUED | CONFIGURING) ;; *) extra+=" exit code $ec;" ;; esac
     fi
     if [ -f "$p" ]; then
-      pct=100 extra+=" $p"
+      pct=100 notes+=("$p")
       [ "$st" != -- ] || st=done
     elif [ -f "$p.checkpoint.exr" ]; then
       age=$((now - $(stat -c %Y "$p.checkpoint.exr")))
+      [ "$age" -ge 0 ] || age=0
       if t=$(checkpoint_tiles "$p.checkpoint.exr"); then
         pct=$((100 * ${t% *} / ${t#* }))
-        extra+=" ${t% *} of ${t#* } tiles at the checkpoint of ${age} s ago"
+        notes+=("${t% *} of ${t#* } tiles at the last checkpoint (${age} s old)")
       else
-        pct='?' extra+=" checkpoint ${age} s old"
+        pct='?' notes+=("checkpoint ${age} s old")
       fi
     else
       pct=0
     fi
-    [ -f "$p" ] || [ ! -f "$parts/task-$i.log" ] || extra+=" log $parts/task-$i.log"
-    printf 'part %-3d %-22s %4s%%%s\n' "$i" "$st" "$pct" "$extra"
+    case $st in -- | done | COMPLETED | RUNNING | PENDING* | REQUEUED* | CONFIGURING | COMPLETING) ;; *) notes+=("exit code $ec") ;; esac
+    case ${rs:-0} in 0 | '?') ;; 1) notes+=("requeued once") ;; *) notes+=("requeued $rs times") ;; esac
+    [ -f "$p" ] || [ ! -f "$parts/task-$i.log" ] || notes+=("log $parts/task-$i.log")
+    line=$(printf 'part %-3d %-20s %4s%%' "$i" "$st" "$pct")
+    if [ ${#notes[@]} -gt 0 ]; then line+="  ${notes[0]}"; fi
+    for ((k = 1; k < ${#notes[@]}; k++)); do line+="; ${notes[k]}"; done
+    echo "$line"
+    rs=0
   done
   if [ -n "$merge" ]; then
     s=$(job_state "$merge") || true
     st=${s%% *}
-    m="merge    ${st:---}"
-    [ -f "$out" ] && [ "$st" = COMPLETED ] && m+=" $out"
-    [ "$st" = FAILED ] && m+=" see $parts/merge.log"
-    echo "$m"
+    line=$(printf 'merge    %s' "${st:---}")
+    if [ -f "$out" ] && [ "$st" = COMPLETED ]; then line+="  $out"; fi
+    if [ -n "$st" ] && [ "$st" != COMPLETED ] && [ -f "$parts/merge.log" ]; then line+="  log $parts/merge.log"; fi
+    echo "$line"
   fi
   ;;
 *)

@@ -294,11 +294,16 @@ P=$tmp/cluster/out.exr.parts
 scontrol -o show job "${array}_0" | grep -q 'TimeLimit=00:10:00 .*Partition=lftest\|Partition=lftest .*TimeLimit=00:10:00' ||
   fail "--time/--partition did not reach sbatch: $(scontrol -o show job "${array}_0")"
 scontrol -o show job "$merge" | grep -q 'Comment=lftest' || fail "--sbatch did not reach the merge job"
+if (cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../cluster/out.exr 4) 2> "$tmp/again.err"; then
+  fail "a second submit to an output still being rendered was accepted"
+fi
+grep -q "still queued or running (array job $array, merge job $merge)" "$tmp/again.err" || fail "second submit: $(cat "$tmp/again.err")"
 wait_checkpoint "$P/part-1.exr.checkpoint.exr" "${array}_1"
 scontrol requeue "${array}_1"
 say "requeued task ${array}_1 mid-render"
 # while it waits to run again, status shows its progress from the checkpoint
-for _ in $(seq 100); do
+# (final once lfrender said so, or was killed KillWait = 10 s after SIGTERM)
+for _ in $(seq 300); do
   grep -q 'interrupted with' "$P/task-1.log" 2>/dev/null && break
   sleep 0.1
 done

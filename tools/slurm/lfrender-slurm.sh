@@ -152,6 +152,11 @@ submit)
   mkdir -p -- "$(dirname -- "$out")"
   out=$(abspath "$out")
   parts=$out.parts
+  # never pull the files from under an earlier submission still in the queue
+  read_jobs "$parts"
+  if [ -n "$array" ] && q=$(squeue -h -j "$array,$merge" -o %i 2>/dev/null) && [ -n "$q" ]; then
+    die "a render of $out is still queued or running (array job $array, merge job $merge): wait, or cancel it with scancel $array $merge"
+  fi
   script=$(abspath "${BASH_SOURCE[0]}")
   mkdir -p -- "$parts"
   # A resubmission of the same render resumes its tasks' checkpoints; a
@@ -212,7 +217,7 @@ task)
   threads=${SLURM_CPUS_PER_TASK:-}
   if [ -z "$threads" ] && [ -n "${SLURM_JOB_CPUS_PER_NODE:-}" ]; then threads=${SLURM_JOB_CPUS_PER_NODE%%[!0-9]*}; fi
   [ -n "$threads" ] || threads=$(nproc)
-  echo "$me: task $i of $tasks: $part, job ${SLURM_JOB_ID:-(by hand)} on $(hostname), attempt $((${SLURM_RESTART_COUNT:-0} + 1)), $threads threads, $(date -u +%FT%TZ)"
+  echo "$me: task $i of $tasks: $part, job ${SLURM_JOB_ID:-(by hand)} on $(hostname), attempt $((${SLURM_RESTART_COUNT:-0} + 1)), threads $threads, $(date -u +%FT%TZ)"
   if [ -f "$part.checkpoint.exr" ]; then
     if t=$(checkpoint_tiles "$part.checkpoint.exr"); then
       echo "$me: resuming from $part.checkpoint.exr: ${t% *} of ${t#* } tiles done"

@@ -146,6 +146,7 @@ submit)
       ;;
     esac
   done
+  [[ $ck =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! $ck =~ ^[0.]+$ ]] || die "--checkpoint-every expects seconds > 0, got \"$ck\""
   command -v sbatch > /dev/null || die "sbatch not found: this needs a Slurm client (see docs/distributed.md for running the same split without Slurm)"
   lfr=$(find_lfrender "$lfr")
   scene=$(abspath "$scene")
@@ -165,19 +166,20 @@ submit)
   if [ -f "$parts/render.key" ] && [ "$(cat "$parts/render.key")" != "$key" ]; then
     rm -f -- "$parts"/part-*.exr.checkpoint.exr
   fi
-  printf '%s\n' "$key" > "$parts/render.key"
   resumed=0
   for ((i = 0; i < tasks; i++)); do
     [ -f "$parts/part-$i.exr.checkpoint.exr" ] && resumed=$((resumed + 1))
     # stale results of an earlier submission (regular files only)
     for f in "$parts/part-$i.exr" "$parts/task-$i.log"; do [ ! -f "$f" ] || rm -f -- "$f"; done
   done
-  [ ! -f "$parts/merge.log" ] || rm -f -- "$parts/merge.log"
+  rm -f -- "$parts/merge.log" "$parts/jobs"
   name=lfrender-$(basename -- "$out" .exr)
   array=$(cd -- "$parts" && sbatch --parsable --array="0-$((tasks - 1))${maxrun:+%$maxrun}" --requeue \
     --open-mode=append --job-name="$name" --output="$parts/task-%a.log" "${sb[@]}" \
-    "$script" task --lfrender "$lfr" --checkpoint-every "$ck" "$scene" "$out" "$tasks" "${lf[@]}")
+    "$script" task --lfrender "$lfr" --checkpoint-every "$ck" "$scene" "$out" "$tasks" "${lf[@]}") ||
+    die "sbatch refused the array job (its message is above); nothing submitted"
   array=${array%%;*}
+  echo "array=$array tasks=$tasks" > "$parts/jobs" # before the merge job can run
   # afterany, not afterok: the merge runs when every task has ended, however,
   # and fails naming the missing parts instead of waiting forever.
   merge=$(cd -- "$parts" && sbatch --parsable --dependency="afterany:$array" --job-name="$name-merge" \
@@ -188,6 +190,7 @@ submit)
   }
   merge=${merge%%;*}
   echo "array=$array merge=$merge tasks=$tasks" > "$parts/jobs"
+  printf '%s\n' "$key" > "$parts/render.key"
   note=''
   [ "$resumed" -eq 0 ] || note=", $resumed resuming from their checkpoints"
   echo "submitted array job $array ($tasks tasks$note) and merge job $merge"
@@ -197,8 +200,11 @@ task)
   lfr='' ck=${LF_CHECKPOINT_EVERY:-300}
   while [ $# -gt 0 ]; do
     case $1 in
-    --lfrender) lfr=$2 && shift 2 ;;
-    --checkpoint-every) ck=$2 && shift 2 ;;
+    --lfrender | --checkpoint-every)
+      [ $# -ge 2 ] || usage
+      if [ "$1" = --lfrender ]; then lfr=$2; else ck=$2; fi
+      shift 2
+      ;;
     *) break ;;
     esac
   done
@@ -230,7 +236,7 @@ task)
   ;;
 merge)
   lfr=''
-  if [ "${1:-}" = --lfrender ]; then lfr=$2 && shift 2; fi
+  if [ "${1:-}" = --lfrender ] && [ $# -ge 2 ]; then lfr=$2 && shift 2; fi
   [ $# -eq 2 ] || usage
   out=$1 tasks=$2
   int_arg TASKS "$tasks" 1
@@ -269,7 +275,7 @@ status)
       [ "$n" -ge "$tasks" ] && tasks=$((n + 1))
     done
   fi
-  echo "$out: ${array:+array job $array, merge job $merge, }$tasks tasks"
+  echo "$out: ${array:+array job $array, }${merge:+merge job $merge, }$tasks tasks"
   now=$(date +%s)
   for ((i = 0; i < tasks; i++)); do
     p=$parts/part-$i.exr st=-- notes=()

@@ -160,7 +160,7 @@ chmod 755 "$S" "$S/munge"
 head -c 1024 /dev/urandom > "$S/munge/munge.key"
 chmod 400 "$S/munge/munge.key"
 (cd "$S" && exec munged -F --socket="$S/munge/socket" --key-file="$S/munge/munge.key" \
-  --pid-file="$S/munge/munged.pid" --seed-file="$S/munge/seed" --log-file="$S/log/munged.log" \
+  --pid-file="$S/munge/munged.pid" --seed-file="$S/munge/seed" \
   > "$S/log/munged.log" 2>&1) &
 daemon_pids+=($!)
 for _ in $(seq 100); do [ -S "$S/munge/socket" ] && break; sleep 0.1; done
@@ -279,13 +279,51 @@ tiles_done() { # CHECKPOINT: finished tiles (16x16) it lists
   done
   echo $n
 }
-wait_checkpoint() { # CHECKPOINT JOB: until it lists a finished tile while JOB runs
-  for _ in $(seq 600); do
-    [ ! -f "$1" ] || [ "$(tiles_done "$1")" = 0 ] || return 0
-    [ "$(state "$2")" != COMPLETED ] || fail "$2 completed before it could be interrupted (too fast a render?)"
-    sleep 0.1
+# Catch tasks mid-render, however loaded the machine: once each task's
+# checkpoint exists (a cheap test; the task is unfinished, as the checkpoint
+# goes when it ends), stop its processes (SIGSTOP to the pids `scontrol
+# listpids` gives) and read the checkpoint at leisure; if it lists no
+# finished tile yet, let the task run a little longer and look again. The
+# tasks are left stopped: Slurm's requeue or cancel sends SIGCONT and
+# SIGTERM (SIGKILL KillWait later), and they end with that checkpoint or one
+# with a few more tiles. (scontrol suspend would do, but Slurm then gives
+# the suspended task's CPU to another task.)
+job_pids() { # JOB: its processes on this node
+  local id
+  id=$(scontrol -o show job "$1" | grep -o '^JobId=[0-9]*' | cut -d= -f2)
+  [ -z "$id" ] || scontrol listpids "$id" 2>/dev/null | awk '$1 ~ /^[0-9]+$/ && $1 > 1 { print $1 }'
+}
+stop_mid_render() { # JOB CHECKPOINT [JOB CHECKPOINT...]
+  local args=("$@") j k n ok pids
+  for ((n = 0; n < 1200; n++)); do
+    ok=1
+    for ((j = 1; j < ${#args[@]}; j += 2)); do [ -f "${args[j]}" ] || ok=0; done
+    [ $ok = 0 ] || break
+    if ((n % 20 == 19)); then
+      for ((j = 0; j < ${#args[@]}; j += 2)); do
+        case $(state "${args[j]}") in PENDING | RUNNING | CONFIGURING) ;; *) fail "${args[j]} ended before its first checkpoint (too fast a render?)" ;; esac
+      done
+    fi
+    sleep 0.05
   done
-  fail "$2 wrote no checkpoint with a finished tile in 60 s"
+  [ $ok = 1 ] || fail "no checkpoint from ${args[*]} within 60 s"
+  for ((n = 0; n < 50; n++)); do
+    for ((j = 0; j < ${#args[@]}; j += 2)); do
+      pids=$(job_pids "${args[j]}")
+      [ -n "$pids" ] || fail "${args[j]} has no processes (ended already? too fast a render?)"
+      kill -STOP $pids
+    done
+    ok=1
+    for ((j = 1; j < ${#args[@]}; j += 2)); do
+      [ -f "${args[j]}" ] || fail "${args[j]} vanished: the task ended before it could be stopped"
+      k=$(tiles_done "${args[j]}")
+      [ "$k" -ge 1 ] || ok=0
+    done
+    [ $ok = 0 ] || return 0
+    for ((j = 0; j < ${#args[@]}; j += 2)); do kill -CONT $(job_pids "${args[j]}"); done
+    sleep 0.3
+  done
+  fail "checkpoints of ${args[*]} list no finished tile after 50 looks"
 }
 
 # 4 tasks; task 1 requeued once its checkpoint holds a finished tile
@@ -298,13 +336,13 @@ if (cd "$tmp/submit" && env -i "${envs[@]}" bash "$script" submit ../s.pbrt ../c
   fail "a second submit to an output still being rendered was accepted"
 fi
 grep -q "still queued or running (array job $array, merge job $merge)" "$tmp/again.err" || fail "second submit: $(cat "$tmp/again.err")"
-wait_checkpoint "$P/part-1.exr.checkpoint.exr" "${array}_1"
+stop_mid_render "${array}_1" "$P/part-1.exr.checkpoint.exr"
 scontrol requeue "${array}_1"
-say "requeued task ${array}_1 mid-render"
+say "requeued task ${array}_1 mid-render (stopped with $(tiles_done "$P/part-1.exr.checkpoint.exr") of 6 tiles done)"
 # while it waits to run again, status shows its progress from the checkpoint
-# (final once lfrender said so, or was killed KillWait = 10 s after SIGTERM)
+# (final once the task's processes are gone: PENDING, no longer COMPLETING)
 for _ in $(seq 300); do
-  grep -q 'interrupted with' "$P/task-1.log" 2>/dev/null && break
+  [ "$(state "${array}_1")" != PENDING ] || break
   sleep 0.1
 done
 "$script" status "$tmp/cluster/out.exr" > "$tmp/status1"
@@ -335,8 +373,7 @@ say "array of 4 tasks, task 1 requeued with $k of 6 tiles done and resumed: merg
 # again: the merge of the cancelled run fails, the new tasks resume
 submit again.exr 2 --checkpoint-every 0.2 --seed 4 --spp "$spp"
 A=$tmp/cluster/again.exr.parts
-wait_checkpoint "$A/part-0.exr.checkpoint.exr" "${array}_0"
-wait_checkpoint "$A/part-1.exr.checkpoint.exr" "${array}_1"
+stop_mid_render "${array}_0" "$A/part-0.exr.checkpoint.exr" "${array}_1" "$A/part-1.exr.checkpoint.exr"
 scancel "$array"
 s=$(wait_end "$merge")
 [ "$s" = FAILED ] || fail "merge after cancelled tasks ended $s, not FAILED"

@@ -11,8 +11,10 @@
 #    directory with an empty environment, requeues one task mid-render with
 #    `scontrol requeue`, and checks that the task resumed from its checkpoint,
 #    that status showed its progress, and that the merged image equals the
-#    local render bit for bit; then a task forced to fail (its part path is a
-#    directory) must make the merge job fail naming the part and its log.
+#    local render bit for bit; a render cancelled mid-render and submitted
+#    again resumes both tasks and is identical too; then a task forced to
+#    fail (its part path is a directory) must make the merge job fail naming
+#    the part and its log.
 #    Every daemon it started is stopped by pid on exit, jobs first.
 # Where the daemons cannot start (not root, Slurm or munge not installed) the
 # Slurm part is skipped with the reason (exit 77, ctest "Skipped"), except

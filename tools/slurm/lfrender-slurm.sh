@@ -133,7 +133,10 @@ submit)
       --max-running) int_arg "$a" "$2" 1 && maxrun=$2 ;;
       --checkpoint-every) ck=$2 ;;
       --lfrender) lfr=$2 ;;
-      --camera-plugin) lf+=("$a" "$(abspath "$2")") ;; # the jobs may run elsewhere
+      --camera-plugin) # the jobs run elsewhere
+        pl=$(abspath "$2") || exit 1
+        lf+=("$a" "$pl")
+        ;;
       esac
       shift 2
       ;;

@@ -127,6 +127,7 @@ skip() {
   echo "skipped: the Slurm part: $* ($passed passed: the by-hand steps)"
   exit 77
 }
+PATH=$PATH:/usr/sbin:/sbin # the daemons, for users whose PATH lacks sbin
 for c in munged slurmctld slurmd sbatch scontrol squeue scancel sinfo; do
   command -v "$c" > /dev/null || skip "$c not found (Debian: apt-get install slurm-wlm munge)"
 done

@@ -47,24 +47,27 @@ stop_pid() {
   kill -KILL "$p" 2>/dev/null || true
 }
 cleanup() {
-  local rc=$? k i p
+  local rc=$? k i p q
   set +e
-  if [ ${#daemon_pids[@]} -ge 3 ] && kill -0 "${daemon_pids[1]}" 2>/dev/null; then
-    scancel --quiet $(squeue -h -o %A 2>/dev/null) 2>/dev/null
+  if [ ${#daemon_pids[@]} -ge 3 ] && kill -0 "${daemon_pids[1]}" 2>/dev/null && kill -0 "${daemon_pids[2]}" 2>/dev/null; then
+    # cancel every job and let slurmd see its steps end (jobs leave squeue
+    # once completed; each running step has a socket in the spool)
+    q=$(squeue -h -o %A 2>/dev/null)
+    [ -z "$q" ] || scancel --quiet $q 2>/dev/null
     for k in $(seq 150); do
-      ls "$tmp/slurm/spool/${host}_"[0-9]* > /dev/null 2>&1 || break # a socket per running step
+      q=$(squeue -h -o %A 2>/dev/null) || break
+      [ -n "$q" ] || ls "$tmp/slurm/spool/${host}_"[0-9]* > /dev/null 2>&1 || break
       sleep 0.2
     done
   fi
-  # last resort for steps that would not end: processes whose working
-  # directory is in this test's directory (slurmstepd and the job's lfrender)
+  for ((i = ${#daemon_pids[@]} - 1; i >= 0; i--)); do stop_pid "${daemon_pids[i]}"; done
+  # last resort, for steps that would not end: every process working in
+  # this test's directory was started by it (slurmstepd, job processes)
   for p in /proc/[0-9]*; do
     i=${p#/proc/}
     [ "$i" != $$ ] || continue
-    case "$(readlink "$p/cwd" 2>/dev/null)" in "$tmp" | "$tmp"/*) ;; *) continue ;; esac
-    case "$(cat "$p/comm" 2>/dev/null)" in slurmstepd | lfrender | lfrender-slurm*) kill -KILL "$i" 2>/dev/null ;; esac
+    case "$(readlink "$p/cwd" 2>/dev/null)" in "$tmp" | "$tmp"/*) kill -KILL "$i" 2>/dev/null ;; esac
   done
-  for ((i = ${#daemon_pids[@]} - 1; i >= 0; i--)); do stop_pid "${daemon_pids[i]}"; done
   if [ $rc -ne 0 ] && [ $rc -ne 77 ] && [ -d "$tmp/slurm/log" ]; then
     for f in "$tmp"/slurm/log/*; do
       echo "--- last lines of $f" >&2
@@ -120,6 +123,45 @@ mkdir "$tmp/hand/elsewhere"
 identical "$tmp/ref16.exr" "$tmp/hand/rel.exr"
 passed=$((passed + 1))
 say "by hand: 3 tasks + merge identical to the local render; status; missing part refused; relative paths"
+
+# submit as slurmd would run it, without Slurm: a stand-in sbatch records
+# each job; every job then runs as a copy of the script in a spool directory
+# of its own, from that directory, with an empty environment (lfrender not
+# on PATH): everything must come from the arguments resolved at submit
+F=$tmp/fake
+mkdir -p "$F/bin" "$F/submit"
+cat > "$F/bin/sbatch" <<EOF
+#!/bin/bash
+n=\$(ls "$F" | grep -c '^job-[0-9]*$')
+printf '%s\n' "\$@" > "$F/job-\$((n + 1))"
+echo "\$((n + 1))"
+EOF
+printf '#!/bin/sh\nexit 0\n' > "$F/bin/squeue"
+chmod +x "$F/bin/sbatch" "$F/bin/squeue"
+if [ "$bin" -ef "$root/build/bin" ]; then lfopt=(); else lfopt=(--lfrender "$bin/lfrender"); fi
+(cd "$F/submit" && env -i PATH="$F/bin:/usr/bin:/bin" bash "$script" submit ../../s.pbrt ../out/fake.exr 3 "${lfopt[@]}" \
+  --partition p1 --time 0:30:00 --sbatch --qos=low --seed 4 > /dev/null)
+run_job() { # N [TASK]: runs recorded job N as slurmd runs a batch script
+  local args=() k
+  mapfile -t args < "$F/job-$1"
+  for ((k = 0; k < ${#args[@]}; k++)); do [ "${args[k]}" != "$script" ] || break; done
+  [ $k -lt ${#args[@]} ] || fail "job $1 does not run the script: ${args[*]}"
+  printf '%s\n' "${args[@]:0:k}" > "$F/opts-$1"
+  mkdir -p "$F/spool/job$1"
+  cp "$script" "$F/spool/job$1/slurm_script"
+  (cd "$F/spool/job$1" && env -i PATH=/usr/bin:/bin ${2:+SLURM_ARRAY_TASK_ID=$2} bash slurm_script "${args[@]:k+1}") \
+    >> "$F/job-$1.out" 2>&1 || fail "job $1${2:+ task $2} failed: $(cat "$F/job-$1.out")"
+}
+for i in 0 1 2; do run_job 1 "$i"; done
+run_job 2
+identical "$tmp/ref16.exr" "$F/out/fake.exr"
+grep -qx -- '--array=0-2' "$F/opts-1" && grep -qx -- '--requeue' "$F/opts-1" || fail "array job options: $(cat "$F/opts-1")"
+for o in --partition=p1 --time=0:30:00 --qos=low; do
+  grep -qx -- "$o" "$F/opts-1" && grep -qx -- "$o" "$F/opts-2" || fail "$o not passed to both jobs"
+done
+grep -qx -- '--dependency=afterany:1' "$F/opts-2" || fail "merge job dependency: $(cat "$F/opts-2")"
+passed=$((passed + 1))
+say "submit without Slurm: the jobs, run as copies from a spool directory with an empty environment, reproduce the render"
 
 # ---- 2. on a single-node Slurm started here ----
 skip() {

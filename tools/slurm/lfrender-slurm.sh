@@ -158,8 +158,11 @@ submit)
   parts=$out.parts
   # never pull the files from under an earlier submission still in the queue
   read_jobs "$parts"
-  if [ -n "$array" ] && q=$(squeue -h -j "$array,$merge" -o %i 2>/dev/null) && [ -n "$q" ]; then
-    die "a render of $out is still queued or running (array job $array, merge job $merge): wait, or cancel it with scancel $array $merge"
+  if [ -n "$array" ]; then
+    q=$(squeue -h -o %F) || die "cannot ask Slurm (squeue) whether jobs $array and $merge of an earlier submission to $out still run"
+    if grep -qx -e "$array" ${merge:+-e "$merge"} <<< "$q"; then
+      die "a render of $out is still queued or running (array job $array${merge:+, merge job $merge}): wait, or cancel it with scancel $array $merge"
+    fi
   fi
   script=$(abspath "${BASH_SOURCE[0]}")
   mkdir -p -- "$parts"

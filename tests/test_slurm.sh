@@ -3,7 +3,9 @@
 #
 # 1. By hand (runs everywhere): the task and merge steps as Slurm would run
 #    them reproduce the single-machine render bit for bit; status reports
-#    the parts; a missing part makes merge fail naming the part and its log.
+#    the parts; a missing part makes merge fail naming the part and its log;
+#    submit with a stand-in sbatch, each recorded job then run as slurmd
+#    runs it (a copy of the script in a spool directory, empty environment).
 # 2. On Slurm: the test starts its own munged, slurmctld and slurmd (its own
 #    key, socket, ports, state, spool and slurm.conf in a temporary
 #    directory; SLURM_CONF points the clients there, so a system-wide

@@ -8,6 +8,7 @@ PACKAGES=(
   libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools
   clang libclang-rt-14-dev
   chromium nodejs
+  slurm-wlm munge
 )
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

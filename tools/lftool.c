@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 
@@ -29,6 +30,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include "cli.h"
 #include "image/lf_image.h"
 #include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
@@ -36,40 +38,7 @@
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
 
-static const char *usage_text =
-    "usage: lftool COMMAND INPUT [flags]\n"
-    "commands:\n"
-    "  info RAW.exr                          layout from the lensfield:* attributes\n"
-    "  decode RAW.exr -o DIR                 sub-aperture views + mosaic [--format exr|png] [--white W.exr]\n"
-    "                                        [--layout hci]\n"
-    "  calibrate WHITE.exr -o OUT.exr        estimate the microlens grid; OUT carries the layout attributes\n"
-    "  refocus RAW.exr -o OUT                --alpha A | --depth M | --disparity PX; [--aperture R]\n"
-    "                                        [--views u0 u1 v0 v1] [--method shift|fourier] [--oversample S]\n"
-    "  stack RAW.exr -o DIR                  focal stack --from D0 --to D1 [--steps N] (disparities)\n"
-    "  allfocus RAW.exr -o OUT               all-in-focus image from a stack (same flags)\n"
-    "  depth RAW.exr -o OUT.exr|.pfm         disparity map of the centre view (docs/depth.md) [--from D0 --to D1]\n"
-    "                                        [--confidence CONF.exr] [--method stack: focal-stack contrast]\n"
-    "  view RAW.exr --u U --v V -o OUT       view from (U, V) in view units from the centre, per-pixel depth\n"
-    "                                        [--disparity-map D.exr [--confidence C.exr]]; plane blend:\n"
-    "                                        --geometry plane [--disparity PX]\n"
-    "  synth LF.exr OUT.exr                  CS348B virtual camera: --samplesperpixel N --focaldistance D\n"
-    "                                        [--geometry depth [--disparity-map D.exr]]\n"
-    "                                        --camerapos x y z --camerarot x y z --inputfov DEG --outputfov DEG\n"
-    "                                        --lensradius R --griddim minx maxx miny maxy --camsperdim nx ny\n"
-    "                                        --outputdim w h [--coverage COV.exr] [--seed S]\n"
-    "  export-web RAW.exr -o DIR             static web page: click to focus, drag to move the viewpoint\n"
-    "                                        [--format jpg|png] [--from D0 --to D1] [--steps N] (docs/web.md)\n"
-    "  serve DIR [--port P]                  serve DIR on http://127.0.0.1:P/ (default 8000) until Ctrl-C\n"
-    "layout flags (when the file lacks attributes; they must agree with it otherwise):\n"
-    "  --kind camera-array|plenoptic --camsperdim NX NY --griddim MINX MAXX MINY MAXY --inputfov DEG\n"
-    "  --tilesize W H --grid square|hex --pitch PX --rotation RAD --offset X Y --lenscount NX NY\n"
-    "  --mainlens FOCAL_MM FSTOP MLA_DISTANCE_MM MICROLENS_PITCH_UM\n"
-    "other: --threads N, --allow-nonfinite (treat NaN/Inf raw pixels as missing samples), --help\n"
-    "every RAW.exr / LF.exr may also be a folder of views (docs/lightfield-format.md): the HCI layout\n"
-    "  (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC[...].png|exr (row, column; from 0 or 1);\n"
-    "  decode --layout hci writes the HCI layout (with gt_disp_lowres.pfm when the raw has disparity)\n";
-
-/* ---------- flags ---------- */
+/* ---------- flags (one table per command; `lftool COMMAND --help`) ---------- */
 
 typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
@@ -84,277 +53,216 @@ typedef struct opts {
     int have_outfov, have_outdim, have_pos, have_focal;
     /* export-web, serve */
     int port, have_steps;
+    /* 8-bit outputs */
+    double exposure;
+    const char *tonemap;
 } opts;
+
+static opts opt = {.steps = 9, .oversample = 2, .port = 8000};
+
+/* Flags whose values are gathered first and turned into opt's fields by
+ * apply_flags(): the layout (CS348B names) and the synth camera. */
+static struct {
+    const char *kind, *grid;
+    int cams[2], tile[2], lenses[2], outdim[2], spp;
+    double griddim[4], fov, pitch, rotation, offset[2], mainlens[4], pos[3], rot[3], focal, outfov, lensradius;
+    long long seed;
+    int g_kind, g_cams, g_griddim, g_fov, g_tile, g_grid, g_pitch, g_rot, g_offset, g_lenses, g_main, g_spp, g_rot3,
+        g_lensradius, g_seed;
+} fl;
 
 static int usage(const char *fmt, const char *arg)
 {
     fprintf(stderr, "lftool: ");
     fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\n(lftool --help for usage)\n");
+    fprintf(stderr, "\n(lftool %s --help for its flags)\n", opt.cmd ? opt.cmd : "COMMAND");
     return EXIT_USAGE;
 }
 
-static int num(const char *s, double *v)
-{
-    char *end;
-    errno = 0;
-    *v = strtod(s, &end);
-    return s[0] && !*end && !errno && isfinite(*v);
-}
+#define R_MIN(lo) .min = (lo), .flags = LF_ARG_HAS_MIN
+#define R_POS .min = 0, .flags = LF_ARG_MIN_OPEN
+#define R_IN(lo, hi) .min = (lo), .max = (hi), .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX
 
-/* Reads n numbers after flag argv[*i]; returns 0 on success. */
-static int nums(int argc, char **argv, int *i, int n, double *v)
-{
-    if (*i + n >= argc)
-        return usage("%s needs more values", argv[*i]);
-    for (int k = 0; k < n; k++)
-        if (!num(argv[*i + 1 + k], &v[k]))
-            return usage("%s: not a number", argv[*i + 1 + k]);
-    *i += n;
-    return 0;
-}
+/* Layout flags: for raws without lensfield:* attributes (they must agree
+ * with the file otherwise). */
+#define LAYOUT_FLAGS                                                                                               \
+    {"--kind", NULL, LF_ARG_CHOICE, &fl.kind, "KIND", "layout: camera-array or plenoptic",                         \
+     .choices = "camera-array|plenoptic", .given = &fl.g_kind},                                                    \
+        {"--camsperdim", NULL, LF_ARG_INT, fl.cams, "NX NY", "layout: data cameras per row and column",           \
+         R_IN(1, 4096), .count = 2, .given = &fl.g_cams},                                                          \
+        {"--griddim", NULL, LF_ARG_DOUBLE, fl.griddim, "MINX MAXX MINY MAXY", "layout: camera grid bounds (m)",   \
+         .count = 4, .given = &fl.g_griddim},                                                                      \
+        {"--inputfov", NULL, LF_ARG_DOUBLE, &fl.fov, "DEG", "layout: the data cameras' field of view",            \
+         .min = 0, .max = 180, .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &fl.g_fov},                     \
+        {"--tilesize", NULL, LF_ARG_INT, fl.tile, "W H", "layout: tile of one data camera (px)", R_IN(1, 1 << 20), \
+         .count = 2, .given = &fl.g_tile},                                                                         \
+        {"--grid", NULL, LF_ARG_CHOICE, &fl.grid, "GRID", "layout: microlens grid square or hex",                  \
+         .choices = "square|hex", .given = &fl.g_grid},                                                            \
+        {"--pitch", NULL, LF_ARG_DOUBLE, &fl.pitch, "PX", "layout: microlens pitch (px)", R_POS, .given = &fl.g_pitch}, \
+        {"--rotation", NULL, LF_ARG_DOUBLE, &fl.rotation, "RAD", "layout: microlens grid rotation",                \
+         .given = &fl.g_rot},                                                                                      \
+        {"--offset", NULL, LF_ARG_DOUBLE, fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,     \
+         .given = &fl.g_offset},                                                                                   \
+        {"--lenscount", NULL, LF_ARG_INT, fl.lenses, "NX NY", "layout: microlenses per row and column",           \
+         R_IN(1, 1 << 20), .count = 2, .given = &fl.g_lenses},                                                     \
+        {"--mainlens", NULL, LF_ARG_DOUBLE, fl.mainlens, "FOCAL_MM FSTOP MLA_DISTANCE_MM PITCH_UM",                \
+         "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &fl.g_main},    \
+        {"--threads", NULL, LF_ARG_INT, &opt.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},       \
+        {"--allow-nonfinite", NULL, LF_ARG_FLAG, &opt.allow_nonfinite, NULL,                                      \
+         "treat NaN/Inf raw pixels as missing samples instead of failing"}
 
-static int parse(int argc, char **argv, opts *o)
+#define OUTPUT_FLAG(what) {"--output", "-o", LF_ARG_STRING, &opt.output, "OUT", what, .flags = LF_ARG_REQUIRED}
+#define PICTURE_FLAGS                                                                                              \
+    {"--exposure", NULL, LF_ARG_DOUBLE, &opt.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",  \
+     R_IN(-64, 64)},                                                                                                \
+        {"--tonemap", NULL, LF_ARG_CHOICE, &opt.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)", \
+         .choices = "clamp|filmic|aces"}
+#define FOCUS_FLAGS                                                                                                \
+    {"--alpha", NULL, LF_ARG_DOUBLE, &opt.alpha, "A", "synthetic film at alpha F (Ng 2005)", R_POS,               \
+     .given = &opt.have_alpha},                                                                                    \
+        {"--depth", NULL, LF_ARG_DOUBLE, &opt.depth, "M", "the depth brought into focus (m)", R_POS,              \
+         .given = &opt.have_depth},                                                                                \
+        {"--disparity", NULL, LF_ARG_DOUBLE, &opt.disp, "PX", "the disparity brought into focus (px per view)",    \
+         .given = &opt.have_disp}
+#define APERTURE_FLAGS                                                                                             \
+    {"--aperture", NULL, LF_ARG_DOUBLE, &opt.aperture, "R", "synthetic aperture radius (views from the centre)",   \
+     R_MIN(0), .given = &opt.have_aperture},                                                                       \
+        {"--views", NULL, LF_ARG_INT, opt.views, "U0 U1 V0 V1", "use only views [U0,U1] x [V0,V1]",                \
+         R_IN(0, 1 << 20), .count = 4, .given = &opt.have_views}
+#define RANGE_FLAGS(lo)                                                                                            \
+    {"--from", NULL, LF_ARG_DOUBLE, &opt.from, "D0", "lowest disparity (px per view)", .given = &opt.have_from},   \
+        {"--to", NULL, LF_ARG_DOUBLE, &opt.to, "D1", "highest disparity (px per view)", .given = &opt.have_to},    \
+        {"--steps", NULL, LF_ARG_INT, &opt.steps, "N", "slices between them", R_IN(lo, 4096),                     \
+         .given = &opt.have_steps}
+
+static const lf_arg info_args[] = {LAYOUT_FLAGS};
+static const lf_arg decode_args[] = {
+    OUTPUT_FLAG("folder of views (view_ROW_COL) and mosaic"), LAYOUT_FLAGS, PICTURE_FLAGS,
+    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "views as exr (default) or png", .choices = "exr|png"},
+    {"--white", NULL, LF_ARG_STRING, &opt.white, "WHITE.exr", "divide by a white image (devignetting)"},
+    {"--layout", NULL, LF_ARG_CHOICE, &opt.hci, "hci",
+     "write the HCI benchmark layout (input_CamNNN.png, parameters.cfg, gt_disp_lowres.pfm)", .choices = "hci"},
+};
+static const lf_arg calibrate_args[] = {
+    OUTPUT_FLAG("the white image with the estimated layout attributes"),
+    {"--grid", NULL, LF_ARG_CHOICE, &fl.grid, "GRID", "microlens grid square or hex (default: estimated)",
+     .choices = "square|hex", .given = &fl.g_grid},
+};
+static const lf_arg refocus_args[] = {
+    OUTPUT_FLAG("the refocused image"), FOCUS_FLAGS, APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+    {"--white", NULL, LF_ARG_STRING, &opt.white, "WHITE.exr", "divide by a white image (devignetting)"},
+    {"--method", NULL, LF_ARG_CHOICE, &opt.method, "METHOD", "shift-and-add (default) or Fourier slice",
+     .choices = "shift|fourier"},
+    {"--oversample", NULL, LF_ARG_DOUBLE, &opt.oversample, "S", "Fourier slice: spectrum oversampling (default 2)",
+     R_IN(1, 8)},
+};
+static const lf_arg stack_args[] = {
+    OUTPUT_FLAG("folder of slices stack_NNN"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "slices as exr (default) or png", .choices = "exr|png"},
+};
+static const lf_arg allfocus_args[] = {
+    OUTPUT_FLAG("the all-in-focus image"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+};
+static const lf_arg depth_args[] = {
+    OUTPUT_FLAG("disparity map: .exr/.pfm values, .png a colour map with a legend"), RANGE_FLAGS(3), APERTURE_FLAGS,
+    LAYOUT_FLAGS,
+    {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "also write the confidence map"},
+    {"--method", NULL, LF_ARG_CHOICE, &opt.method, "METHOD",
+     "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
+     .choices = "volume|stack"},
+};
+static const lf_arg view_args[] = {
+    OUTPUT_FLAG("the synthesized view"), FOCUS_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+    {"--u", NULL, LF_ARG_DOUBLE, &opt.u, "U", "viewpoint, in view steps right of the centre", .given = &opt.have_u,
+     .flags = LF_ARG_REQUIRED},
+    {"--v", NULL, LF_ARG_DOUBLE, &opt.v, "V", "viewpoint, in view steps below the centre", .given = &opt.have_v,
+     .flags = LF_ARG_REQUIRED},
+    {"--geometry", NULL, LF_ARG_CHOICE, &opt.geometry, "GEOM",
+     "depth: per-pixel disparity (default); plane: blend on one plane", .choices = "depth|plane"},
+    {"--disparity-map", NULL, LF_ARG_STRING, &opt.dispmap, "D.exr", "use this disparity map instead of estimating"},
+    {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "its confidence (with --disparity-map)"},
+};
+static const lf_arg synth_args[] = {
+    LAYOUT_FLAGS, PICTURE_FLAGS,
+    {"--samplesperpixel", NULL, LF_ARG_INT, &fl.spp, "N", "samples per pixel", R_IN(1, 1 << 20), .given = &fl.g_spp},
+    {"--focaldistance", NULL, LF_ARG_DOUBLE, &fl.focal, "D", "virtual focal plane distance", R_POS,
+     .given = &opt.have_focal},
+    {"--camerapos", NULL, LF_ARG_DOUBLE, fl.pos, "X Y Z", "virtual camera position", .count = 3,
+     .given = &opt.have_pos},
+    {"--camerarot", NULL, LF_ARG_DOUBLE, fl.rot, "X Y Z", "virtual camera rotation (degrees)", .count = 3,
+     .given = &fl.g_rot3},
+    {"--outputfov", NULL, LF_ARG_DOUBLE, &fl.outfov, "DEG", "virtual camera field of view", .min = 0, .max = 180,
+     .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &opt.have_outfov},
+    {"--lensradius", NULL, LF_ARG_DOUBLE, &fl.lensradius, "R", "virtual lens radius (0: pinhole)", R_MIN(0),
+     .given = &fl.g_lensradius},
+    {"--outputdim", NULL, LF_ARG_INT, fl.outdim, "W H", "output size in pixels", R_IN(1, 65536), .count = 2,
+     .given = &opt.have_outdim},
+    {"--coverage", NULL, LF_ARG_STRING, &opt.coverage, "COV.exr", "also write where rays left the captured aperture"},
+    {"--seed", NULL, LF_ARG_LONG, &fl.seed, "S", "sampler seed", R_IN(0, 4294967295.0), .given = &fl.g_seed},
+    {"--geometry", NULL, LF_ARG_CHOICE, &opt.geometry, "GEOM", "depth: look data up on the estimated surface",
+     .choices = "depth|plane"},
+    {"--disparity-map", NULL, LF_ARG_STRING, &opt.dispmap, "D.exr", "with --geometry depth: this disparity map"},
+};
+static const lf_arg web_args[] = {
+    OUTPUT_FLAG("folder for index.html, lf.js and data.js"), LAYOUT_FLAGS,
+    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "atlases as jpg (default) or png", .choices = "jpg|png"},
+    {"--from", NULL, LF_ARG_DOUBLE, &opt.from, "D0", "lowest disparity (px per view)", .given = &opt.have_from},
+    {"--to", NULL, LF_ARG_DOUBLE, &opt.to, "D1", "highest disparity (px per view)", .given = &opt.have_to},
+    {"--steps", NULL, LF_ARG_INT, &opt.steps, "N", "focal-stack slices (default 9)", R_IN(2, 64),
+     .given = &opt.have_steps},
+};
+static const lf_arg serve_args[] = {
+    {"--port", NULL, LF_ARG_INT, &opt.port, "P", "port on 127.0.0.1 (default 8000; 0: any free)", R_IN(0, 65535)},
+};
+
+/* Turns the gathered layout and synth flags into opt.flags and opt.synth. */
+static void apply_flags(void)
 {
-    memset(o, 0, sizeof *o);
-    lf_lf_layout_init(&o->flags);
-    o->synth = lf_lf_synth_defaults();
-    o->steps = 9;
-    o->oversample = 2;
-    o->port = 8000;
-    o->cmd = argv[1];
-    int positional = 0;
-    for (int i = 2; i < argc; i++) {
-        const char *a = argv[i];
-        double v[4];
-        lf_lf_layout *f = &o->flags;
-#define NUMS(n)                                 \
-    do {                                        \
-        int rc_ = nums(argc, argv, &i, n, v);   \
-        if (rc_)                                \
-            return rc_;                         \
-    } while (0)
-#define STR(dst)                                           \
-    do {                                                   \
-        if (i + 1 >= argc)                                 \
-            return usage("%s needs a value", a);           \
-        dst = argv[++i];                                   \
-    } while (0)
-        if (!strcmp(a, "-o") || !strcmp(a, "--output"))
-            STR(o->output);
-        else if (!strcmp(a, "--white"))
-            STR(o->white);
-        else if (!strcmp(a, "--format")) {
-            STR(o->format);
-            if (!strcmp(o->cmd, "export-web")) {
-                if (strcmp(o->format, "jpg") && strcmp(o->format, "png"))
-                    return usage("--format %s: expected jpg or png", o->format);
-            } else if (strcmp(o->format, "exr") && strcmp(o->format, "png"))
-                return usage("--format %s: expected exr or png", o->format);
-        } else if (!strcmp(a, "--layout")) {
-            STR(o->hci);
-            if (strcmp(o->hci, "hci"))
-                return usage("--layout %s: only hci is known", o->hci);
-        } else if (!strcmp(a, "--method")) {
-            STR(o->method);
-            if (strcmp(o->method, "shift") && strcmp(o->method, "fourier") && strcmp(o->method, "stack"))
-                return usage("--method %s: expected shift or fourier (refocus) or stack (depth)", o->method);
-        } else if (!strcmp(a, "--coverage"))
-            STR(o->coverage);
-        else if (!strcmp(a, "--confidence"))
-            STR(o->confidence);
-        else if (!strcmp(a, "--disparity-map"))
-            STR(o->dispmap);
-        else if (!strcmp(a, "--geometry")) {
-            STR(o->geometry);
-            if (strcmp(o->geometry, "plane") && strcmp(o->geometry, "depth"))
-                return usage("--geometry %s: expected plane or depth", o->geometry);
-        }
-        else if (!strcmp(a, "--alpha"))
-            {
-            NUMS(1);
-            o->alpha = v[0], o->have_alpha = 1;
-        }
-        else if (!strcmp(a, "--depth"))
-            {
-            NUMS(1);
-            o->depth = v[0], o->have_depth = 1;
-        }
-        else if (!strcmp(a, "--disparity"))
-            {
-            NUMS(1);
-            o->disp = v[0], o->have_disp = 1;
-        }
-        else if (!strcmp(a, "--aperture"))
-            {
-            NUMS(1);
-            o->aperture = v[0], o->have_aperture = 1;
-        }
-        else if (!strcmp(a, "--views")) {
-            NUMS(4);
-            for (int k = 0; k < 4; k++)
-                o->views[k] = (int)v[k];
-            o->have_views = 1;
-        } else if (!strcmp(a, "--oversample"))
-            {
-            NUMS(1);
-            o->oversample = v[0];
-        }
-        else if (!strcmp(a, "--from"))
-            {
-            NUMS(1);
-            o->from = v[0], o->have_from = 1;
-        }
-        else if (!strcmp(a, "--to"))
-            {
-            NUMS(1);
-            o->to = v[0], o->have_to = 1;
-        }
-        else if (!strcmp(a, "--steps"))
-            {
-            NUMS(1);
-            o->steps = (int)v[0], o->have_steps = 1;
-        }
-        else if (!strcmp(a, "--u"))
-            {
-            NUMS(1);
-            o->u = v[0], o->have_u = 1;
-        }
-        else if (!strcmp(a, "--v"))
-            {
-            NUMS(1);
-            o->v = v[0], o->have_v = 1;
-        }
-        else if (!strcmp(a, "--threads"))
-            {
-            NUMS(1);
-            o->threads = (int)v[0], o->synth.threads = (int)v[0];
-        }
-        else if (!strcmp(a, "--port")) {
-            NUMS(1);
-            if (v[0] < 0 || v[0] > 65535 || v[0] != (int)v[0])
-                return usage("--port %s: expected an integer 0..65535", argv[i]);
-            o->port = (int)v[0];
-        } else if (!strcmp(a, "--allow-nonfinite"))
-            o->allow_nonfinite = 1;
-        /* layout flags */
-        else if (!strcmp(a, "--kind")) {
-            const char *k;
-            STR(k);
-            if (!strcmp(k, "camera-array"))
-                f->kind = LF_LF_CAMERA_ARRAY;
-            else if (!strcmp(k, "plenoptic"))
-                f->kind = LF_LF_PLENOPTIC;
-            else
-                return usage("--kind %s: expected camera-array or plenoptic", k);
-            f->have |= LF_LF_HAVE_KIND;
-        } else if (!strcmp(a, "--camsperdim"))
-            {
-            NUMS(2);
-            f->cams_x = (int)v[0], f->cams_y = (int)v[1], f->have |= LF_LF_HAVE_CAMS | LF_LF_HAVE_KIND,
-                     f->kind = LF_LF_CAMERA_ARRAY;
-        }
-        else if (!strcmp(a, "--griddim")) {
-            NUMS(4);
-            memcpy(f->grid_bounds, v, sizeof f->grid_bounds);
-            f->have |= LF_LF_HAVE_BOUNDS;
-        } else if (!strcmp(a, "--inputfov"))
-            {
-            NUMS(1);
-            f->fov_deg = v[0], f->have |= LF_LF_HAVE_FOV;
-        }
-        else if (!strcmp(a, "--tilesize"))
-            {
-            NUMS(2);
-            f->tile_w = (int)v[0], f->tile_h = (int)v[1], f->have |= LF_LF_HAVE_TILE;
-        }
-        else if (!strcmp(a, "--grid")) {
-            const char *g;
-            STR(g);
-            if (strcmp(g, "square") && strcmp(g, "hex"))
-                return usage("--grid %s: expected square or hex", g);
-            f->grid = strcmp(g, "hex") ? LF_LF_GRID_SQUARE : LF_LF_GRID_HEX;
-            f->have |= LF_LF_HAVE_GRID;
-        } else if (!strcmp(a, "--pitch"))
-            {
-            NUMS(1);
-            f->pitch_px = v[0], f->have |= LF_LF_HAVE_PITCH;
-        }
-        else if (!strcmp(a, "--rotation"))
-            {
-            NUMS(1);
-            f->rotation_rad = v[0], f->have |= LF_LF_HAVE_ROTATION;
-        }
-        else if (!strcmp(a, "--offset"))
-            {
-            NUMS(2);
-            f->offset_px[0] = v[0], f->offset_px[1] = v[1], f->have |= LF_LF_HAVE_OFFSET;
-        }
-        else if (!strcmp(a, "--lenscount"))
-            {
-            NUMS(2);
-            f->lens_x = (int)v[0], f->lens_y = (int)v[1], f->have |= LF_LF_HAVE_LENS_COUNT;
-        }
-        else if (!strcmp(a, "--mainlens")) {
-            NUMS(4);
-            f->main_focal_mm = v[0], f->main_fstop = v[1], f->mla_distance_mm = v[2], f->pitch_um = v[3];
-            f->have |= LF_LF_HAVE_MAIN_LENS;
-        }
-        /* synth (CS348B names) */
-        else if (!strcmp(a, "--samplesperpixel"))
-            {
-            NUMS(1);
-            o->synth.spp = (int)v[0];
-        }
-        else if (!strcmp(a, "--focaldistance"))
-            {
-            NUMS(1);
-            o->synth.focal_distance = v[0], o->have_focal = 1;
-        }
-        else if (!strcmp(a, "--camerapos"))
-            {
-            NUMS(3);
-            memcpy(o->synth.pos, v, sizeof o->synth.pos), o->have_pos = 1;
-        }
-        else if (!strcmp(a, "--camerarot"))
-            {
-            NUMS(3);
-            memcpy(o->synth.rot_deg, v, sizeof o->synth.rot_deg);
-        }
-        else if (!strcmp(a, "--outputfov"))
-            {
-            NUMS(1);
-            o->synth.fov_deg = v[0], o->have_outfov = 1;
-        }
-        else if (!strcmp(a, "--lensradius"))
-            {
-            NUMS(1);
-            o->synth.lens_radius = v[0];
-        }
-        else if (!strcmp(a, "--outputdim"))
-            {
-            NUMS(2);
-            o->synth.width = (int)v[0], o->synth.height = (int)v[1], o->have_outdim = 1;
-        }
-        else if (!strcmp(a, "--seed"))
-            {
-            NUMS(1);
-            o->synth.seed = (uint32_t)v[0];
-        }
-        else if (a[0] == '-' && a[1])
-            return usage("unknown flag %s", a);
-        else if (positional == 0)
-            o->input = a, positional++;
-        else if (positional == 1 && !strcmp(o->cmd, "synth") && !o->output)
-            o->output = a, positional++;
-        else
-            return usage("unexpected argument %s", a);
-#undef NUMS
-#undef STR
-    }
-    if (!o->input)
-        return usage("%s needs an input file", o->cmd);
-    return 0;
+    lf_lf_layout *f = &opt.flags;
+    lf_lf_layout_init(f);
+    if (fl.g_kind)
+        f->kind = strcmp(fl.kind, "plenoptic") ? LF_LF_CAMERA_ARRAY : LF_LF_PLENOPTIC, f->have |= LF_LF_HAVE_KIND;
+    if (fl.g_cams)
+        f->cams_x = fl.cams[0], f->cams_y = fl.cams[1], f->kind = LF_LF_CAMERA_ARRAY,
+        f->have |= LF_LF_HAVE_CAMS | LF_LF_HAVE_KIND;
+    if (fl.g_griddim)
+        memcpy(f->grid_bounds, fl.griddim, sizeof f->grid_bounds), f->have |= LF_LF_HAVE_BOUNDS;
+    if (fl.g_fov)
+        f->fov_deg = fl.fov, f->have |= LF_LF_HAVE_FOV;
+    if (fl.g_tile)
+        f->tile_w = fl.tile[0], f->tile_h = fl.tile[1], f->have |= LF_LF_HAVE_TILE;
+    if (fl.g_grid)
+        f->grid = strcmp(fl.grid, "hex") ? LF_LF_GRID_SQUARE : LF_LF_GRID_HEX, f->have |= LF_LF_HAVE_GRID;
+    if (fl.g_pitch)
+        f->pitch_px = fl.pitch, f->have |= LF_LF_HAVE_PITCH;
+    if (fl.g_rot)
+        f->rotation_rad = fl.rotation, f->have |= LF_LF_HAVE_ROTATION;
+    if (fl.g_offset)
+        f->offset_px[0] = fl.offset[0], f->offset_px[1] = fl.offset[1], f->have |= LF_LF_HAVE_OFFSET;
+    if (fl.g_lenses)
+        f->lens_x = fl.lenses[0], f->lens_y = fl.lenses[1], f->have |= LF_LF_HAVE_LENS_COUNT;
+    if (fl.g_main)
+        f->main_focal_mm = fl.mainlens[0], f->main_fstop = fl.mainlens[1], f->mla_distance_mm = fl.mainlens[2],
+        f->pitch_um = fl.mainlens[3], f->have |= LF_LF_HAVE_MAIN_LENS;
+    lf_lf_synth_opts *s = &opt.synth;
+    *s = lf_lf_synth_defaults();
+    s->threads = opt.threads;
+    if (fl.g_spp)
+        s->spp = fl.spp;
+    if (opt.have_focal)
+        s->focal_distance = fl.focal;
+    if (opt.have_pos)
+        memcpy(s->pos, fl.pos, sizeof s->pos);
+    if (fl.g_rot3)
+        memcpy(s->rot_deg, fl.rot, sizeof s->rot_deg);
+    if (opt.have_outfov)
+        s->fov_deg = fl.outfov;
+    if (fl.g_lensradius)
+        s->lens_radius = fl.lensradius;
+    if (opt.have_outdim)
+        s->width = fl.outdim[0], s->height = fl.outdim[1];
+    if (fl.g_seed)
+        s->seed = (uint32_t)fl.seed;
 }
 
 /* ---------- loading ---------- */
@@ -454,7 +362,11 @@ static int load(const opts *o, loaded *l, int layout_only)
 static int write_image(const char *path, const lf_image *img, const lf_attrs *a)
 {
     lf_error err = {0};
-    if (lf_image_write(path, img, a, NULL, &err)) {
+    lf_write_opts wo = {0};
+    wo.exposure = (float)opt.exposure;
+    if (opt.tonemap)
+        lf_tonemap_parse(opt.tonemap, &wo.tonemap);
+    if (lf_image_write(path, img, a, &wo, &err)) {
         fprintf(stderr, "lftool: %s\n", err.msg);
         return EXIT_INPUT;
     }
@@ -839,7 +751,20 @@ static int cmd_depth(const opts *o)
     lf_attrs_set_floats(&a, "lensfield:disparity_search_range", range, 2);
     lf_attrs_set_string(&a, "lensfield:disparity_convention",
                         "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step");
-    rc = write_image(o->output, &disp, &a);
+    const char *dot = strrchr(o->output, '.');
+    if (dot && (!strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg"))) {
+        /* a picture of the map: the colour map over the search range, with its legend */
+        lf_image pic;
+        if (lf_image_colormap(&disp, d.d0, d.d1, &pic, &err)) {
+            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+            rc = EXIT_INPUT;
+        } else {
+            rc = write_image(o->output, &pic, NULL);
+            lf_image_free(&pic);
+        }
+    } else {
+        rc = write_image(o->output, &disp, &a);
+    }
     if (!rc && o->confidence)
         rc = write_image(o->confidence, &conf, NULL);
     if (!rc)
@@ -1118,34 +1043,63 @@ static int cmd_serve(const opts *o)
     return EXIT_OK;
 }
 
-typedef struct command {
-    const char *name;
-    int (*run)(const opts *o);
-} command;
+#define RUNNER(name, fn)                  \
+    static int run_##fn(int n, char **pos) \
+    {                                     \
+        opt.cmd = name;                   \
+        opt.input = pos[0];               \
+        if (n > 1)                        \
+            opt.output = pos[1];          \
+        apply_flags();                    \
+        return fn(&opt);                  \
+    }
+RUNNER("info", cmd_info)
+RUNNER("decode", cmd_decode)
+RUNNER("calibrate", cmd_calibrate)
+RUNNER("refocus", cmd_refocus)
+RUNNER("stack", cmd_stack)
+RUNNER("allfocus", cmd_allfocus)
+RUNNER("depth", cmd_depth)
+RUNNER("view", cmd_view)
+RUNNER("synth", cmd_synth)
+RUNNER("export-web", cmd_export_web)
+RUNNER("serve", cmd_serve)
 
-static const command commands[] = {
-    {"info", cmd_info},       {"decode", cmd_decode},     {"calibrate", cmd_calibrate}, {"refocus", cmd_refocus},
-    {"stack", cmd_stack},     {"allfocus", cmd_allfocus}, {"depth", cmd_depth},         {"view", cmd_view},
-    {"synth", cmd_synth},     {"export-web", cmd_export_web}, {"serve", cmd_serve},
+#define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, run_##fn, desc}
+static const lf_command commands[] = {
+    CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
+    CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
+        "sub-aperture views and a mosaic, or the HCI benchmark layout", decode_args, cmd_decode, NULL),
+    CMD("calibrate", "WHITE.exr -o OUT.exr [--grid square|hex]", "estimate the microlens grid from a white image",
+        calibrate_args, cmd_calibrate, NULL),
+    CMD("refocus", "IN (--alpha A | --depth M | --disparity PX) -o OUT [options]",
+        "refocus after capture (shift-and-add or Fourier slice)", refocus_args, cmd_refocus,
+        "Refocusing outside the refocusable range (Ng 2005) is done, with a warning: the sub-aperture views are "
+        "themselves blurred there."),
+    CMD("stack", "IN --from D0 --to D1 [--steps N] -o DIR", "a focal stack over a disparity range", stack_args,
+        cmd_stack, NULL),
+    CMD("allfocus", "IN --from D0 --to D1 [--steps N] -o OUT", "an all-in-focus image from a focal stack",
+        allfocus_args, cmd_allfocus, NULL),
+    CMD("depth", "IN -o OUT.exr|.pfm|.png [--from D0 --to D1] [--confidence C.exr]",
+        "disparity map of the centre view (docs/depth.md)", depth_args, cmd_depth,
+        "Without --from/--to the range comes from the input's metadata or is estimated from the data. Output in "
+        "the HCI benchmark's convention: a point moves by -d pixels when the viewpoint moves one view right."),
+    CMD("view", "IN --u U --v V -o OUT [--geometry depth|plane] [--disparity-map D.exr]",
+        "synthesize a view from another viewpoint", view_args, cmd_view, NULL),
+    {"synth", "LF OUT.exr [CS348B flags]", "the CS348B virtual camera between the data cameras", synth_args,
+     LF_ARRAY_LEN(synth_args), 2, 2, run_cmd_synth, NULL},
+    CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
+        "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
+    CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),
 };
+
+static const lf_tool tool = {
+    "lftool", "decode, refocus and re-view light fields", LF_VERSION, commands, LF_ARRAY_LEN(commands),
+    "IN is a light-field raw (EXR with lensfield:* attributes, or any image plus layout flags) or a folder of "
+    "views: the HCI layout (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC.png|exr (docs/lightfield-format.md). "
+    "Exit status: 0 success; 1 bad input (the message names the file); 2 bad command line."};
 
 int main(int argc, char **argv)
 {
-    if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-        fputs(usage_text, stdout);
-        return EXIT_OK;
-    }
-    if (argc < 2) {
-        fputs(usage_text, stderr);
-        return EXIT_USAGE;
-    }
-    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (!strcmp(argv[1], commands[i].name)) {
-            opts o;
-            int rc = parse(argc, argv, &o);
-            if (rc)
-                return rc;
-            return commands[i].run(&o);
-        }
-    return usage("unknown command %s", argv[1]);
+    return lf_cli_main(&tool, argc, argv);
 }

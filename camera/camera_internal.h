@@ -97,5 +97,6 @@ extern const lf_camera_type lf_camera_thinlens;
 extern const lf_camera_type lf_camera_realistic;
 extern const lf_camera_type lf_camera_lightfield;
 extern const lf_camera_type lf_camera_plenoptic;
+extern const lf_camera_type lf_camera_spherical;
 
 #endif

@@ -324,6 +324,7 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                        "%s: warning: Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
                        "image",
                        where, type);
+    r->integrator.volumetric = strcmp(type, "path") != 0;
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
     /* pbrt-v4's names; "bvh" (its default) is our automatic choice: every
@@ -557,6 +558,14 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     }
     if (r->scene.warnings)
         lf_warn_append(&r->warnings, "%s", r->scene.warnings);
+    if (r->scene.has_media && !r->integrator.volumetric) {
+        char where[512];
+        where_of(where, sizeof where, &d->integrator.loc);
+        lf_warn_append(&r->warnings,
+                       "%s: warning: Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
+                       "renders them",
+                       where);
+    }
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
             d->accelerator.params.items[i].used = 1; /* Embree builds its own BVH */
@@ -703,8 +712,17 @@ char *lf_renderer_explain(const lf_renderer *r)
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
     appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
-    appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette\n",
-            r->integrator_name, r->integrator.max_depth);
+    if (s->has_media && r->integrator.volumetric)
+        appendf(&b, &len, &cap,
+                "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, Russian roulette; %d "
+                "homogeneous media (closed-form transmittance, spectral-MIS distance sampling, Henyey-Greenstein), "
+                "camera in %s\n",
+                r->integrator_name, r->integrator.max_depth, s->n_media,
+                s->camera_medium >= 0 ? "a medium" : "vacuum");
+    else
+        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette%s\n",
+                r->integrator_name, r->integrator.max_depth,
+                s->n_media ? " (media defined but no ray can enter one, or ignored by \"path\")" : "");
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
@@ -797,7 +815,10 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
     double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
     lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
-    lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
+    lf_vec3 L = r->scene.has_media && r->integrator.volumetric
+                    ? lf_volpath_li(&r->scene, &r->integrator, of, df, (float)p->tau, r->scene.camera_medium, &p->st,
+                                    rays)
+                    : lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
     L = lf_scale(L, (float)w * (float)r->imaging_ratio);
     if ((r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) && cr->wavelength_nm > 0)
         L = lf_mul(L, lf_wavelength_rgb_weight(cr->wavelength_nm));

@@ -54,6 +54,22 @@ typedef struct builder {
     int *object_proto; /* per ObjectBegin: its shared lf_proto, -1 none, -2 not built yet */
 } builder;
 
+/* A shape's MediumInterface as medium indices; *in = LF_MEDIUM_SAME when
+ * it changes nothing (none given, or one medium on both sides). */
+static int shape_media(builder *b, const lf_shape_desc *sh, int *in, int *out)
+{
+    *in = *out = LF_MEDIUM_SAME;
+    if (!sh->medium_inside && !sh->medium_outside)
+        return 0;
+    int i, o;
+    if (lf_media_lookup(b->d, sh->medium_inside, &sh->e.loc, "MediumInterface (inside)", &i, b->err) ||
+        lf_media_lookup(b->d, sh->medium_outside, &sh->e.loc, "MediumInterface (outside)", &o, b->err))
+        return b->err->code;
+    if (i != o)
+        *in = i, *out = o;
+    return 0;
+}
+
 static int push_mesh(builder *b, lf_mesh *m)
 {
     if (b->s->n_meshes == b->cap_meshes) {
@@ -223,6 +239,10 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, fl
     m.proto = b->proto;
     m.material = sh->material;
     m.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
+    if (shape_media(b, sh, &m.medium_in, &m.medium_out)) {
+        free(P), free(N), free(uv), free(idx);
+        return b->err->code;
+    }
     if (b->proto >= 0 && sh->area_light >= 0) { /* never routed here: emitters keep keyframes */
         free(P), free(N), free(uv), free(idx);
         return lf_error_set(b->err, LF_ERR_INTERNAL, "internal: an emissive shape in an instance prototype");
@@ -448,6 +468,10 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
         sp.material = sh->material;
         sp.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
         sp.light = -1;
+        if (shape_media(b, sh, &sp.medium_in, &sp.medium_out)) {
+            free(sp.centers);
+            return b->err->code;
+        }
         if (sh->area_light >= 0) {
             area_emission ae;
             if (read_area_light(b, sh->area_light, &ae))
@@ -1100,6 +1124,10 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         b.object_proto[i] = -2;
     if (lf_materials_build(d, &s->materials, err))
         goto fail;
+    if (lf_media_build(d, s, err))
+        goto fail;
+    if (lf_media_lookup(d, d->camera.medium, &d->camera.e.loc, "the camera's medium", &s->camera_medium, err))
+        goto fail;
     if (lf_materials_warnings(s->materials))
         lf_warn_append(&s->warnings, "%s", lf_materials_warnings(s->materials));
     for (size_t i = 0; i < d->n_shapes; i++) {
@@ -1116,6 +1144,12 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     b.object_proto = NULL;
     if (lf_scene_build_lights(d, s, err))
         goto fail;
+    /* Media cost only when a ray can enter one. */
+    s->has_media = s->camera_medium >= 0;
+    for (int i = 0; i < s->n_meshes && !s->has_media; i++)
+        s->has_media = s->meshes[i].medium_in != LF_MEDIUM_SAME;
+    for (int i = 0; i < s->n_spheres && !s->has_media; i++)
+        s->has_media = s->spheres[i].medium_in != LF_MEDIUM_SAME;
 
     /* Embree */
     s->device = rtcNewDevice("verbose=0");
@@ -1301,6 +1335,7 @@ int lf_scene_build_white(lf_scene *s, lf_error *err)
     s->infinite_lights[0] = 0;
     s->n_infinite = 1;
     s->scene_radius = 1;
+    s->camera_medium = -1;
     double one = 1;
     return lf_distrib1d_init(&s->light_distrib, &one, 1, err);
 }
@@ -1338,6 +1373,7 @@ void lf_scene_free(lf_scene *s)
     if (s->n_lights)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);
+    free(s->media);
     free(s->warnings);
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
@@ -1488,6 +1524,8 @@ static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 
     sc->ng = n;
     hit->material = m->material;
     hit->light = m->light_first >= 0 ? m->light_first + t : -1;
+    hit->medium_in = m->medium_in;
+    hit->medium_out = m->medium_out;
 }
 
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit)
@@ -1529,6 +1567,8 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
         sc->ng = sc->ns = n;
         hit->material = sp->material;
         hit->light = sp->light;
+        hit->medium_in = sp->medium_in;
+        hit->medium_out = sp->medium_out;
         return 1;
     }
     hit->sphere = -1;

@@ -54,7 +54,7 @@ static lf_vec3 light_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *b
     if (!lf_light_sample_li(s, l, h->sc.p, h->tau, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
         return lf_v3(0, 0, 0);
     lf_vec3 f = lf_bsdf_f(bsdf, wo, ls.wi);
-    float cosi = lf_absdot(ls.wi, h->sc.ns);
+    float cosi = lf_absdot(ls.wi, bsdf->n); /* the (maybe bumped) shading normal */
     if (lf_is_black(f) || cosi == 0)
         return lf_v3(0, 0, 0);
     lf_vec3 o = lf_offset_origin(h->sc.p, h->sc.ng, ls.wi);
@@ -171,7 +171,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         struct lf_bsdf_sample bs;
         if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
             break;
-        float cosi = lf_absdot(bs.wi, h.sc.ns);
+        float cosi = lf_absdot(bs.wi, bsdf.n);
         beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
         p_b = bs.pdf;
         specular_bounce = bs.specular;

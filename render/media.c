@@ -226,7 +226,7 @@ static lf_vec3 vol_light_direct(const lf_scene *s, const vertex *v, int li, doub
     lf_vec3 o = v->p;
     int medium = v->medium;
     if (v->h) {
-        float cosi = lf_absdot(ls.wi, v->h->sc.ns);
+        float cosi = lf_absdot(ls.wi, v->bsdf->n);
         f = lf_scale(lf_bsdf_f(v->bsdf, v->wo, ls.wi), cosi);
         if (lf_is_black(f))
             return lf_v3(0, 0, 0);
@@ -429,7 +429,7 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
         struct lf_bsdf_sample bs;
         if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
             break;
-        float cosi = lf_absdot(bs.wi, h.sc.ns);
+        float cosi = lf_absdot(bs.wi, bsdf.n);
         beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
         p_b = bs.pdf;
         specular_bounce = bs.specular;

@@ -30,6 +30,7 @@ typedef struct lf_mesh {
     int light_first;   /* index of the first triangle's light, -1 if not emissive */
     int flip_normal;   /* reverse orientation XOR handedness swap */
     int medium_in, medium_out; /* MediumInterface (lf_scene.media indices, -1 vacuum); LF_MEDIUM_SAME: none */
+    int bump;          /* its material has a displacement: hits carry (u,v) derivatives */
 } lf_mesh;
 
 typedef struct lf_sphere {
@@ -42,6 +43,7 @@ typedef struct lf_sphere {
     int light;         /* -1 if not emissive */
     int flip_normal;
     int medium_in, medium_out; /* as lf_mesh */
+    int bump;                  /* as lf_mesh */
 } lf_sphere;
 
 /* A shape whose MediumInterface does not change the medium (none given,

@@ -14,7 +14,8 @@
  *     an emitter at distance D dimmed by exp(-sigma_t D), with the medium's
  *     own emission sigma_a Le (1 - exp(-sigma_t D)) / sigma_t added;
  *   - grid media are refused naming file:line:column and "not supported";
- *     media nobody can enter leave the surface integrator in charge.
+ *     media nobody can enter leave the surface integrator in charge;
+ *     Integrator "path" ignores media with a warning (as pbrt-v4).
  * Monte Carlo margins are stated at each assertion; seeds are fixed. */
 #include <math.h>
 #include <stdio.h>
@@ -269,6 +270,19 @@ static void test_fast_path(void)
     CHECK_MSG(rc == 0, "%s", msg);
     CHECK_MSG(ex && strstr(ex, "volumetric"), "%s", ex ? ex : "");
     free(ex);
+    /* "path" ignores media as pbrt-v4's PathIntegrator, and says so */
+    lf_scene_desc d;
+    lf_error err = {0};
+    const char *text = "Integrator \"path\"\nWorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                       "MediumInterface \"fog\" \"\"\nMaterial \"interface\"\nShape \"sphere\"\n";
+    CHECK(lf_scene_parse_string(text, "test.pbrt", &d, &err) == 0);
+    lf_render_opts o = lf_render_opts_default();
+    lf_renderer *r = NULL;
+    CHECK_MSG(lf_renderer_create(&d, &o, &r, &err) == 0, "%s", err.msg);
+    const char *w = r ? lf_renderer_warnings(r) : NULL;
+    CHECK_MSG(w && strstr(w, "test.pbrt:1:1") && strstr(w, "ignores participating media"), "%s", w ? w : "");
+    lf_renderer_free(r);
+    lf_scene_desc_free(&d);
 }
 
 int main(void)

@@ -1712,6 +1712,8 @@ static int d_make_named_medium(parser *P, lexer *L, const token *dir)
     lf_medium_desc *m = &d->media[d->n_media];
     memset(m, 0, sizeof *m);
     rc = parse_params(P, L, &m->e.params);
+    if (!rc)
+        rc = merge_attrs(P, &m->e.params, ATTR_MEDIUM); /* Attribute "medium" defaults */
     if (rc) {
         lf_params_free(&m->e.params);
         free(name);

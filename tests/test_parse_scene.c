@@ -340,6 +340,24 @@ static void test_lights_options(void)
         CHECK_MSG(strstr(w, "test.pbrt:19:1: warning: WorldEnd"), "%s", w);
         lf_scene_desc_free(&d);
     }
+    /* Attribute "medium" gives MakeNamedMedium defaults; a MediumInterface
+     * before Camera is the camera's medium (its exterior name) */
+    if (parse_ok("MakeNamedMedium \"air\" \"string type\" \"homogeneous\"\n"
+                 "MediumInterface \"\" \"air\"\nCamera \"perspective\"\nWorldBegin\n"
+                 "AttributeBegin\nAttribute \"medium\" \"float g\" 0.3\n"
+                 "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"air\"\n"
+                 "Shape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n",
+                 &d)) {
+        CHECK(d.camera.medium && !strcmp(d.camera.medium, "air"));
+        CHECK(d.n_media == 2 && lf_params_float(&d.media[1].e.params, "g", 0) == 0.3);
+        CHECK(lf_params_float(&d.media[0].e.params, "g", 0) == 0);
+        CHECK(d.n_shapes == 2 && !strcmp(d.shapes[0].medium_inside, "fog") &&
+              !strcmp(d.shapes[0].medium_outside, "air"));
+        /* AttributeEnd restores the interface in effect before (camera's) */
+        CHECK(d.shapes[1].medium_inside && !strcmp(d.shapes[1].medium_inside, "") &&
+              !strcmp(d.shapes[1].medium_outside, "air"));
+        lf_scene_desc_free(&d);
+    }
 }
 
 static void test_motion(void)

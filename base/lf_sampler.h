@@ -13,6 +13,22 @@
  * LF_SAMPLER_STRATIFIED: jittered strata (x by y) in each 2D pair, strata
  * permuted independently per pair.
  * LF_SAMPLER_INDEPENDENT: uniform random numbers (a hash, no state).
+ * LF_SAMPLER_HALTON: pbrt-v4's HaltonSampler: one Halton sequence over the
+ * image (pixels tiled every 128), whose first two dimensions (bases 2 and
+ * 3) place the samples of a pixel inside it; dimension d >= 2 is the
+ * radical inverse in the d-th prime base (wrapping to 2 after 1000), with
+ * random digit permutations ("permutedigits", pbrt's default), Owen
+ * scrambling ("owen") or none ("none").  Needs lf_sampler_prepare.
+ * LF_SAMPLER_PMJ02BN: pbrt-v4's PMJ02BNSampler structure over progressive
+ * (0,2) sequences (every power-of-two prefix a (0,2)-net, the property of
+ * Christensen, Kensler and Kilpatrick's pmj02), generated at start-up by
+ * nested scrambling of the first two Sobol dimensions; pbrt's tables are
+ * also blue-noise optimised, these are not.  Pixel samples spread one
+ * sequence over a tile of pixels (so neighbouring pixels are stratified
+ * together), other dimension pairs take a per-pixel shuffle of the first
+ * spp points of one of 5 sequences with a random toroidal shift (pbrt
+ * shifts by a blue-noise texture), 1D values are shuffled jittered strata.
+ * spp must be a power of 4.  Needs lf_sampler_prepare.
  */
 #ifndef LF_SAMPLER_H
 #define LF_SAMPLER_H
@@ -26,19 +42,51 @@ extern "C" {
 typedef enum lf_sampler_kind {
     LF_SAMPLER_SOBOL,
     LF_SAMPLER_STRATIFIED,
-    LF_SAMPLER_INDEPENDENT
+    LF_SAMPLER_INDEPENDENT,
+    LF_SAMPLER_HALTON,
+    LF_SAMPLER_PMJ02BN
 } lf_sampler_kind;
+
+typedef enum lf_halton_random {
+    LF_HALTON_PERMUTE_DIGITS, /* pbrt-v4 "permutedigits" (default) */
+    LF_HALTON_OWEN,           /* "owen" */
+    LF_HALTON_NONE            /* "none" */
+} lf_halton_random;
 
 typedef struct lf_sampler {
     lf_sampler_kind kind;
     uint32_t seed;
     int spp;
     int strata_x, strata_y; /* stratified only: strata_x * strata_y == spp */
+    /* halton (lf_sampler_prepare) */
+    lf_halton_random randomize;
+    int halton_scale[2], halton_exp[2]; /* 2^e0 and 3^e1 covering min(resolution, 128) */
+    uint64_t halton_mult_inv[2];
+    /* pmj02bn (lf_sampler_prepare; lf_sampler_free releases them) */
+    float *pmj_sets;        /* LF_PMJ_SETS sequences of pmj_set_len points, x y interleaved */
+    int pmj_set_len;
+    float *pmj_pixel;       /* pmj_tile^2 pixels x spp in-pixel positions */
+    int pmj_tile;
 } lf_sampler;
+
+enum { LF_PMJ_SETS = 5, LF_PMJ_MAX = 65536 };
+
+/* Precomputes what halton and pmj02bn need for a film of xres x yres
+ * (other kinds: nothing).  Returns 0, or -1 when out of memory or spp is
+ * not allowed (pmj02bn: a power of 4 up to 65536). */
+int lf_sampler_prepare(lf_sampler *s, int xres, int yres);
+void lf_sampler_free(lf_sampler *s);
+
+/* pmj02bn: n points (n a power of 2, <= LF_PMJ_MAX) of one progressive
+ * (0,2) sequence generated from seed; xy receives 2n floats.  Every prefix
+ * of 2^k points is a (0,k,2)-net in base 2.  Returns 0, or -1 for a bad n. */
+int lf_pmj02bn_generate(uint32_t seed, int n, float *xy);
 
 /* The state of one pixel sample: cheap to create, no allocation. */
 typedef struct lf_sample_stream {
     const lf_sampler *s;
+    uint64_t halton_index; /* halton: the sample's index in the image-wide sequence */
+    int px, py;            /* pmj02bn: the pixel */
     uint32_t pixel_hash;
     uint32_t index;
     uint32_t rindex; /* index with its bits reversed (the Owen scramble works on it) */

@@ -68,5 +68,6 @@ extern const lf_camera_type lf_camera_thinlens;
 extern const lf_camera_type lf_camera_realistic;
 extern const lf_camera_type lf_camera_lightfield;
 extern const lf_camera_type lf_camera_plenoptic;
+extern const lf_camera_type lf_camera_spherical;
 
 #endif

@@ -14,6 +14,7 @@ static const lf_camera_type *const builtin[] = {
     &lf_camera_realistic,
     &lf_camera_lightfield,
     &lf_camera_plenoptic,
+    &lf_camera_spherical,
 };
 #define N_BUILTIN ((int)(sizeof builtin / sizeof builtin[0]))
 

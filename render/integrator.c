@@ -28,8 +28,7 @@ lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s
     return in->light_sampler;
 }
 
-/* Probability that NEE samples this light at a vertex (1 when all are). */
-static double light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
+double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
 {
     if (s->lights[light].kind == LF_LIGHT_INFINITE_UNIFORM)
         return 0.0; /* never sampled by NEE (lf_scene.nee_lights) */
@@ -55,7 +54,7 @@ static lf_vec3 light_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *b
     if (!lf_light_sample_li(s, l, h->sc.p, h->tau, u0, u1, &ls) || !(ls.pdf > 0) || lf_is_black(ls.Li))
         return lf_v3(0, 0, 0);
     lf_vec3 f = lf_bsdf_f(bsdf, wo, ls.wi);
-    float cosi = lf_absdot(ls.wi, h->sc.ns);
+    float cosi = lf_absdot(ls.wi, bsdf->n); /* the (maybe bumped) shading normal */
     if (lf_is_black(f) || cosi == 0)
         return lf_v3(0, 0, 0);
     lf_vec3 o = lf_offset_origin(h->sc.p, h->sc.ng, ls.wi);
@@ -122,7 +121,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                 if (depth == 0 || specular_bounce) {
                     L = lf_add(L, lf_mul(beta, Le));
                 } else {
-                    float p_l = (float)light_pmf(s, lsm, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
+                    float p_l = (float)lf_light_pmf(s, lsm, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
                     L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
                 }
             }
@@ -136,7 +135,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                 if (depth == 0 || specular_bounce) {
                     L = lf_add(L, lf_mul(beta, Le));
                 } else {
-                    float p_l = (float)light_pmf(s, lsm, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
+                    float p_l = (float)lf_light_pmf(s, lsm, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
                     L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
                 }
             }
@@ -172,7 +171,7 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         struct lf_bsdf_sample bs;
         if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
             break;
-        float cosi = lf_absdot(bs.wi, h.sc.ns);
+        float cosi = lf_absdot(bs.wi, bsdf.n);
         beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
         p_b = bs.pdf;
         specular_bounce = bs.specular;

@@ -48,7 +48,15 @@ typedef struct lf_entity {
 typedef struct lf_camera_desc {
     lf_entity e;                  /* type NULL when the scene has no Camera: perspective defaults */
     lf_anim_xform world_to_camera; /* the CTM when Camera was seen */
+    const char *medium;           /* the exterior medium current at Camera (pbrt-v4's CameraMedium); NULL: none */
 } lf_camera_desc;
+
+/* MakeNamedMedium "name" "string type" ... (params include "type"). */
+typedef struct lf_medium_desc {
+    lf_entity e;                   /* e.type: NULL (the type is the "string type" parameter) */
+    char *name;
+    lf_transform medium_to_world;  /* the CTM at MakeNamedMedium */
+} lf_medium_desc;
 
 typedef struct lf_texture_desc {
     lf_entity e;        /* e.type is the texture class: "checkerboard", "imagemap", "scale", ... */
@@ -76,6 +84,9 @@ typedef struct lf_shape_desc {
     int reverse_orientation;
     int object;                  /* -1, or index of the object (ObjectBegin) it belongs to */
     const char *base_dir;        /* directory of the file that named it, for plymesh paths */
+    /* MediumInterface current at the shape: medium names ("" = vacuum), or
+     * NULL for both when no MediumInterface is in effect. */
+    const char *medium_inside, *medium_outside;
 } lf_shape_desc;
 
 typedef struct lf_object_desc {  /* ObjectBegin "name" ... ObjectEnd */
@@ -101,6 +112,7 @@ typedef struct lf_scene_desc {
     lf_shape_desc *shapes;       size_t n_shapes;
     lf_object_desc *objects;     size_t n_objects;
     lf_instance_desc *instances; size_t n_instances;
+    lf_medium_desc *media;       size_t n_media;              /* MakeNamedMedium, in order */
 
     /* Warnings for unsupported-but-harmless directives, one per line,
      * "file:line:col: warning: ...".  NULL if none. */

@@ -41,6 +41,13 @@ extern "C" {
 typedef struct lf_shading_ctx {
     lf_vec3 p, ng, ns, dpdu;
     lf_vec2 uv;
+    /* For bump mapping only (has_derivs set by the renderer for surfaces
+     * whose material has a "displacement", lf_material_bumps): pbrt-v4's
+     * shading.dpdu and shading.dpdv (not normalised; with shading normals
+     * the tangents re-orthogonalised around ns as pbrt's triangles do) and
+     * the normal's derivatives dndu, dndv. */
+    lf_vec3 sdpdu, sdpdv, dndu, dndv;
+    int has_derivs;
 } lf_shading_ctx;
 
 /* ------------------------------------------------------------------ BSDF */
@@ -169,6 +176,16 @@ int lf_material_is_interface(const lf_material *mat);
  * texture?  If not, the surface's (u,v) is never read and a renderer may
  * skip computing it. */
 int lf_material_uses_textures(const lf_material *mat);
+/* Has the material (or a mix's component) a "displacement"?  Then the
+ * renderer fills the ctx derivatives (has_derivs) at its hits. */
+int lf_material_bumps(const lf_material *mat);
+/* pbrt-v4's BumpMap: the shading normal and tangent of ctx perturbed by the
+ * displacement d: finite differences of d over du = dv = 0.0005 in (u,v)
+ * (pbrt's step when a hit has no uv differentials, as lensfield's have
+ * not), dp/du' = sdpdu + (d(u+du) - d) / du ns + d dndu, likewise for v;
+ * ns' = normalize(dp/du' x dp/dv') on the side of ng.  Writes the bumped
+ * context to out (ns, dpdu changed). */
+/* (lf_bump_shading, below lf_tex_input) */
 /* A "mix" material picks one of its two materials: the second with
  * probability "amount" (pbrt-v4 MixMaterial::ChooseMaterial), using u in
  * [0,1); nested mixes are resolved with u re-stretched.  Any other material
@@ -206,6 +223,7 @@ int lf_tex_input_read(lf_paramset *ps, const char *name, int is_float, lf_spectr
                       const lf_texture_list *texs, lf_tex_input *out, lf_error *err);
 float lf_tex_input_float(const lf_tex_input *in, const lf_shading_ctx *ctx);
 lf_vec3 lf_tex_input_rgb(const lf_tex_input *in, const lf_shading_ctx *ctx);
+void lf_bump_shading(const lf_tex_input *disp, const lf_shading_ctx *ctx, lf_shading_ctx *out);
 
 /* Builds d's texture td (which may use the textures in texs); warnings are
  * appended to *warnings. */

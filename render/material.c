@@ -5,7 +5,8 @@
  * dielectric, thindielectric, diffusetransmission, coateddiffuse,
  * coatedconductor (both approximated: see the comment in bsdf.c), mix, and
  * interface ("", "none").  measured, hair and subsurface are reported as
- * unsupported.  "displacement" and "normalmap" are read and ignored with a
+ * unsupported.  "displacement" bump-maps the shading normal (lf_bump_shading);
+ * "normalmap" is read and ignored with a
  * warning.
  */
 #include "lf_shading.h"
@@ -52,6 +53,8 @@ struct lf_material {
     const lf_material *mix[2];
     int mix_index[2];
     lf_tex_input amount;
+    lf_tex_input displacement; /* bump map (pbrt-v4 "float displacement"), when bump */
+    int bump;
     lf_loc loc;
 };
 
@@ -366,14 +369,12 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
 
     /* Common to every pbrt-v4 material; not supported here. */
     if (m->kind != MAT_INTERFACE && m->kind != MAT_MIX) {
-        const lf_param *dp = lf_params_peek(ps, "displacement");
-        if (dp) {
-            lf_tex_input disp;
-            rc = lf_tex_input_read(ps, "displacement", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs, &disp, err);
+        if (lf_params_peek(ps, "displacement")) {
+            rc = lf_tex_input_read(ps, "displacement", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs,
+                                   &m->displacement, err);
             if (rc)
                 return rc;
-            lf_shading_warn(&ms->warnings, &dp->loc, "%s: \"displacement\" (bump mapping) is not supported; ignored",
-                            m->type);
+            m->bump = 1;
         }
         const lf_param *np = lf_params_peek(ps, "normalmap");
         if (np) {
@@ -530,7 +531,7 @@ int lf_material_uses_textures(const lf_material *mat)
     for (int depth = 0; depth < 64 && mat; depth++) {
         const lf_tex_input *in[] = {&mat->reflectance, &mat->transmittance, &mat->eta_c,   &mat->k_c,
                                     &mat->rough.u,     &mat->rough.v,       &mat->rough_b.u, &mat->rough_b.v,
-                                    &mat->amount};
+                                    &mat->amount,      &mat->displacement};
         for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
             if (in[i]->tex)
                 return 1;
@@ -543,6 +544,50 @@ int lf_material_uses_textures(const lf_material *mat)
     return 0;
 }
 const char *lf_material_type(const lf_material *mat) { return mat->type; }
+
+int lf_material_bumps(const lf_material *mat)
+{
+    for (int depth = 0; depth < 64 && mat; depth++) {
+        if (mat->bump)
+            return 1;
+        if (mat->kind != MAT_MIX)
+            return 0;
+        if (lf_material_bumps(mat->mix[0]))
+            return 1;
+        mat = mat->mix[1];
+    }
+    return 0;
+}
+
+void lf_bump_shading(const lf_tex_input *disp, const lf_shading_ctx *ctx, lf_shading_ctx *out)
+{
+    *out = *ctx;
+    if (!ctx->has_derivs)
+        return;
+    const float du = 0.0005f, dv = 0.0005f;
+    lf_shading_ctx sh = *ctx;
+    sh.p = lf_madd(ctx->p, ctx->sdpdu, du);
+    sh.uv.x = ctx->uv.x + du;
+    float d_u = lf_tex_input_float(disp, &sh);
+    sh.p = lf_madd(ctx->p, ctx->sdpdv, dv);
+    sh.uv.x = ctx->uv.x;
+    sh.uv.y = ctx->uv.y + dv;
+    float d_v = lf_tex_input_float(disp, &sh);
+    float d = lf_tex_input_float(disp, ctx);
+    lf_vec3 dpdu = lf_add(lf_add(ctx->sdpdu, lf_scale(ctx->ns, (d_u - d) / du)), lf_scale(ctx->dndu, d));
+    lf_vec3 dpdv = lf_add(lf_add(ctx->sdpdv, lf_scale(ctx->ns, (d_v - d) / dv)), lf_scale(ctx->dndv, d));
+    lf_vec3 n = lf_cross(dpdu, dpdv);
+    float len2 = lf_dot(n, n);
+    if (!(len2 > 0) || !isfinite(len2))
+        return;
+    n = lf_scale(n, 1.f / sqrtf(len2));
+    if (lf_dot(n, ctx->ng) < 0) /* pbrt: the shading normal follows the geometric one's side */
+        n = lf_neg(n);
+    out->ns = n;
+    float tl = lf_dot(dpdu, dpdu);
+    if (tl > 0 && isfinite(tl))
+        out->dpdu = lf_scale(dpdu, 1.f / sqrtf(tl));
+}
 
 const lf_material *lf_material_resolve(const lf_material *mat, const lf_shading_ctx *ctx, float u)
 {
@@ -593,6 +638,11 @@ void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf
 {
     if (mat->kind == MAT_MIX)
         mat = lf_material_resolve(mat, ctx, hash_position(ctx->p));
+    lf_shading_ctx bumped;
+    if (mat->bump && ctx->has_derivs) {
+        lf_bump_shading(&mat->displacement, ctx, &bumped);
+        ctx = &bumped;
+    }
     lf_bsdf_frame(out, ctx);
     switch (mat->kind) {
     case MAT_INTERFACE:

@@ -9,9 +9,8 @@
  * Where lensfield deliberately differs from pbrt-v4 (all documented at the
  * handler): Include paths are relative to the including file; TransformBegin
  * saves only the CTMs (pbrt-v3 semantics, which is what files that still use
- * it expect); WorldEnd, ColorSpace, Option, MakeNamedMedium and
- * MediumInterface are accepted with a warning; an unclosed AttributeBegin is
- * a warning.
+ * it expect); WorldEnd, ColorSpace and Option are accepted with a warning;
+ * an unclosed AttributeBegin is a warning.
  */
 #include "lf_scene_desc.h"
 
@@ -340,6 +339,7 @@ typedef struct gstate {
     int material;   /* >= 0: index; -1: none; <= -2: NamedMaterial reference -2 - material */
     int area_light; /* index into area_lights, or -1 */
     int reverse_orientation;
+    const char *medium_inside, *medium_outside; /* MediumInterface names (kept strings), NULL: none given */
     lf_paramset attrs[ATTR_COUNT];
 } gstate;
 
@@ -378,7 +378,7 @@ struct parser {
     size_t cap_instance_refs;
 
     size_t cap_strings, cap_textures, cap_materials, cap_lights, cap_area_lights, cap_shapes, cap_objects,
-        cap_instances;
+        cap_instances, cap_media;
     size_t warnings_len, warnings_cap;
     int include_depth;
     int warned_transform_begin;
@@ -1359,6 +1359,7 @@ static int d_option_entity(parser *P, lexer *L, const token *dir)
     *slot = e;
     if (slot == &d->camera.e) {
         d->camera.world_to_camera = current_xform(P);
+        d->camera.medium = P->gs.medium_outside;
         /* pbrt-v4 names the camera-to-world transform "camera". */
         lf_transform inv[2] = {lf_transform_inverse(&P->gs.ctm[0]), lf_transform_inverse(&P->gs.ctm[1])};
         return set_coordsys(P, "camera", inv);
@@ -1606,6 +1607,8 @@ static int d_shape(parser *P, lexer *L, const token *dir)
     s->reverse_orientation = P->gs.reverse_orientation;
     s->object = P->current_object;
     s->base_dir = L->dir;
+    s->medium_inside = P->gs.medium_inside;
+    s->medium_outside = P->gs.medium_outside;
     if (s->object >= 0 && s->area_light >= 0)
         pwarn(P, &dir->loc, "area lights are not supported with object instancing");
     d->n_shapes++;
@@ -1691,35 +1694,73 @@ static int d_object_instance(parser *P, lexer *L, const token *dir)
     return LF_OK;
 }
 
-/* Participating media are not rendered: read the directive, drop it. */
+/* MakeNamedMedium "name" params: kept with the CTM; the scene builder reads
+ * the "string type" and the rest (homogeneous media are rendered, grid
+ * media refused there with this location).  Allowed before WorldBegin too
+ * (a camera may sit in a medium). */
 static int d_make_named_medium(parser *P, lexer *L, const token *dir)
 {
     char *name;
     int rc = expect_string(P, L, dir, "a medium name", &name, NULL);
     if (rc)
         return rc;
-    lf_paramset ps = {0};
-    rc = parse_params(P, L, &ps);
+    lf_scene_desc *d = P->d;
+    if (grow((void **)&d->media, &P->cap_media, d->n_media, sizeof *d->media)) {
+        free(name);
+        return nomem(P);
+    }
+    lf_medium_desc *m = &d->media[d->n_media];
+    memset(m, 0, sizeof *m);
+    rc = parse_params(P, L, &m->e.params);
     if (!rc)
-        pwarn(P, &dir->loc, "MakeNamedMedium \"%s\" ignored: participating media are not supported", name);
-    lf_params_free(&ps);
-    free(name);
-    return rc;
+        rc = merge_attrs(P, &m->e.params, ATTR_MEDIUM); /* Attribute "medium" defaults */
+    if (rc) {
+        lf_params_free(&m->e.params);
+        free(name);
+        return rc;
+    }
+    for (size_t i = 0; i < d->n_media; i++)
+        if (!strcmp(d->media[i].name, name)) {
+            rc = perr(P, LF_ERR_PARSE, &dir->loc, "medium \"%s\" redefined", name);
+            lf_params_free(&m->e.params);
+            free(name);
+            return rc;
+        }
+    m->name = name;
+    m->e.loc = dir->loc;
+    m->medium_to_world = P->gs.ctm[0];
+    d->n_media++;
+    return LF_OK;
 }
 
+/* MediumInterface "inside" ["outside"]: one name sets both (pbrt-v4). The
+ * names are resolved by the scene builder ("" is vacuum). */
 static int d_medium_interface(parser *P, lexer *L, const token *dir)
 {
     char *inside;
     int rc = expect_string(P, L, dir, "an interior medium name", &inside, NULL);
     if (rc)
         return rc;
-    free(inside);
     token t;
-    if ((rc = lex_peek(P, L, &t)))
+    if ((rc = lex_peek(P, L, &t))) {
+        free(inside);
         return rc;
-    if (t.kind == TK_STRING) /* the exterior name is optional */
-        lex_next(P, L, &t);
-    pwarn(P, &dir->loc, "MediumInterface ignored: participating media are not supported");
+    }
+    const char *in = keep_string(P, inside), *out = in;
+    free(inside);
+    if (!in)
+        return nomem(P);
+    if (t.kind == TK_STRING) { /* the exterior name is optional */
+        char *outside;
+        if ((rc = expect_string(P, L, dir, "an exterior medium name", &outside, NULL)))
+            return rc;
+        out = keep_string(P, outside);
+        free(outside);
+        if (!out)
+            return nomem(P);
+    }
+    P->gs.medium_inside = in;
+    P->gs.medium_outside = out;
     return LF_OK;
 }
 
@@ -1966,6 +2007,11 @@ void lf_scene_desc_free(lf_scene_desc *d)
         free(d->objects[i].name);
     free(d->objects);
     free(d->instances);
+    for (size_t i = 0; i < d->n_media; i++) {
+        entity_free(&d->media[i].e);
+        free(d->media[i].name);
+    }
+    free(d->media);
     free(d->warnings);
     for (size_t i = 0; i < d->n_strings; i++)
         free(d->strings[i]);

@@ -30,6 +30,8 @@ typedef struct lf_mesh {
     int material;
     int light_first;   /* index of the first triangle's light, -1 if not emissive */
     int flip_normal;   /* reverse orientation XOR handedness swap */
+    int medium_in, medium_out; /* MediumInterface (lf_scene.media indices, -1 vacuum); LF_MEDIUM_SAME: none */
+    int bump;          /* its material has a displacement: hits carry (u,v) derivatives */
 } lf_mesh;
 
 typedef struct lf_sphere {
@@ -41,7 +43,23 @@ typedef struct lf_sphere {
     int material;
     int light;         /* -1 if not emissive */
     int flip_normal;
+    int medium_in, medium_out; /* as lf_mesh */
+    int bump;                  /* as lf_mesh */
 } lf_sphere;
+
+/* A shape whose MediumInterface does not change the medium (none given,
+ * or the same medium on both sides): rays keep the medium they are in. */
+enum { LF_MEDIUM_SAME = -2 };
+
+/* A homogeneous participating medium (pbrt-v4 "homogeneous"), per RGB
+ * channel, "scale" applied (render/media.c). */
+typedef struct lf_medium {
+    lf_vec3 sigma_a, sigma_s, sigma_t;
+    lf_vec3 Le;          /* emitted radiance, Lescale applied; emission is sigma_a Le per unit length */
+    float g;             /* Henyey-Greenstein asymmetry */
+    int scatters;        /* sigma_s > 0 in some channel */
+    int emits;           /* sigma_a Le > 0 in some channel */
+} lf_medium;
 
 /* Keyframe segment and blend for Embree time tau in [0,1] over n keys. */
 static inline int lf_key_segment(int n_keys, float tau, float *frac)
@@ -186,6 +204,11 @@ typedef struct lf_scene {
     lf_vec3 scene_center;
     long long n_triangles;
     lf_materials *materials;
+    lf_medium *media;        /* MakeNamedMedium "homogeneous" */
+    int n_media;
+    int camera_medium;       /* medium camera rays start in (-1: vacuum) */
+    int has_media;           /* some medium is reachable (the camera or a shape's MediumInterface):
+                                the volumetric integrator runs; otherwise the surface-only one */
     char *warnings;
 } lf_scene;
 
@@ -210,6 +233,7 @@ typedef struct lf_hit {
     int light;         /* -1 if not emissive */
     int sphere;        /* analytic sphere index, or -1; its uv is filled by lf_scene_sphere_uv */
     float tau;         /* Embree time of the ray that found it */
+    int medium_in, medium_out; /* the shape's MediumInterface; medium_in LF_MEDIUM_SAME: no transition */
 } lf_hit;
 
 /* ---- lights (render/lights.c) ---- */
@@ -276,6 +300,7 @@ typedef enum lf_light_sampler {
 enum { LF_LIGHTS_ALL_MAX = 8 };
 
 typedef struct lf_integrator {
+    int volumetric;    /* "volpath" (the default): media are rendered; "path" ignores them (pbrt-v4) */
     int max_depth;
     int regularize;
     lf_light_sampler light_sampler;
@@ -287,5 +312,21 @@ lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s
 /* Radiance along a world-space camera ray. rays counts traced rays. */
 lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
                    long long *rays);
+/* Probability that NEE samples light `light` at a vertex (1 when all are). */
+double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light);
+
+/* ---- participating media (render/media.c) ---- */
+/* Reads the MakeNamedMedium directives into s->media (grid media are
+ * refused with their location). */
+int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err);
+/* Index of a named medium: -1 for NULL or "" (vacuum); an unknown name is
+ * an error naming loc. */
+int lf_media_lookup(const lf_scene_desc *d, const char *name, const lf_loc *loc, const char *what, int *index,
+                    lf_error *err);
+/* Radiance along a camera ray that starts in `medium` (volumetric path
+ * tracing: absorption, emission, single and multiple scattering with the
+ * Henyey-Greenstein phase function, transmittance on shadow rays). */
+lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, int medium,
+                      lf_sample_stream *st, long long *rays);
 
 #endif

@@ -223,15 +223,26 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     where_of(where, sizeof where, &e->loc);
     r->sampler.spp = lf_params_int(ps, "pixelsamples", 16);
     r->sampler.seed = (uint32_t)lf_params_int(ps, "seed", 0);
-    lf_params_string(ps, "randomization", NULL);
-    if (!strcmp(type, "zsobol") || !strcmp(type, "sobol") || !strcmp(type, "paddedsobol") ||
-        !strcmp(type, "pmj02bn") || !strcmp(type, "halton")) {
+    if (!strcmp(type, "halton")) {
+        /* pbrt-v4: "permutedigits" (default), "owen", "none"; "fastowen" is refused there too */
+        const char *rz = lf_params_string(ps, "randomization", "permutedigits");
+        r->sampler.kind = LF_SAMPLER_HALTON;
+        if (!strcmp(rz, "permutedigits"))
+            r->sampler.randomize = LF_HALTON_PERMUTE_DIGITS;
+        else if (!strcmp(rz, "owen"))
+            r->sampler.randomize = LF_HALTON_OWEN;
+        else if (!strcmp(rz, "none"))
+            r->sampler.randomize = LF_HALTON_NONE;
+        else
+            return lf_error_set(err, LF_ERR_PARAM,
+                                "%s: Sampler \"halton\": \"randomization\" must be \"permutedigits\", \"owen\" or "
+                                "\"none\", got \"%s\"",
+                                where, rz);
+    } else if (!strcmp(type, "pmj02bn")) {
+        r->sampler.kind = LF_SAMPLER_PMJ02BN;
+    } else if (!strcmp(type, "zsobol") || !strcmp(type, "sobol") || !strcmp(type, "paddedsobol")) {
+        lf_params_string(ps, "randomization", NULL);
         r->sampler.kind = LF_SAMPLER_SOBOL;
-        if (strcmp(type, "zsobol") && strcmp(type, "sobol") && strcmp(type, "paddedsobol"))
-            lf_warn_append(&r->warnings,
-                           "%s: note: Sampler \"%s\" is not implemented; using \"paddedsobol\" (Owen-scrambled Sobol), "
-                           "the closest",
-                           where, type);
     } else if (!strcmp(type, "stratified")) {
         r->sampler.kind = LF_SAMPLER_STRATIFIED;
         int xs = lf_params_int(ps, "xsamples", 4), ys = lf_params_int(ps, "ysamples", 4);
@@ -261,6 +272,23 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         r->sampler.seed = r->opts.seed;
     if (r->sampler.spp <= 0)
         return lf_error_set(err, LF_ERR_PARAM, "%s: pixelsamples must be positive, got %d", where, r->sampler.spp);
+    if (r->sampler.kind == LF_SAMPLER_PMJ02BN) {
+        /* pbrt-v4 rounds the count up to a power of 4 */
+        int n = 1;
+        while (n < r->sampler.spp && n < LF_PMJ_MAX)
+            n *= 4;
+        if (r->sampler.spp > LF_PMJ_MAX)
+            return lf_error_set(err, LF_ERR_PARAM, "%s: Sampler \"pmj02bn\" takes at most %d samples per pixel, got %d",
+                                where, LF_PMJ_MAX, r->sampler.spp);
+        if (n != r->sampler.spp)
+            lf_warn_append(&r->warnings,
+                           "%s: note: Sampler \"pmj02bn\": %d samples per pixel is not a power of 4; rounded up to %d "
+                           "(as pbrt-v4)",
+                           where, r->sampler.spp, n);
+        r->sampler.spp = n;
+    }
+    if (lf_sampler_prepare(&r->sampler, r->xres, r->yres))
+        return lf_error_set(err, LF_ERR_NOMEM, "%s: cannot prepare Sampler \"%s\" (out of memory)", where, type);
     char ctx[128];
     snprintf(ctx, sizeof ctx, "Sampler \"%s\"", type);
     return lf_params_finish(ps, ctx, err);
@@ -324,6 +352,7 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                        "%s: warning: Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
                        "image",
                        where, type);
+    r->integrator.volumetric = strcmp(type, "path") != 0;
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
     /* pbrt-v4's names; "bvh" (its default) is our automatic choice: every
@@ -557,6 +586,14 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     }
     if (r->scene.warnings)
         lf_warn_append(&r->warnings, "%s", r->scene.warnings);
+    if (r->scene.has_media && !r->integrator.volumetric) {
+        char where[512];
+        where_of(where, sizeof where, &d->integrator.loc);
+        lf_warn_append(&r->warnings,
+                       "%s: warning: Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
+                       "renders them",
+                       where);
+    }
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
             d->accelerator.params.items[i].used = 1; /* Embree builds its own BVH */
@@ -608,6 +645,7 @@ void lf_renderer_free(lf_renderer *r)
         return;
     if (r->camera && r->camera_type)
         r->camera_type->destroy(r->camera);
+    lf_sampler_free(&r->sampler);
     if (r->scene.device || r->scene.meshes || r->scene.materials)
         lf_scene_free(&r->scene);
     if (r->has_curve)
@@ -699,12 +737,26 @@ char *lf_renderer_explain(const lf_renderer *r)
             r->shutter_close - r->shutter_open);
     appendf(&b, &len, &cap, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
             r->sampler.kind == LF_SAMPLER_SOBOL        ? "Owen-scrambled Sobol, padded pairs"
+            : r->sampler.kind == LF_SAMPLER_HALTON
+                ? (r->sampler.randomize == LF_HALTON_OWEN   ? "image-wide Halton, Owen-scrambled digits"
+                   : r->sampler.randomize == LF_HALTON_NONE ? "image-wide Halton, not randomised"
+                                                            : "image-wide Halton, random digit permutations")
+            : r->sampler.kind == LF_SAMPLER_PMJ02BN    ? "progressive multi-jittered (0,2) with blue noise"
             : r->sampler.kind == LF_SAMPLER_STRATIFIED ? "jittered strata"
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
     appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
-    appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette\n",
-            r->integrator_name, r->integrator.max_depth);
+    if (s->has_media && r->integrator.volumetric)
+        appendf(&b, &len, &cap,
+                "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, Russian roulette; %d "
+                "homogeneous media (closed-form transmittance, spectral-MIS distance sampling, Henyey-Greenstein), "
+                "camera in %s\n",
+                r->integrator_name, r->integrator.max_depth, s->n_media,
+                s->camera_medium >= 0 ? "a medium" : "vacuum");
+    else
+        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette%s\n",
+                r->integrator_name, r->integrator.max_depth,
+                s->n_media ? " (media defined but no ray can enter one, or ignored by \"path\")" : "");
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
@@ -797,7 +849,10 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
     double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
     lf_vec3 df = lf_v3((float)(d.x / dl), (float)(d.y / dl), (float)(d.z / dl));
-    lf_vec3 L = lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
+    lf_vec3 L = r->scene.has_media && r->integrator.volumetric
+                    ? lf_volpath_li(&r->scene, &r->integrator, of, df, (float)p->tau, r->scene.camera_medium, &p->st,
+                                    rays)
+                    : lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
     L = lf_scale(L, (float)w * (float)r->imaging_ratio);
     if ((r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) && cr->wavelength_nm > 0)
         L = lf_mul(L, lf_wavelength_rgb_weight(cr->wavelength_nm));

@@ -55,6 +55,22 @@ typedef struct builder {
     int *object_proto; /* per ObjectBegin: its shared lf_proto, -1 none, -2 not built yet */
 } builder;
 
+/* A shape's MediumInterface as medium indices; *in = LF_MEDIUM_SAME when
+ * it changes nothing (none given, or one medium on both sides). */
+static int shape_media(builder *b, const lf_shape_desc *sh, int *in, int *out)
+{
+    *in = *out = LF_MEDIUM_SAME;
+    if (!sh->medium_inside && !sh->medium_outside)
+        return 0;
+    int i, o;
+    if (lf_media_lookup(b->d, sh->medium_inside, &sh->e.loc, "MediumInterface (inside)", &i, b->err) ||
+        lf_media_lookup(b->d, sh->medium_outside, &sh->e.loc, "MediumInterface (outside)", &o, b->err))
+        return b->err->code;
+    if (i != o)
+        *in = i, *out = o;
+    return 0;
+}
+
 static int push_mesh(builder *b, lf_mesh *m)
 {
     if (b->s->n_meshes == b->cap_meshes) {
@@ -224,6 +240,11 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, fl
     m.proto = b->proto;
     m.material = sh->material;
     m.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
+    m.bump = lf_material_bumps(lf_materials_get(b->s->materials, sh->material));
+    if (shape_media(b, sh, &m.medium_in, &m.medium_out)) {
+        free(P), free(N), free(uv), free(idx);
+        return b->err->code;
+    }
     if (b->proto >= 0 && sh->area_light >= 0) { /* never routed here: emitters keep keyframes */
         free(P), free(N), free(uv), free(idx);
         return lf_error_set(b->err, LF_ERR_INTERNAL, "internal: an emissive shape in an instance prototype");
@@ -449,6 +470,11 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
         sp.material = sh->material;
         sp.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
         sp.light = -1;
+        sp.bump = lf_material_bumps(lf_materials_get(b->s->materials, sh->material));
+        if (shape_media(b, sh, &sp.medium_in, &sp.medium_out)) {
+            free(sp.centers);
+            return b->err->code;
+        }
         if (sh->area_light >= 0) {
             area_emission ae;
             if (read_area_light(b, sh->area_light, &ae))
@@ -1105,6 +1131,10 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         b.object_proto[i] = -2;
     if (lf_materials_build(d, &s->materials, err))
         goto fail;
+    if (lf_media_build(d, s, err))
+        goto fail;
+    if (lf_media_lookup(d, d->camera.medium, &d->camera.e.loc, "the camera's medium", &s->camera_medium, err))
+        goto fail;
     if (lf_materials_warnings(s->materials))
         lf_warn_append(&s->warnings, "%s", lf_materials_warnings(s->materials));
     for (size_t i = 0; i < d->n_shapes; i++) {
@@ -1121,6 +1151,12 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     b.object_proto = NULL;
     if (lf_scene_build_lights(d, s, err))
         goto fail;
+    /* Media cost only when a ray can enter one. */
+    s->has_media = s->camera_medium >= 0;
+    for (int i = 0; i < s->n_meshes && !s->has_media; i++)
+        s->has_media = s->meshes[i].medium_in != LF_MEDIUM_SAME;
+    for (int i = 0; i < s->n_spheres && !s->has_media; i++)
+        s->has_media = s->spheres[i].medium_in != LF_MEDIUM_SAME;
 
     /* Embree */
     s->device = rtcNewDevice("verbose=0");
@@ -1307,6 +1343,7 @@ int lf_scene_build_white(lf_scene *s, lf_error *err)
     s->infinite_lights[0] = 0;
     s->n_infinite = 1;
     s->scene_radius = 1;
+    s->camera_medium = -1;
     double one = 1;
     return lf_distrib1d_init(&s->light_distrib, &one, 1, err);
 }
@@ -1344,6 +1381,7 @@ void lf_scene_free(lf_scene *s)
     if (s->n_lights)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);
+    free(s->media);
     free(s->warnings);
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
@@ -1436,6 +1474,60 @@ static inline lf_vec3 instance_normal(const instance_xf *xf, lf_vec3 n)
  * transpose R S^-1, and the geometric normal, a cross product of edges, by
  * cross(M a, M b) = det(M) M^-T cross(a, b) = R (cof(S) cross(a, b)), which
  * keeps pbrt's orientation.  sc->p is then the caller's to set. */
+/* pbrt-v4's triangle derivatives for bump mapping: dp/du, dp/dv from the
+ * (u,v) of the corners (a coordinate system around n when degenerate); with
+ * vertex normals, pbrt's shading tangents ss = (ns x dpdu) x ns... re-built
+ * around the interpolated normal and dn/du, dn/dv from the normals. */
+static void mesh_derivs(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 *nsv, lf_vec3 n, float b0,
+                        float b1, float b2, const instance_xf *xf, lf_shading_ctx *sc)
+{
+    int i0 = m->idx[3 * t], i1 = m->idx[3 * t + 1], i2 = m->idx[3 * t + 2];
+    lf_vec2 uv0 = {0, 0}, uv1 = {1, 0}, uv2 = {1, 1};
+    if (m->uv) {
+        uv0 = (lf_vec2){m->uv[2 * i0], m->uv[2 * i0 + 1]};
+        uv1 = (lf_vec2){m->uv[2 * i1], m->uv[2 * i1 + 1]};
+        uv2 = (lf_vec2){m->uv[2 * i2], m->uv[2 * i2 + 1]};
+    }
+    float du02 = uv0.x - uv2.x, du12 = uv1.x - uv2.x, dv02 = uv0.y - uv2.y, dv12 = uv1.y - uv2.y;
+    float det = du02 * dv12 - dv02 * du12;
+    lf_vec3 dp02 = lf_sub(p[0], p[2]), dp12 = lf_sub(p[1], p[2]);
+    lf_vec3 dpdu, dpdv, dndu = lf_v3(0, 0, 0), dndv = lf_v3(0, 0, 0);
+    int ok = fabsf(det) >= 1e-9f;
+    if (ok) {
+        float inv = 1.f / det;
+        dpdu = lf_scale(lf_sub(lf_scale(dp02, dv12), lf_scale(dp12, dv02)), inv);
+        dpdv = lf_scale(lf_sub(lf_scale(dp12, du02), lf_scale(dp02, du12)), inv);
+        lf_vec3 c = lf_cross(dpdu, dpdv);
+        ok = lf_dot(c, c) > 0 && isfinite(c.x + c.y + c.z);
+        if (ok && xf) {
+            dpdu = rotate(xf->R, lf_mul(dpdu, xf->scale));
+            dpdv = rotate(xf->R, lf_mul(dpdv, xf->scale));
+        }
+        if (ok && nsv) {
+            lf_vec3 dn1 = lf_sub(nsv[0], nsv[2]), dn2 = lf_sub(nsv[1], nsv[2]);
+            dndu = lf_scale(lf_sub(lf_scale(dn1, dv12), lf_scale(dn2, dv02)), inv);
+            dndv = lf_scale(lf_sub(lf_scale(dn2, du02), lf_scale(dn1, du12)), inv);
+        }
+    }
+    if (!ok)
+        lf_basis(n, &dpdu, &dpdv);
+    if (nsv) {
+        lf_vec3 ns = lf_normalize(lf_add(lf_add(lf_scale(nsv[0], b0), lf_scale(nsv[1], b1)), lf_scale(nsv[2], b2)));
+        lf_vec3 ts = lf_cross(ns, dpdu);
+        if (lf_dot(ts, ts) > 0) {
+            dpdu = lf_cross(ts, ns);
+            dpdv = ts;
+        } else {
+            lf_basis(ns, &dpdu, &dpdv);
+        }
+    }
+    sc->sdpdu = dpdu;
+    sc->sdpdv = dpdv;
+    sc->dndu = dndu;
+    sc->dndv = dndv;
+    sc->has_derivs = 1;
+}
+
 static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 *nsv, float b1, float b2, int flip,
                      const instance_xf *xf, lf_hit *hit)
 {
@@ -1475,6 +1567,9 @@ static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 
         }
     }
     sc->dpdu = lf_normalize(dpdu);
+    sc->has_derivs = 0;
+    if (m->bump)
+        mesh_derivs(m, t, p, nsv, n, b0, b1, b2, xf, sc);
     if (nsv) {
         lf_vec3 ns = lf_add(lf_add(lf_scale(nsv[0], b0), lf_scale(nsv[1], b1)), lf_scale(nsv[2], b2));
         if (xf && xf->uniform_scale) /* the vertex normals' lengths all scale alike: blend, then transform */
@@ -1494,6 +1589,8 @@ static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 
     sc->ng = n;
     hit->material = m->material;
     hit->light = m->light_first >= 0 ? m->light_first + t : -1;
+    hit->medium_in = m->medium_in;
+    hit->medium_out = m->medium_out;
 }
 
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit)
@@ -1530,11 +1627,29 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
             dpdu_o = lf_v3(1, 0, 0);
         sc->dpdu = lf_normalize(lf_xform_vector(&sp->object_to_world, dpdu_o));
         sc->p = p;
+        sc->has_derivs = 0;
+        if (sp->bump) {
+            /* pbrt-v4's full sphere: u = phi / 2pi, v from the bottom pole,
+             * dp/du = 2pi (-y, x, 0), dp/dv = -pi (z cos phi, z sin phi,
+             * -r sin theta) in object space; dn = dp / r (Weingarten). */
+            float rho = sqrtf(q.x * q.x + q.y * q.y), r_o = lf_length(q);
+            float cp = rho > 0 ? q.x / rho : 1.f, spn = rho > 0 ? q.y / rho : 0.f;
+            lf_vec3 du_o = lf_v3(-2 * (float)LF_PI * q.y, 2 * (float)LF_PI * q.x, 0);
+            lf_vec3 dv_o = lf_scale(lf_v3(q.z * cp, q.z * spn, -rho), -(float)LF_PI);
+            sc->sdpdu = lf_xform_vector(&sp->object_to_world, du_o);
+            sc->sdpdv = lf_xform_vector(&sp->object_to_world, dv_o);
+            float inv_r = r_o > 0 ? 1.f / r_o : 0.f;
+            sc->dndu = lf_scale(sc->sdpdu, inv_r * r_o / sp->radius);
+            sc->dndv = lf_scale(sc->sdpdv, inv_r * r_o / sp->radius);
+            sc->has_derivs = 1;
+        }
         if (sp->flip_normal)
             n = lf_neg(n);
         sc->ng = sc->ns = n;
         hit->material = sp->material;
         hit->light = sp->light;
+        hit->medium_in = sp->medium_in;
+        hit->medium_out = sp->medium_out;
         return 1;
     }
     hit->sphere = -1;

@@ -191,6 +191,139 @@ static void test_distrib(void)
     lf_distrib2d_free(&d2);
 }
 
+/* Exactly one point in each box [i/bx^a, (i+1)/bx^a) x [j/by^b, ...).
+ * Radical inverses land exactly on box edges (1/3 is point 1's y), which
+ * the 32-bit values of lf_sample_2d_d truncate to up to 2^-32 below: the
+ * box index is taken 1e-9 up, far less than the smallest digit (5^-9) of
+ * the indices used here. */
+static int stratified_boxes(const double *x, const double *y, int n, int nx, int ny)
+{
+    if (nx * ny != n)
+        return 0;
+    int *count = calloc((size_t)n, sizeof(int));
+    int ok = 1;
+    for (int i = 0; i < n; i++) {
+        int cx = (int)((x[i] + 1e-9) * nx), cy = (int)((y[i] + 1e-9) * ny);
+        if (cx < 0 || cx >= nx || cy < 0 || cy >= ny || count[cy * nx + cx]++)
+            ok = 0;
+    }
+    free(count);
+    return ok;
+}
+
+/* pbrt-v4's Halton sampler: inside a pixel, the first 2^a 3^b samples
+ * stratify the pixel in 2^a x 3^b boxes (radical-inverse intervals of the
+ * digits below the pixel's); dimensions 2 and 3 (bases 5 and 7) stratify
+ * 5^a x 7^b boxes with every randomisation (digit permutations and Owen
+ * scrambling keep each digit position a bijection). */
+static void test_halton(void)
+{
+    static const lf_halton_random rz[3] = {LF_HALTON_PERMUTE_DIGITS, LF_HALTON_OWEN, LF_HALTON_NONE};
+    static const int res[][2] = {{640, 480}, {37, 23}, {1, 1}, {300, 2}};
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 4; k++) {
+            lf_sampler s = {LF_SAMPLER_HALTON, 9, 216, 0, 0};
+            s.randomize = rz[r];
+            CHECK(lf_sampler_prepare(&s, res[k][0], res[k][1]) == 0);
+            static const int pix[][2] = {{0, 0}, {5, 3}, {130, 7}, {639, 479}};
+            for (int q = 0; q < 4; q++) {
+                int px = pix[q][0] % res[k][0], py = pix[q][1] % res[k][1];
+                double x[245], y[245], u[245], v[245]; /* 245 = 5 x 49 */
+                for (int i = 0; i < 245; i++) {
+                    lf_sample_stream st;
+                    lf_sample_start(&st, &s, px, py, (uint32_t)i);
+                    lf_sample_2d_d(&st, &x[i], &y[i]);
+                    lf_sample_2d_d(&st, &u[i], &v[i]);
+                }
+                CHECK_MSG(stratified_boxes(x, y, 6, 2, 3) && stratified_boxes(x, y, 36, 4, 9) &&
+                              stratified_boxes(x, y, 216, 8, 27),
+                          "halton pixel samples, randomization %d, res %dx%d, pixel %d %d", r, res[k][0], res[k][1],
+                          px, py);
+                CHECK_MSG(stratified_boxes(u, v, 35, 5, 7) && stratified_boxes(u, v, 175, 25, 7) &&
+                              stratified_boxes(u, v, 245, 5, 49),
+                          "halton dimensions 2,3, randomization %d, res %dx%d", r, res[k][0], res[k][1]);
+            }
+            /* the unrandomised sequence is the textbook Halton: pixel (0,0)'s
+             * first sample is index 0 and dimension 2 is 0 */
+            if (rz[r] == LF_HALTON_NONE) {
+                lf_sample_stream st;
+                lf_sample_start(&st, &s, 0, 0, 1);
+                double a, b;
+                lf_sample_2d_d(&st, &a, &b);
+                float c, d;
+                lf_sample_2d(&st, &c, &d);
+                /* index stride = 2^e0 3^e1; dimension 2 = radical inverse base 5 of it */
+                uint64_t stride = (uint64_t)s.halton_scale[0] * s.halton_scale[1];
+                double ri5 = 0, f = 0.2;
+                for (uint64_t t = stride; t; t /= 5, f /= 5)
+                    ri5 += (double)(t % 5) * f;
+                CHECK_NEAR(c, ri5, 1e-6);
+            }
+            lf_sampler_free(&s);
+        }
+    /* different pixels get different samples */
+    lf_sampler s = {LF_SAMPLER_HALTON, 1, 4, 0, 0};
+    CHECK(lf_sampler_prepare(&s, 64, 64) == 0);
+    lf_sample_stream a, b;
+    lf_sample_start(&a, &s, 3, 4, 0);
+    lf_sample_start(&b, &s, 4, 3, 0);
+    CHECK(a.halton_index != b.halton_index);
+}
+
+/* pmj02bn: every power-of-two prefix of a generated sequence is a
+ * (0,k,2)-net; the in-pixel samples (a tile of pixels shares one sequence)
+ * form a (0,2)-net in every pixel; the other pairs are a shuffle of the
+ * first spp points of a sequence, toroidally shifted (so each pixel's spp
+ * values still have one point per 1/spp column and per 1/spp row). */
+static void test_pmj02bn(void)
+{
+    int n = 1 << 14;
+    float *xy = malloc(sizeof(float) * 2 * (size_t)n);
+    float *x = malloc(sizeof(float) * (size_t)n), *y = malloc(sizeof(float) * (size_t)n);
+    CHECK(lf_pmj02bn_generate(3, n, xy) == 0);
+    for (int i = 0; i < n; i++)
+        x[i] = xy[2 * i], y[i] = xy[2 * i + 1];
+    for (int m = 0; m <= 14; m++)
+        CHECK_MSG(is_02_net(x, y, m), "pmj02 prefix of 2^%d points is not a (0,%d,2)-net", m, m);
+    CHECK(lf_pmj02bn_generate(3, 3, xy) != 0);
+    free(xy), free(x), free(y);
+
+    static const int spps[] = {1, 4, 16, 64};
+    for (int k = 0; k < 4; k++) {
+        lf_sampler s = {LF_SAMPLER_PMJ02BN, 5, spps[k], 0, 0};
+        CHECK(lf_sampler_prepare(&s, 200, 100) == 0);
+        int spp = spps[k], m = 0;
+        while ((1 << m) < spp)
+            m++;
+        float px[64], py[64], ux[64], uy[64];
+        int bad = 0, badcols = 0;
+        for (int p = 0; p < 50; p++) {
+            for (int i = 0; i < spp; i++) {
+                lf_sample_stream st;
+                lf_sample_start(&st, &s, 3 * p + 1, 7 * p + 2, (uint32_t)i);
+                double a, b;
+                lf_sample_2d_d(&st, &a, &b);
+                px[i] = (float)a, py[i] = (float)b;
+                lf_sample_2d(&st, &ux[i], &uy[i]);
+            }
+            bad += !is_02_net(px, py, m);
+            /* shifted (0,2) points: one per column and per row, cyclically */
+            int cols[64] = {0}, rows[64] = {0};
+            for (int i = 0; i < spp; i++) {
+                cols[(int)(ux[i] * spp) % spp]++;
+                rows[(int)(uy[i] * spp) % spp]++;
+            }
+            for (int i = 0; i < spp; i++)
+                badcols += cols[i] > 2 || rows[i] > 2; /* a shift can split one stratum's point pair */
+        }
+        CHECK_MSG(bad == 0, "pmj02bn spp %d: %d pixels whose samples are not a (0,2)-net", spp, bad);
+        CHECK_MSG(badcols == 0, "pmj02bn spp %d: shifted pairs pile up", spp);
+        lf_sampler_free(&s);
+    }
+    lf_sampler s = {LF_SAMPLER_PMJ02BN, 5, 8, 0, 0};
+    CHECK(lf_sampler_prepare(&s, 10, 10) != 0); /* not a power of 4 */
+}
+
 int main(void)
 {
     test_sobol_stratification();
@@ -199,5 +332,7 @@ int main(void)
     test_determinism();
     test_filters();
     test_distrib();
+    test_halton();
+    test_pmj02bn();
     return lf_test_end();
 }

@@ -51,6 +51,8 @@ static const char *g_string(void *c, const char *name, const char *def)
     (void)c;
     if (!strcmp(name, "lensfile") && !strcmp(current_camera, "realistic"))
         return "lenses/dgauss.50mm.dat";
+    if (!strcmp(name, "mapping") && !strcmp(current_camera, "spherical"))
+        return "equirectangular"; /* equal area needs a square image (tests/test_camera_spherical.c) */
     if (!strcmp(name, "aperture") && current_aperture)
         return current_aperture;
     return def;

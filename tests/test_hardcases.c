@@ -291,8 +291,10 @@ static void test_every_camera_defaults(void)
         const lf_camera_type *t = lf_camera_at(i);
         for (int k = 0; k < 4; k++) {
             store s = {{{0}}, 0};
-            /* defaults must work at an ordinary size; odd sizes may be refused with a message */
-            run_case(t, &s, sizes[k][0], sizes[k][1], k == 0);
+            /* defaults must work at an ordinary size; odd sizes may be refused with a message
+             * (the spherical camera's default equal-area mapping needs a square image) */
+            int sq = k == 0 && !strcmp(t->name, "spherical");
+            run_case(t, &s, sizes[k][0], sq ? sizes[k][0] : sizes[k][1], k == 0);
         }
     }
 }
@@ -310,6 +312,17 @@ static void test_projective(void)
                     store s = {{KV1("fov", fovs[a]), KV1("lensradius", radii[b]), KV1("focaldistance", focus[c])}, 3};
                     run_case(t, &s, 37, 23, 1);
                 }
+    t = lf_camera_find("spherical");
+    if (t) {
+        static const int dims[][2] = {{37, 23}, {1, 1}, {2000, 3}, {3, 2000}};
+        for (int k = 0; k < 4; k++) {
+            store s = {{KVS("mapping", "equirectangular")}, 1};
+            run_case(t, &s, dims[k][0], dims[k][1], 1);
+        }
+        store s = {{KVS("mapping", "equalarea")}, 1};
+        run_case(t, &s, 1, 1, 1);
+        run_case(t, &s, 2000, 2000, 1);
+    }
     t = lf_camera_find("orthographic");
     if (t) {
         static const double win[] = {1e-6, 1, 1e6};

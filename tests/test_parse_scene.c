@@ -315,7 +315,7 @@ static void test_lights_options(void)
                  "LightSource \"point\" \"blackbody I\" 3000\nAttributeEnd\n"
                  "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3]\n"
                  "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n"
-                 "MediumInterface \"fog\"\nWorldEnd\n",
+                 "MediumInterface \"fog\"\nShape \"sphere\"\nWorldEnd\n",
                  &d)) {
         CHECK(strcmp(d.film.type, "rgb") == 0 && lf_params_int(&d.film.params, "xresolution", 0) == 320);
         CHECK(strcmp(d.sampler.type, "halton") == 0 && lf_params_int(&d.sampler.params, "pixelsamples", 0) == 16);
@@ -331,9 +331,31 @@ static void test_lights_options(void)
         const char *w = d.warnings ? d.warnings : "";
         CHECK_MSG(strstr(w, "test.pbrt:6:1: warning: ColorSpace \"srgb\" ignored"), "%s", w);
         CHECK_MSG(strstr(w, "test.pbrt:7:1: warning: Option \"disablepixeljitter\" ignored"), "%s", w);
-        CHECK_MSG(strstr(w, "test.pbrt:15:1: warning: MakeNamedMedium \"fog\" ignored"), "%s", w);
-        CHECK_MSG(strstr(w, "test.pbrt:16:1: warning: MediumInterface ignored"), "%s", w);
-        CHECK_MSG(strstr(w, "test.pbrt:18:1: warning: WorldEnd"), "%s", w);
+        /* media are kept: MediumInterface with one name sets both sides */
+        CHECK(d.n_media == 1 && !strcmp(d.media[0].name, "fog") && d.media[0].e.loc.line == 15);
+        CHECK(!strcmp(lf_params_string(&d.media[0].e.params, "type", ""), "homogeneous"));
+        CHECK(d.n_shapes == 1 && d.shapes[0].medium_inside && !strcmp(d.shapes[0].medium_inside, "fog") &&
+              !strcmp(d.shapes[0].medium_outside, "fog"));
+        CHECK(d.camera.medium == NULL);
+        CHECK_MSG(strstr(w, "test.pbrt:19:1: warning: WorldEnd"), "%s", w);
+        lf_scene_desc_free(&d);
+    }
+    /* Attribute "medium" gives MakeNamedMedium defaults; a MediumInterface
+     * before Camera is the camera's medium (its exterior name) */
+    if (parse_ok("MakeNamedMedium \"air\" \"string type\" \"homogeneous\"\n"
+                 "MediumInterface \"\" \"air\"\nCamera \"perspective\"\nWorldBegin\n"
+                 "AttributeBegin\nAttribute \"medium\" \"float g\" 0.3\n"
+                 "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"air\"\n"
+                 "Shape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n",
+                 &d)) {
+        CHECK(d.camera.medium && !strcmp(d.camera.medium, "air"));
+        CHECK(d.n_media == 2 && lf_params_float(&d.media[1].e.params, "g", 0) == 0.3);
+        CHECK(lf_params_float(&d.media[0].e.params, "g", 0) == 0);
+        CHECK(d.n_shapes == 2 && !strcmp(d.shapes[0].medium_inside, "fog") &&
+              !strcmp(d.shapes[0].medium_outside, "air"));
+        /* AttributeEnd restores the interface in effect before (camera's) */
+        CHECK(d.shapes[1].medium_inside && !strcmp(d.shapes[1].medium_inside, "") &&
+              !strcmp(d.shapes[1].medium_outside, "air"));
         lf_scene_desc_free(&d);
     }
 }

@@ -867,6 +867,198 @@ static int compare(compare_job *j, submission *s, lf_error *err)
     return 0;
 }
 
+/* ---------- focus of a refocused plenoptic image, region by region ---------- */
+
+typedef struct focus_subject {
+    char name[64];
+    double depth;
+    int x0, y0, x1, y1;
+} focus_subject;
+
+/* subjects='near card@0.3:7,27,28,57;...' (view pixels, x1 y1 exclusive) */
+static int parse_subjects(const char *spec, focus_subject *sj, int max, char *why, size_t wn)
+{
+    int n = 0;
+    const char *p = spec;
+    while (*p && n < max) {
+        const char *end = strchr(p, ';');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char item[200];
+        if (len >= sizeof item) {
+            snprintf(why, wn, "grader: subject too long in '%s'", spec);
+            return -1;
+        }
+        memcpy(item, p, len), item[len] = 0;
+        char *at = strchr(item, '@');
+        focus_subject *f = &sj[n];
+        if (!at || sscanf(at + 1, "%lf:%d,%d,%d,%d", &f->depth, &f->x0, &f->y0, &f->x1, &f->y1) != 5 ||
+            !(f->depth > 0) || f->x1 <= f->x0 + 2 || f->y1 <= f->y0 + 2) {
+            snprintf(why, wn, "grader: subject '%s': expected NAME@DEPTH:X0,Y0,X1,Y1", item);
+            return -1;
+        }
+        *at = 0;
+        snprintf(f->name, sizeof f->name, "%.63s", item);
+        n++;
+        p += len;
+        if (*p == ';')
+            p++;
+    }
+    if (n == 0)
+        snprintf(why, wn, "grader: no subjects in '%s'", spec);
+    return n ? n : -1;
+}
+
+static double depth_of_disparity(const lf_lightfield *lf, double d)
+{
+    double den = d - lf->disp_at_inf;
+    return lf->disp_per_inv_m != 0 && den * lf->disp_per_inv_m > 0 ? lf->disp_per_inv_m / den : INFINITY;
+}
+
+/* kind focus (docs/grading.md): the submitted image must be the reference
+ * plenoptic capture refocused at `depth`: the subject at that depth as sharp
+ * as in the reference refocused there (>= min_sharpness of it), the others
+ * no sharper than max_sharpness of theirs (a full aperture), the brightness
+ * within max_brightness.  Failing, the reason gives the measurements and the
+ * depth the image looks focused at (the refocus sweep of the reference whose
+ * per-region sharpness matches best). */
+static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r, lf_error *err)
+{
+    focus_subject sj[8];
+    char why[700];
+    int ns = parse_subjects(lf_grade_check_get(c, "subjects", ""), sj, 8, why, sizeof why);
+    if (ns < 0)
+        return lf_error_set(err, LF_ERR_PARSE, "check %s: %s", c->id, why);
+    double want = atof(lf_grade_check_get(c, "depth", "0"));
+    double min_sharp = atof(lf_grade_check_get(c, "min_sharpness", "0.6"));
+    double max_sharp = atof(lf_grade_check_get(c, "max_sharpness", "1.8"));
+    double max_bright = atof(lf_grade_check_get(c, "max_brightness", "1.2"));
+    double focus_tol = atof(lf_grade_check_get(c, "focus_tol", "0.1")); /* px/view */
+    int spp = atoi(lf_grade_check_get(c, "spp", "8"));
+    uint32_t seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
+    const lf_image *raw;
+    const lf_attrs *meta;
+    if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
+        return lf_error_set(err, err->code, "check %s: reference light field: %s", c->id, err->msg);
+    lf_lf_layout file, flags, lay;
+    lf_lf_layout_init(&flags);
+    lf_lightfield lf;
+    memset(&lf, 0, sizeof lf);
+    lf_error e = {0};
+    if (lf_lf_layout_from_attrs(meta, &file, &e) ||
+        lf_lf_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) || lf_lf_decode(raw, &lay, NULL, &lf, &e)) {
+        lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: reference light field: %s", c->id, e.msg);
+    }
+    double d_want = 0;
+    if (lf_lf_depth_to_disparity(&lf, want, &d_want, &e)) {
+        lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: depth=%g: %s", c->id, want, e.msg);
+    }
+    int target = 0;
+    for (int k = 1; k < ns; k++)
+        if (fabs(sj[k].depth - want) < fabs(sj[target].depth - want))
+            target = k;
+    sub_image *im = get_image(s, lf_grade_check_get(c, "image", c->id), lf.ns, lf.nt, why, sizeof why);
+    if (!im) {
+        fail(r, "%s", why);
+        lf_lf_free(&lf);
+        return 0;
+    }
+    int eight_bit = !strcmp(im->format, "png");
+    /* the reference refocused as asked, and a sweep over the subjects' disparities */
+    double dmin = d_want, dmax = d_want;
+    for (int k = 0; k < ns; k++) {
+        double d;
+        if (!lf_lf_depth_to_disparity(&lf, sj[k].depth, &d, &e))
+            dmin = fmin(dmin, d), dmax = fmax(dmax, d);
+    }
+    dmin -= 0.5, dmax += 0.5;
+    enum { NSWEEP = 41 };
+    double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0};
+    lf_image ref = {0};
+    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+    ro.threads = g->threads > 0 ? g->threads : 2;
+    ro.disparity_px = d_want;
+    int rc = lf_lf_refocus(&lf, &ro, &ref, &e);
+    for (int q = 0; !rc && q <= NSWEEP; q++) {
+        lf_image sw = {0};
+        /* the sweep, plus exactly zero (the unrefocused image) as the last step */
+        ro.disparity_px = q < NSWEEP ? dmin + (dmax - dmin) * q / (NSWEEP - 1) : 0.0;
+        if ((rc = lf_lf_refocus(&lf, &ro, &sw, &e)))
+            break;
+        if (eight_bit)
+            lf_grade_quantize8(&sw);
+        double sum = 0, v[8];
+        for (int k = 0; k < ns; k++) {
+            v[k] = lf_grade_sharpness(&sw, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+            double a = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+            double l = log((a + 1e-9) / (v[k] + 1e-9));
+            sum += l * l;
+        }
+        if (sum < best_err - 1e-12)
+            best_err = sum, best_d = ro.disparity_px, memcpy(best_sweep, v, sizeof v);
+        lf_image_free(&sw);
+    }
+    if (rc) {
+        lf_image_free(&ref), lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
+    }
+    if (eight_bit)
+        lf_grade_quantize8(&ref);
+    for (int k = 0; k < ns; k++) {
+        ref_sharp[k] = lf_grade_sharpness(&ref, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+        sub_sharp[k] = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+    }
+    lf_image_psnr(&im->img, &ref, &r->psnr_db, NULL);
+    r->ssim = lf_grade_ssim(&im->img, &ref);
+    double bright = lf_grade_mean(&im->img) / fmax(lf_grade_mean(&ref), 1e-12);
+    double z_est = depth_of_disparity(&lf, best_d);
+    char looks[300], ztxt[48];
+    if (isinf(z_est))
+        snprintf(ztxt, sizeof ztxt, "beyond infinity");
+    else
+        snprintf(ztxt, sizeof ztxt, "%.3g m", z_est);
+    snprintf(looks, sizeof looks, "the image looks focused at %s (disparity %.2f px/view%s; asked: %g m, %.2f px/view)",
+             ztxt, best_d, fabs(best_d) < 1e-9 ? ": not refocused, the plain average of the views" : "", want, d_want);
+    /* the measurements, for the report */
+    char meas[600];
+    int n = snprintf(meas, sizeof meas, "sharpness against the reference:");
+    for (int k = 0; k < ns && n < (int)sizeof meas; k++)
+        n += snprintf(meas + n, sizeof meas - (size_t)n, "%s %s %.2fx", k ? "," : "", sj[k].name,
+                      sub_sharp[k] / fmax(ref_sharp[k], 1e-12));
+    if (n < (int)sizeof meas)
+        snprintf(meas + n, sizeof meas - (size_t)n, "; brightness %.2fx", bright);
+    r->noise_ratio = NAN;
+    r->variant_ratio = sub_sharp[target] / fmax(ref_sharp[target], 1e-12);
+    snprintf(r->best_variant, sizeof r->best_variant, "focus %.3g m", z_est);
+    double ratio_t = r->variant_ratio;
+    /* how far the best full-aperture refocus is from the submission, region by region */
+    int worst = 0;
+    double worst_ratio = 1;
+    for (int k = 0; k < ns; k++) {
+        double q = (sub_sharp[k] + 1e-9) / (best_sweep[k] + 1e-9);
+        if (q > worst_ratio)
+            worst_ratio = q, worst = k;
+    }
+    if (worst_ratio > max_sharp) {
+        fail(r, "%s: the %s at %g m is %.2fx sharper than any full-aperture refocus leaves it (the closest, focused at "
+                "%s, pass <= %.2fx): more depth of field than asked (a smaller --aperture or a single view?); %s",
+             im->file, sj[worst].name, sj[worst].depth, worst_ratio, ztxt, max_sharp, meas);
+    } else if (ratio_t < min_sharp) {
+        fail(r, "%s: the %s at %g m is not in focus: sharpness %.2fx the reference (pass >= %.2fx); %s; %s", im->file,
+             sj[target].name, sj[target].depth, ratio_t, min_sharp, looks, meas);
+    } else if (fabs(best_d - d_want) > focus_tol) {
+        fail(r, "%s: focused near but not at the %s: %s; the focus is off by %+.2f px/view (pass within %.2f), %+.0f%% "
+                "in depth; %s",
+             im->file, sj[target].name, looks, best_d - d_want, focus_tol, 100.0 * (z_est / want - 1.0), meas);
+    } else if (!(bright <= max_bright && bright >= 1 / max_bright)) {
+        fail(r, "%s: brightness %.2fx the reference (pass within %.2fx); %s", im->file, bright, max_bright, meas);
+    }
+    snprintf(r->measurements, sizeof r->measurements, "%s; %s", meas, looks);
+    lf_image_free(&ref), lf_lf_free(&lf);
+    return 0;
+}
+
 /* ---------- checks ---------- */
 
 static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r,
@@ -967,6 +1159,8 @@ static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
                  v, have ? "" : ", the default", gt ? ">" : "<", gt ? gt : lt);
         return 0;
     }
+    if (!strcmp(c->kind, "focus"))
+        return run_focus(g, c, s, r, err);
     if (!strcmp(c->kind, "render")) {
         j.make = make_render;
         return compare(&j, s, err);

@@ -233,3 +233,46 @@ int lf_grade_post(const char *op, lf_image *img, lf_error *err)
     }
     return lf_error_set(err, LF_ERR_PARAM, "unknown post-processing op '%s'", op);
 }
+
+/* Contrast energy of a region: mean over pixels of the squared differences
+ * of Rec. 709 luminance to the right and lower neighbours, over the squared
+ * mean luminance (scale-free, so an exposure change does not move it).
+ * Defocus blur lowers it; noise raises it a little. */
+double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1)
+{
+    if (x0 < 0)
+        x0 = 0;
+    if (y0 < 0)
+        y0 = 0;
+    if (x1 > im->width)
+        x1 = im->width;
+    if (y1 > im->height)
+        y1 = im->height;
+    double e = 0, m = 0;
+    long n = 0;
+    int c = im->channels;
+    for (int y = y0; y < y1 - 1; y++)
+        for (int x = x0; x < x1 - 1; x++) {
+            const float *p = lf_image_px(im, x, y), *r = lf_image_px(im, x + 1, y), *d = lf_image_px(im, x, y + 1);
+            double l = c >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+            double lr = c >= 3 ? 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2] : r[0];
+            double ld = c >= 3 ? 0.2126 * d[0] + 0.7152 * d[1] + 0.0722 * d[2] : d[0];
+            e += (l - lr) * (l - lr) + (l - ld) * (l - ld);
+            m += l;
+            n++;
+        }
+    if (n == 0 || !(m > 0))
+        return 0;
+    m /= (double)n;
+    return e / (double)n / (m * m);
+}
+
+/* Mean of all channels (brightness ratios). */
+double lf_grade_mean(const lf_image *im)
+{
+    double s = 0;
+    size_t n = (size_t)im->width * im->height * im->channels;
+    for (size_t i = 0; i < n; i++)
+        s += isfinite(im->data[i]) ? im->data[i] : 0;
+    return n ? s / (double)n : 0;
+}

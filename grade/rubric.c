@@ -87,7 +87,7 @@ void lf_grade_free_argv(char **argv, int argc)
     free(argv);
 }
 
-static const char *kinds[] = {"files", "sections", "size", "render", "synth", "refocus", "constraint", "answer"};
+static const char *kinds[] = {"files", "sections", "size", "render", "synth", "refocus", "constraint", "answer", "focus"};
 
 const char *lf_grade_check_get(const lf_grade_check *c, const char *key, const char *def)
 {

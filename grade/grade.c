@@ -974,7 +974,8 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     }
     dmin -= 0.5, dmax += 0.5;
     enum { NSWEEP = 41 };
-    double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0};
+    double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0}, errs[NSWEEP + 1];
+    int best_q = -1;
     lf_image ref = {0};
     lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
     ro.threads = g->threads > 0 ? g->threads : 2;
@@ -995,13 +996,23 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
             double l = log((a + 1e-9) / (v[k] + 1e-9));
             sum += l * l;
         }
+        errs[q] = sum;
         if (sum < best_err - 1e-12)
-            best_err = sum, best_d = ro.disparity_px, memcpy(best_sweep, v, sizeof v);
+            best_err = sum, best_d = ro.disparity_px, best_q = q, memcpy(best_sweep, v, sizeof v);
         lf_image_free(&sw);
     }
     if (rc) {
         lf_image_free(&ref), lf_lf_free(&lf);
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
+    }
+    /* between sweep steps: the vertex of the parabola through the best and its neighbours */
+    if (best_q > 0 && best_q < NSWEEP - 1 && fabs(best_d) > 1e-12) {
+        double em = errs[best_q - 1], e0 = errs[best_q], ep = errs[best_q + 1], den = em - 2 * e0 + ep;
+        if (den > 0) {
+            double t = 0.5 * (em - ep) / den;
+            if (t > -1 && t < 1)
+                best_d += t * (dmax - dmin) / (NSWEEP - 1);
+        }
     }
     if (eight_bit)
         lf_grade_quantize8(&ref);

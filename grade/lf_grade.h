@@ -111,6 +111,13 @@ double lf_grade_ssim(const lf_image *a, const lf_image *b);
 double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1);
 /* Mean over all pixels and channels. */
 double lf_grade_mean(const lf_image *im);
+/* Measurements for explaining a wrong image in physical terms:
+ * content magnification (> 1: the submission sees a wider field, tan of the
+ * half angle times it), extra disc blur in pixels (> 0 blurrier, < 0
+ * sharper), and the equivalent diameter of n highlights (bokeh discs). */
+double lf_grade_fit_scale(const lf_image *S, const lf_image *A);
+double lf_grade_fit_blur(const lf_image *S, const lf_image *A);
+double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n);
 
 /* Submission.md commands as data: splits a line into words (quotes group,
  * nothing is expanded).  Fails (-1, reason in why) on shell syntax. */

@@ -138,7 +138,8 @@ static void thinlens(void)
     render_to(flat, NULL, 0, 16, NULL, m, "flatfield.exr");
     write_text(m, "Submission.md", md_ok);
     if (!grade(g, m, &r)) {
-        EXPECT_FAIL(r, "bokeh", "focus distance off by +5%");
+        EXPECT_FAIL(r, "bokeh", "focus distance off by +");
+        EXPECT_FAIL(r, "bokeh", "the lens focused at 0.26");
         EXPECT_PASS(r, "flatfield");
         CHECK(r.score == 15);
         lf_grade_result_free(&r);
@@ -448,7 +449,8 @@ static void lightfield(void)
     student_synth(ok, "lightfield.exr", 0.1, "../l-fov/novel.png");
     write_text(m, "Submission.md", md);
     if (!grade(g, m, &r)) {
-        EXPECT_FAIL(r, "lightfield", "field of view off by +2 degrees");
+        EXPECT_FAIL(r, "lightfield", "field of view off by +");
+        EXPECT_FAIL(r, "lightfield", "matches fov 3");
         lf_grade_result_free(&r);
     }
     /* lens radius 0 where blur is required (declared and used) */

@@ -990,6 +990,21 @@ static int compare(compare_job *j, submission *s, lf_error *err)
         }
     }
     int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
+    /* an 8-bit image clipped at white over much of its area: any larger
+     * exposure explains the clipped part, so no search is named */
+    double clipped = 0;
+    if (eight_bit) {
+        size_t np = (size_t)im->img.width * im->img.height, nc = 0;
+        for (size_t i = 0; i < np; i++) {
+            const float *px = im->img.data + i * (size_t)im->img.channels;
+            int all = 1;
+            for (int ch = 0; ch < im->img.channels && ch < 3; ch++)
+                all &= px[ch] >= 0.999f;
+            nc += (size_t)all;
+        }
+        clipped = np ? (double)nc / (double)np : 0;
+    }
+    int clip_blind = clipped > 0.2;
     for (int k = 0; k < j->c->nvariants && !gerr && j->make == make_render; k++) {
         const lf_grade_variant *v = &j->c->variants[k];
         if (!v->search)
@@ -1067,7 +1082,7 @@ static int compare(compare_job *j, submission *s, lf_error *err)
             if (nfound >= sizeof found)
                 nfound = sizeof found - 1;
         }
-        if (!fixed_ok && rfull < r->variant_ratio) {
+        if (!fixed_ok && !clip_blind && rfull < r->variant_ratio) {
             r->variant_ratio = rfull, best = v;
             search_text(v, v->reason, exp(lbest), best_reason, sizeof best_reason);
         }
@@ -1077,6 +1092,13 @@ static int compare(compare_job *j, submission *s, lf_error *err)
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
     }
     measure(j, &im->img, &a, r->measurements, sizeof r->measurements);
+    if (clip_blind) {
+        size_t l = strlen(r->measurements);
+        snprintf(r->measurements + l, sizeof r->measurements - l,
+                 "; %.0f%% of the pixels clipped at white (over-exposed: brightness and exposure cannot be measured "
+                 "there)",
+                 100 * clipped);
+    }
     if (found[0]) {
         size_t l = strlen(r->measurements);
         snprintf(r->measurements + l, sizeof r->measurements - l, "%s", found);

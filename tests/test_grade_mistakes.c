@@ -2,7 +2,8 @@
  * image (issue 17): every listed mistake as a mutant submission for each
  * assignment, with the reason and the measured value asserted, and
  * submissions no single mistake explains reported as "unrecognised" with
- * their measurements.
+ * their measurements.  Also: every assignment's scenes/ folder copied
+ * elsewhere still renders (issue 17: a copied assignment scene works).
  *
  * Each mutant is the assignment's scene with one physical change, rendered
  * at the check's sample count with another seed (77), as a student's
@@ -116,6 +117,46 @@ int main(void)
     if (!mkdtemp(tmp)) {
         perror("mkdtemp");
         return 1;
+    }
+    /* a copied assignment scene still works: every scenes/ folder copied
+     * elsewhere renders (no path leads back into the repository), and a
+     * scene copied without its lens file names the path it looked for */
+    {
+        const char *as[] = {"1-thinlens", "2-realistic", "3-motion", "4-lightfield"};
+        for (size_t k = 0; k < 4; k++) {
+            char cmd[800];
+            snprintf(cmd, sizeof cmd, "mkdir -p %s/copy-%s && cp -r assignments/%s/scenes/. %s/copy-%s/", tmp, as[k],
+                     as[k], tmp, as[k]);
+            CHECK(system(cmd) == 0);
+        }
+        const char *scenes[] = {"1-thinlens/bokeh.pbrt",   "1-thinlens/flatfield.pbrt", "2-realistic/dgauss.pbrt",
+                                "2-realistic/fisheye.pbrt", "3-motion/blur.pbrt",        "3-motion/rolling.pbrt",
+                                "4-lightfield/lightfield.pbrt", "4-lightfield/plenoptic.pbrt"};
+        for (size_t k = 0; k < sizeof scenes / sizeof *scenes; k++) {
+            char path[600];
+            snprintf(path, sizeof path, "%s/copy-%s", tmp, scenes[k]);
+            lf_image img;
+            lf_attrs meta = {0};
+            lf_error err = {0};
+            int rc = lf_grade_render(path, NULL, 0, 1, 1, 2, &img, &meta, &err);
+            CHECK_MSG(rc == 0, "copied %s: %s", path, err.msg);
+            if (!rc)
+                lf_image_free(&img), lf_attrs_free(&meta);
+        }
+        char lone[600], cmd[1400];
+        snprintf(lone, sizeof lone, "%s/lone", tmp);
+        snprintf(cmd, sizeof cmd, "mkdir -p %s && cp assignments/2-realistic/scenes/dgauss.pbrt %s/", lone, lone);
+        CHECK(system(cmd) == 0);
+        snprintf(lone, sizeof lone, "%s/lone/dgauss.pbrt", tmp);
+        lf_image img;
+        lf_attrs meta = {0};
+        lf_error err = {0};
+        char want[600];
+        snprintf(want, sizeof want, "%s/lone/dgauss.50mm.dat", tmp);
+        int rc = lf_grade_render(lone, NULL, 0, 1, 1, 2, &img, &meta, &err);
+        CHECK_MSG(rc != 0 && strstr(err.msg, want), "a lone copy: %s (want the path %s)", err.msg, want);
+        if (!rc)
+            lf_image_free(&img), lf_attrs_free(&meta);
     }
     char cache[300];
     snprintf(cache, sizeof cache, "%s/cache", tmp);

@@ -24,8 +24,8 @@ render 4-lightfield/scenes/lightfield.pbrt "$W/4/lightfield.exr"
 render 4-lightfield/scenes/plenoptic.pbrt "$W/4/plenoptic.exr"
 SYN="--camerapos 0.03 0.05 0 --lensradius 0.1 --focaldistance 2.5 --samplesperpixel 64 --outputdim 96 72 --outputfov 30"
 "$B/lftool" synth "$W/4/lightfield.exr" "$W/4/novel.png" $SYN > /dev/null
-"$B/lftool" refocus "$W/4/plenoptic.exr" --depth 1.5 -o "$W/4/refocused.png" > /dev/null
-printf '## Answers\nx\n## Commands\nlftool synth lightfield.exr novel.png %s\nlftool refocus plenoptic.exr --depth 1.5 -o refocused.png\n' "$SYN" > "$W/4/Submission.md"
+"$B/lftool" refocus "$W/4/plenoptic.exr" --depth 0.3 -o "$W/4/refocused.png" > /dev/null
+printf '## Answers\nx\n## Commands\nlftool synth lightfield.exr novel.png %s\nlftool refocus plenoptic.exr --depth 0.3 -o refocused.png\n' "$SYN" > "$W/4/Submission.md"
 printf '%-14s %10s %12s %14s %8s\n' assignment "cold (s)" "warm med (s)" "in-process (s)" score
 i=0
 for a in 1-thinlens 2-realistic 3-motion 4-lightfield; do

@@ -663,6 +663,30 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
            c->mla_sensor * 1e3, c->sensor_offset * 1e3, c->sensor_offset == 0.0 ? ": plenoptic 1.0" : ": focused plenoptic 2.0");
     LF_CAM_APPEND("sub-aperture views: %d x %d pixels, %.4g x %.4g views\n", c->nx, c->ny, c->image_pitch_px,
            c->image_pitch_px);
+    {
+        /* Ng 2005's range of exact refocusing (docs/lightfield.md, "Refocusable
+         * range"): a sub-aperture view sees the aperture through a slice D/P
+         * wide, so a point imaged at alpha z_i blurs on the MLA by
+         * |1 - 1/alpha| D / P; it stays within one microlens (one view pixel)
+         * while |1 - 1/alpha| <= P p / D.  In disparity: |d| <= 1 px/view. */
+        double b = c->image_pitch_px * c->pitch / D, zo = c->focus_distance;
+        double inv_near = (isinf(zo) ? 0.0 : 1.0 / zo) + b / zi, inv_far = (isinf(zo) ? 0.0 : 1.0 / zo) - b / zi;
+        char far[64];
+        if (inv_far > 0.0)
+            snprintf(far, sizeof far, "%.4g m", 1.0 / inv_far);
+        else
+            snprintf(far, sizeof far, "infinity");
+        char amax[64];
+        if (b < 1.0)
+            snprintf(amax, sizeof amax, "%.6g", 1.0 / (1.0 - b));
+        else
+            snprintf(amax, sizeof amax, "infinity");
+        LF_CAM_APPEND("refocusable range (Ng 2005, |1 - 1/alpha| <= P p / D = %.4g; disparity within +-1 px/view): "
+               "alpha %.6g .. %s, depths %.4g m .. %s; each sub-aperture view has the depth of field of f/%.3g "
+               "(f/N x %.4g views)%s\n",
+               b, 1.0 / (1.0 + b), amax, 1.0 / inv_near, far, c->fstop * c->image_pitch_px, c->image_pitch_px,
+               c->sensor_offset != 0.0 ? " [plenoptic 1.0 formula; this is a focused 2.0 design]" : "");
+    }
     LF_CAM_APPEND("pixel values are exposure: (1/d^2) int L cos^4 dA over the microlenses x shutter x ISO/100\n");
     return n;
 }

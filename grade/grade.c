@@ -782,6 +782,149 @@ static void write_png(const char *dir, const char *id, const char *what, const l
     lf_image_write(path, img, NULL, NULL, &e);
 }
 
+/* A search variant at one value: its with= texts with {v} / {v*K} replaced. */
+static int instantiate(const lf_grade_variant *v, double value, lf_grade_variant *out)
+{
+    *out = *v;
+    out->search = 0;
+    for (int e = 0; e < v->nedits; e++) {
+        const char *t = v->replace[e];
+        size_t cap = strlen(t) + 256, n = 0;
+        char *o = malloc(cap);
+        if (!o) {
+            for (int q = 0; q < e; q++)
+                free(out->replace[q]);
+            return -1;
+        }
+        while (*t && n + 64 < cap) {
+            if (t[0] == '{' && t[1] == 'v') {
+                const char *end = strchr(t, '}');
+                double k = 1;
+                if (end && t[2] == '*')
+                    k = atof(t + 3);
+                if (end) {
+                    n += (size_t)snprintf(o + n, cap - n, "%.6g", value * k);
+                    t = end + 1;
+                    continue;
+                }
+            }
+            o[n++] = *t++;
+        }
+        o[n] = 0;
+        out->replace[e] = o;
+    }
+    return 0;
+}
+
+static void free_instance(lf_grade_variant *v)
+{
+    for (int e = 0; e < v->nedits; e++)
+        free(v->replace[e]);
+}
+
+/* {pct} {value} {base} {K/value} {value*K} in a search variant's texts */
+static void search_text(const lf_grade_variant *v, const char *text, double factor, char *out, size_t n)
+{
+    size_t k = 0;
+    double value = v->base * factor;
+    for (const char *t = text; *t && k + 40 < n;) {
+        const char *end = t[0] == '{' ? strchr(t, '}') : NULL;
+        double K;
+        if (!end) {
+            out[k++] = *t++;
+            continue;
+        }
+        if (!strncmp(t, "{pct}", 5))
+            k += (size_t)snprintf(out + k, n - k, "%+.0f%%", 100 * (factor - 1));
+        else if (!strncmp(t, "{value}", 7))
+            k += (size_t)snprintf(out + k, n - k, "%.4g", value);
+        else if (!strncmp(t, "{base}", 6))
+            k += (size_t)snprintf(out + k, n - k, "%.4g", v->base);
+        else if (!strncmp(t, "{value*", 7))
+            k += (size_t)snprintf(out + k, n - k, "%.3g", value * atof(t + 7));
+        else if (sscanf(t + 1, "%lf/value}", &K) == 1 && strstr(t, "/value}") == strchr(t, '/'))
+            k += (size_t)snprintf(out + k, n - k, "%.3g", K / value);
+        else if (sscanf(t + 1, "%lf/base}", &K) == 1 && strstr(t, "/base}") == strchr(t, '/'))
+            k += (size_t)snprintf(out + k, n - k, "%.3g", K / v->base);
+        else {
+            out[k++] = *t++;
+            continue;
+        }
+        t = end + 1;
+    }
+    out[k < n ? k : n - 1] = 0;
+}
+
+/* ratio of the submission against variant v (two seeds); < 0 grader error */
+static double variant_ratio(compare_job *j, const lf_grade_variant *v, const lf_image *x, int eight_bit,
+                            const lf_image *a, char *why, size_t wn, int *grader_err)
+{
+    lf_image va = {0}, vb = {0};
+    int rc = j->make(j, v, 0, &va, why, wn);
+    if (!rc)
+        rc = j->make(j, v, 1, &vb, why, wn);
+    double r = INFINITY;
+    if (rc == -2)
+        *grader_err = 1;
+    else if (!rc && va.width == a->width && va.height == a->height && vb.width == a->width && vb.height == a->height) {
+        if (eight_bit)
+            lf_grade_quantize8(&va), lf_grade_quantize8(&vb);
+        r = lf_grade_noise_ratio(x, &va, &va, &vb);
+    }
+    lf_image_free(&va), lf_image_free(&vb);
+    return r;
+}
+
+/* Physical measurements of x against the correct reference a: brightness,
+ * field of view, blur (docs/grading.md, "Measurements"). */
+static void appendf(char *out, size_t n, size_t *k, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static void appendf(char *out, size_t n, size_t *k, const char *fmt, ...)
+{
+    if (*k + 1 >= n)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int w = vsnprintf(out + *k, n - *k, fmt, ap);
+    va_end(ap);
+    if (w > 0)
+        *k = *k + (size_t)w < n ? *k + (size_t)w : n - 1;
+}
+
+static void measure(const compare_job *j, const lf_image *x, const lf_image *a, char *out, size_t n)
+{
+    const lf_grade_check *c = j->c;
+    size_t k = 0;
+    double bright = lf_grade_mean(x) / fmax(lf_grade_mean(a), 1e-12);
+    appendf(out, n, &k, "brightness %.2fx the reference", bright);
+    double m = lf_grade_fit_scale(x, a);
+    double hfov = atof(lf_grade_check_get(c, "hfov", "0"));
+    if (!strcmp(lf_grade_check_get(c, "fov_fit", "1"), "0"))
+        ; /* tiled light fields: no single image centre */
+    else if (fabs(m - 1) < 0.01)
+        appendf(out, n, &k, "; field of view as expected (no change of magnification explains the difference)");
+    else if (hfov > 0)
+        appendf(out, n, &k, "; field of view %.1f deg across, expected %.1f (content %.3fx the size)",
+                              2 * atan(m * tan(hfov * M_PI / 360)) * 180 / M_PI, hfov, 1 / m);
+    else
+        appendf(out, n, &k, "; field of view %+.1f%% (tan of the half angle; content %.3fx the size)",
+                              100 * (m - 1), 1 / m);
+    const char *hl = lf_grade_check_get(c, "highlights", NULL);
+    int x0, y0, x1, y1, cnt;
+    if (hl && sscanf(hl, "%d,%d,%d,%d:%d", &x0, &y0, &x1, &y1, &cnt) == 5) {
+        double ds = lf_grade_highlight_diameter(x, x0, y0, x1, y1, cnt), da = lf_grade_highlight_diameter(a, x0, y0, x1, y1, cnt);
+        const char *expect = lf_grade_check_get(c, "blur_px", NULL);
+        appendf(out, n, &k, "; blur circle of the highlights %.1f px across, expected %.1f (reference %.1f)", ds,
+                              expect ? atof(expect) : da, da);
+    } else if (strcmp(lf_grade_check_get(c, "blur", "1"), "0")) {
+        double b = lf_grade_fit_blur(x, a);
+        if (b > 0)
+            appendf(out, n, &k, "; blurrier: like the reference through a %.1f px blur disc", b);
+        else if (b < 0)
+            appendf(out, n, &k, "; sharper: the reference looks like it through a %.1f px blur disc", -b);
+    }
+    (void)k;
+}
+
 /* Returns 0, or -2 on a grader-side failure (err filled). */
 static int compare(compare_job *j, submission *s, lf_error *err)
 {
@@ -825,45 +968,356 @@ static int compare(compare_job *j, submission *s, lf_error *err)
         lf_image_free(&a), lf_image_free(&b);
         return 0;
     }
-    /* which known mistake does it look like? */
+    /* which known mistake accounts for it?  Fixed variants first; then
+     * searches (a scene value scaled over a range: any focus error, any
+     * aperture, sensor size or shutter), each located on a grid at 1/8 of
+     * the sample count (the bias dominates away from the best value), then
+     * refined by a parabola and verified at the full count. */
     r->variant_ratio = INFINITY;
     const lf_grade_variant *best = NULL;
-    for (int k = 0; k < j->c->nvariants; k++) {
-        /* each variant with its own two seeds: its noise can differ (a pinhole is noisier) */
-        lf_image va = {0}, vb = {0};
-        rc = j->make(j, &j->c->variants[k], 0, &va, why, sizeof why);
-        if (!rc)
-            rc = j->make(j, &j->c->variants[k], 1, &vb, why, sizeof why);
-        if (rc == -2) {
-            lf_image_free(&va), lf_image_free(&vb);
-            lf_image_free(&a), lf_image_free(&b);
-            return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
+    char best_reason[600] = "", found[700] = "";
+    size_t nfound = 0;
+    int gerr = 0;
+    double fixed_ratio = INFINITY;
+    for (int k = 0; k < j->c->nvariants && !gerr; k++) {
+        const lf_grade_variant *v = &j->c->variants[k];
+        if (!v->search) {
+            /* each variant with its own two seeds: its noise can differ (a pinhole is noisier) */
+            double rv = variant_ratio(j, v, &im->img, eight_bit, &a, why, sizeof why, &gerr);
+            if (rv < r->variant_ratio)
+                r->variant_ratio = rv, best = v, snprintf(best_reason, sizeof best_reason, "%s", v->reason);
+            fixed_ratio = fmin(fixed_ratio, rv);
         }
-        if (rc || va.width != a.width || va.height != a.height || vb.width != a.width || vb.height != a.height) {
-            lf_image_free(&va), lf_image_free(&vb);
+    }
+    int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
+    /* an 8-bit image clipped at white over much of its area: any larger
+     * exposure explains the clipped part, so no search is named */
+    double clipped = 0;
+    if (eight_bit) {
+        size_t np = (size_t)im->img.width * im->img.height, nc = 0;
+        for (size_t i = 0; i < np; i++) {
+            const float *px = im->img.data + i * (size_t)im->img.channels;
+            int all = 1;
+            for (int ch = 0; ch < im->img.channels && ch < 3; ch++)
+                all &= px[ch] >= 0.999f;
+            nc += (size_t)all;
+        }
+        clipped = np ? (double)nc / (double)np : 0;
+    }
+    int clip_blind = clipped > 0.2;
+    for (int k = 0; k < j->c->nvariants && !gerr && j->make == make_render; k++) {
+        const lf_grade_variant *v = &j->c->variants[k];
+        if (!v->search)
             continue;
+        enum { MAXS = 25 };
+        double lf0 = log(v->lo), lf1 = log(v->hi);
+        int ns = (int)ceil((lf1 - lf0) / 0.04) + 1;
+        ns = ns > MAXS ? MAXS : ns < 3 ? 3 : ns;
+        double rr[MAXS], ll[MAXS], bestr = INFINITY;
+        int bi = -1, full_spp = j->spp;
+        j->spp = getenv("LF_GRADE_FULLSEARCH") ? full_spp : full_spp / 8 > 4 ? full_spp / 8 : 4 < full_spp ? 4 : full_spp;
+        for (int q = 0; q < ns && !gerr; q++) {
+            ll[q] = lf0 + (lf1 - lf0) * q / (ns - 1);
+            rr[q] = INFINITY;
+            if (fabs(ll[q]) < 0.005)
+                continue;
+            lf_grade_variant inst;
+            if (instantiate(v, v->base * exp(ll[q]), &inst))
+                continue;
+            rr[q] = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
+            if (getenv("LF_GRADE_DEBUG"))
+                fprintf(stderr, "search %s %s factor %.4f [%s]: %.3f\n", j->c->id, v->name, exp(ll[q]), inst.replace[0], rr[q]);
+            free_instance(&inst);
+            if (rr[q] < bestr)
+                bestr = rr[q], bi = q;
         }
-        if (eight_bit)
-            lf_grade_quantize8(&va), lf_grade_quantize8(&vb);
-        double rv = lf_grade_noise_ratio(&im->img, &va, &va, &vb);
-        if (rv < r->variant_ratio)
-            r->variant_ratio = rv, best = &j->c->variants[k];
-        lf_image_free(&va), lf_image_free(&vb);
+        j->spp = full_spp;
+        if (bi < 0 || gerr)
+            continue;
+        double lbest = ll[bi];
+        if (bi > 0 && bi < ns - 1 && isfinite(rr[bi - 1]) && isfinite(rr[bi + 1])) {
+            double den = rr[bi - 1] - 2 * rr[bi] + rr[bi + 1];
+            if (den > 0) {
+                double t = 0.5 * (rr[bi - 1] - rr[bi + 1]) / den;
+                if (t > -1 && t < 1)
+                    lbest += t * (ll[1] - ll[0]);
+            }
+        }
+        if (fabs(lbest) < 0.005)
+            lbest = ll[bi];
+        /* at the full sample count: lbest and half a step either side, then the parabola's vertex */
+        double h = 0.5 * (ll[1] - ll[0]), rl[3], rfull = INFINITY;
+        for (int q = 0; q < 3 && !gerr; q++) {
+            lf_grade_variant inst;
+            rl[q] = INFINITY;
+            if (fabs(lbest + (q - 1) * h) >= 0.005 && !instantiate(v, v->base * exp(lbest + (q - 1) * h), &inst)) {
+                rl[q] = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
+                free_instance(&inst);
+            }
+        }
+        double lfine = lbest;
+        rfull = rl[1];
+        if (rl[0] < rfull)
+            rfull = rl[0], lfine = lbest - h;
+        if (rl[2] < rfull)
+            rfull = rl[2], lfine = lbest + h;
+        double den = rl[0] - 2 * rl[1] + rl[2];
+        if (isfinite(den) && den > 0) {
+            double t = 0.5 * (rl[0] - rl[2]) / den;
+            if (t > -1 && t < 1 && fabs(lbest + t * h) >= 0.005) {
+                lf_grade_variant inst;
+                if (!gerr && !instantiate(v, v->base * exp(lbest + t * h), &inst)) {
+                    double r2 = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
+                    free_instance(&inst);
+                    if (r2 <= rfull * 1.1) /* the vertex: the estimate, unless clearly worse */
+                        rfull = fmin(r2, rfull), lfine = lbest + t * h;
+                }
+            }
+        }
+        lbest = lfine;
+        if (v->measure[0] && nfound + 8 < sizeof found) {
+            char m[400];
+            search_text(v, v->measure, exp(lbest), m, sizeof m);
+            nfound += (size_t)snprintf(found + nfound, sizeof found - nfound, "; %s (%.1fx)", m, rfull);
+            if (nfound >= sizeof found)
+                nfound = sizeof found - 1;
+        }
+        if (!fixed_ok && !clip_blind && rfull < r->variant_ratio) {
+            r->variant_ratio = rfull, best = v;
+            search_text(v, v->reason, exp(lbest), best_reason, sizeof best_reason);
+        }
+    }
+    if (gerr) {
+        lf_image_free(&a), lf_image_free(&b);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
+    }
+    measure(j, &im->img, &a, r->measurements, sizeof r->measurements);
+    if (clip_blind) {
+        size_t l = strlen(r->measurements);
+        snprintf(r->measurements + l, sizeof r->measurements - l,
+                 "; %.0f%% of the pixels clipped at white (over-exposed: brightness and exposure cannot be measured "
+                 "there)",
+                 100 * clipped);
+    }
+    if (found[0]) {
+        size_t l = strlen(r->measurements);
+        snprintf(r->measurements + l, sizeof r->measurements - l, "%s", found);
     }
     if (best)
         snprintf(r->best_variant, sizeof r->best_variant, "%s", best->name);
     if (best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio)
         fail(r, "%s: %s (matches the reference for that mistake at %.2fx the Monte Carlo noise level; the correct "
-                "reference: %.1fx, pass <= %.1fx)",
-             im->file, best->reason, r->variant_ratio, r->noise_ratio, max_ratio);
-    else if (best)
-        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx); no known "
-                "mistake matches (closest: %s, %.1fx)",
-             im->file, r->noise_ratio, j->spp, max_ratio, best->name, r->variant_ratio);
+                "reference: %.1fx, pass <= %.1fx); measured: %s",
+             im->file, best_reason, r->variant_ratio, r->noise_ratio, max_ratio, r->measurements);
     else
-        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx)", im->file,
-             r->noise_ratio, j->spp, max_ratio);
+        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx); "
+                "unrecognised mistake, measured: %s%s",
+             im->file, r->noise_ratio, j->spp, max_ratio, r->measurements,
+             best ? " (no known mistake accounts for it)" : "");
     lf_image_free(&a), lf_image_free(&b);
+    return 0;
+}
+
+/* ---------- focus of a refocused plenoptic image, region by region ---------- */
+
+typedef struct focus_subject {
+    char name[64];
+    double depth;
+    int x0, y0, x1, y1;
+} focus_subject;
+
+/* subjects='near card@0.3:7,27,28,57;...' (view pixels, x1 y1 exclusive) */
+static int parse_subjects(const char *spec, focus_subject *sj, int max, char *why, size_t wn)
+{
+    int n = 0;
+    const char *p = spec;
+    while (*p && n < max) {
+        const char *end = strchr(p, ';');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char item[200];
+        if (len >= sizeof item) {
+            snprintf(why, wn, "grader: subject too long in '%s'", spec);
+            return -1;
+        }
+        memcpy(item, p, len), item[len] = 0;
+        char *at = strchr(item, '@');
+        focus_subject *f = &sj[n];
+        if (!at || sscanf(at + 1, "%lf:%d,%d,%d,%d", &f->depth, &f->x0, &f->y0, &f->x1, &f->y1) != 5 ||
+            !(f->depth > 0) || f->x1 <= f->x0 + 2 || f->y1 <= f->y0 + 2) {
+            snprintf(why, wn, "grader: subject '%s': expected NAME@DEPTH:X0,Y0,X1,Y1", item);
+            return -1;
+        }
+        *at = 0;
+        snprintf(f->name, sizeof f->name, "%.63s", item);
+        n++;
+        p += len;
+        if (*p == ';')
+            p++;
+    }
+    if (n == 0)
+        snprintf(why, wn, "grader: no subjects in '%s'", spec);
+    return n ? n : -1;
+}
+
+static double depth_of_disparity(const lf_lightfield *lf, double d)
+{
+    double den = d - lf->disp_at_inf;
+    return lf->disp_per_inv_m != 0 && den * lf->disp_per_inv_m > 0 ? lf->disp_per_inv_m / den : INFINITY;
+}
+
+/* kind focus (docs/grading.md): the submitted image must be the reference
+ * plenoptic capture refocused at `depth`: the subject at that depth as sharp
+ * as in the reference refocused there (>= min_sharpness of it), the others
+ * no sharper than max_sharpness of theirs (a full aperture), the brightness
+ * within max_brightness.  Failing, the reason gives the measurements and the
+ * depth the image looks focused at (the refocus sweep of the reference whose
+ * per-region sharpness matches best). */
+static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r, lf_error *err)
+{
+    focus_subject sj[8];
+    char why[700];
+    int ns = parse_subjects(lf_grade_check_get(c, "subjects", ""), sj, 8, why, sizeof why);
+    if (ns < 0)
+        return lf_error_set(err, LF_ERR_PARSE, "check %s: %s", c->id, why);
+    double want = atof(lf_grade_check_get(c, "depth", "0"));
+    double min_sharp = atof(lf_grade_check_get(c, "min_sharpness", "0.6"));
+    double max_sharp = atof(lf_grade_check_get(c, "max_sharpness", "1.8"));
+    double max_bright = atof(lf_grade_check_get(c, "max_brightness", "1.2"));
+    double focus_tol = atof(lf_grade_check_get(c, "focus_tol", "0.1")); /* px/view */
+    int spp = atoi(lf_grade_check_get(c, "spp", "8"));
+    uint32_t seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
+    const lf_image *raw;
+    const lf_attrs *meta;
+    if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
+        return lf_error_set(err, err->code, "check %s: reference light field: %s", c->id, err->msg);
+    lf_lf_layout file, flags, lay;
+    lf_lf_layout_init(&flags);
+    lf_lightfield lf;
+    memset(&lf, 0, sizeof lf);
+    lf_error e = {0};
+    if (lf_lf_layout_from_attrs(meta, &file, &e) ||
+        lf_lf_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) || lf_lf_decode(raw, &lay, NULL, &lf, &e)) {
+        lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: reference light field: %s", c->id, e.msg);
+    }
+    double d_want = 0;
+    if (lf_lf_depth_to_disparity(&lf, want, &d_want, &e)) {
+        lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: depth=%g: %s", c->id, want, e.msg);
+    }
+    int target = 0;
+    for (int k = 1; k < ns; k++)
+        if (fabs(sj[k].depth - want) < fabs(sj[target].depth - want))
+            target = k;
+    sub_image *im = get_image(s, lf_grade_check_get(c, "image", c->id), lf.ns, lf.nt, why, sizeof why);
+    if (!im) {
+        fail(r, "%s", why);
+        lf_lf_free(&lf);
+        return 0;
+    }
+    int eight_bit = !strcmp(im->format, "png");
+    /* the reference refocused as asked, and a sweep over the subjects' disparities */
+    double dmin = d_want, dmax = d_want;
+    for (int k = 0; k < ns; k++) {
+        double d;
+        if (!lf_lf_depth_to_disparity(&lf, sj[k].depth, &d, &e))
+            dmin = fmin(dmin, d), dmax = fmax(dmax, d);
+    }
+    dmin -= 0.5, dmax += 0.5;
+    enum { NSWEEP = 41 };
+    double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0}, errs[NSWEEP + 1];
+    int best_q = -1;
+    lf_image ref = {0};
+    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+    ro.threads = g->threads > 0 ? g->threads : 2;
+    ro.disparity_px = d_want;
+    int rc = lf_lf_refocus(&lf, &ro, &ref, &e);
+    for (int q = 0; !rc && q <= NSWEEP; q++) {
+        lf_image sw = {0};
+        /* the sweep, plus exactly zero (the unrefocused image) as the last step */
+        ro.disparity_px = q < NSWEEP ? dmin + (dmax - dmin) * q / (NSWEEP - 1) : 0.0;
+        if ((rc = lf_lf_refocus(&lf, &ro, &sw, &e)))
+            break;
+        if (eight_bit)
+            lf_grade_quantize8(&sw);
+        double sum = 0, v[8];
+        for (int k = 0; k < ns; k++) {
+            v[k] = lf_grade_sharpness(&sw, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+            double a = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+            double l = log((a + 1e-9) / (v[k] + 1e-9));
+            sum += l * l;
+        }
+        errs[q] = sum;
+        if (sum < best_err - 1e-12)
+            best_err = sum, best_d = ro.disparity_px, best_q = q, memcpy(best_sweep, v, sizeof v);
+        lf_image_free(&sw);
+    }
+    if (rc) {
+        lf_image_free(&ref), lf_lf_free(&lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
+    }
+    /* between sweep steps: the vertex of the parabola through the best and its neighbours */
+    if (best_q > 0 && best_q < NSWEEP - 1 && fabs(best_d) > 1e-12) {
+        double em = errs[best_q - 1], e0 = errs[best_q], ep = errs[best_q + 1], den = em - 2 * e0 + ep;
+        if (den > 0) {
+            double t = 0.5 * (em - ep) / den;
+            if (t > -1 && t < 1)
+                best_d += t * (dmax - dmin) / (NSWEEP - 1);
+        }
+    }
+    if (eight_bit)
+        lf_grade_quantize8(&ref);
+    for (int k = 0; k < ns; k++) {
+        ref_sharp[k] = lf_grade_sharpness(&ref, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+        sub_sharp[k] = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+    }
+    lf_image_psnr(&im->img, &ref, &r->psnr_db, NULL);
+    r->ssim = lf_grade_ssim(&im->img, &ref);
+    double bright = lf_grade_mean(&im->img) / fmax(lf_grade_mean(&ref), 1e-12);
+    double z_est = depth_of_disparity(&lf, best_d);
+    char looks[300], ztxt[48];
+    if (isinf(z_est))
+        snprintf(ztxt, sizeof ztxt, "beyond infinity");
+    else
+        snprintf(ztxt, sizeof ztxt, "%.3g m", z_est);
+    snprintf(looks, sizeof looks, "the image looks focused at %s (disparity %.2f px/view%s; asked: %g m, %.2f px/view)",
+             ztxt, best_d, fabs(best_d) < 1e-9 ? ": not refocused, the plain average of the views" : "", want, d_want);
+    /* the measurements, for the report */
+    char meas[600];
+    int n = snprintf(meas, sizeof meas, "sharpness against the reference:");
+    for (int k = 0; k < ns && n < (int)sizeof meas; k++)
+        n += snprintf(meas + n, sizeof meas - (size_t)n, "%s %s %.2fx", k ? "," : "", sj[k].name,
+                      sub_sharp[k] / fmax(ref_sharp[k], 1e-12));
+    if (n < (int)sizeof meas)
+        snprintf(meas + n, sizeof meas - (size_t)n, "; brightness %.2fx", bright);
+    r->noise_ratio = NAN;
+    r->variant_ratio = sub_sharp[target] / fmax(ref_sharp[target], 1e-12);
+    snprintf(r->best_variant, sizeof r->best_variant, "focus %.3g m", z_est);
+    double ratio_t = r->variant_ratio;
+    /* how far the best full-aperture refocus is from the submission, region by region */
+    int worst = 0;
+    double worst_ratio = 1;
+    for (int k = 0; k < ns; k++) {
+        double q = (sub_sharp[k] + 1e-9) / (best_sweep[k] + 1e-9);
+        if (q > worst_ratio)
+            worst_ratio = q, worst = k;
+    }
+    if (worst_ratio > max_sharp) {
+        fail(r, "%s: the %s at %g m is %.2fx sharper than any full-aperture refocus leaves it (the closest, focused at "
+                "%s, pass <= %.2fx): more depth of field than asked (a smaller --aperture or a single view?); %s",
+             im->file, sj[worst].name, sj[worst].depth, worst_ratio, ztxt, max_sharp, meas);
+    } else if (ratio_t < min_sharp) {
+        fail(r, "%s: the %s at %g m is not in focus: sharpness %.2fx the reference (pass >= %.2fx); %s; %s", im->file,
+             sj[target].name, sj[target].depth, ratio_t, min_sharp, looks, meas);
+    } else if (fabs(best_d - d_want) > focus_tol) {
+        fail(r, "%s: focused near but not at the %s: %s; the focus is off by %+.2f px/view (pass within %.2f), %+.0f%% "
+                "in depth; %s",
+             im->file, sj[target].name, looks, best_d - d_want, focus_tol, 100.0 * (z_est / want - 1.0), meas);
+    } else if (!(bright <= max_bright && bright >= 1 / max_bright)) {
+        fail(r, "%s: brightness %.2fx the reference (pass within %.2fx); %s", im->file, bright, max_bright, meas);
+    }
+    snprintf(r->measurements, sizeof r->measurements, "%s; %s", meas, looks);
+    lf_image_free(&ref), lf_lf_free(&lf);
     return 0;
 }
 
@@ -967,6 +1421,8 @@ static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
                  v, have ? "" : ", the default", gt ? ">" : "<", gt ? gt : lt);
         return 0;
     }
+    if (!strcmp(c->kind, "focus"))
+        return run_focus(g, c, s, r, err);
     if (!strcmp(c->kind, "render")) {
         j.make = make_render;
         return compare(&j, s, err);

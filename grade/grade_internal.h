@@ -20,6 +20,11 @@ typedef struct lf_grade_variant {
     char *find[LF_GRADE_MAX_EDITS], *replace[LF_GRADE_MAX_EDITS];
     char post[128];
     char set[256]; /* synth/refocus overrides "key:value[,key:value]" */
+    /* a search (docs/grading.md): the with= text holds {v} (or {v*K}), the
+     * scene value base x factor, factors searched over [lo, hi] */
+    int search;
+    double base, lo, hi;
+    char measure[256]; /* what the best value means physically ({value}, {base}, {K/value}, {value*K}) */
 } lf_grade_variant;
 
 typedef struct lf_grade_check {

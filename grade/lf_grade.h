@@ -50,6 +50,9 @@ typedef struct lf_grade_check_result {
     double psnr_db;
     char best_variant[64]; /* the known mistake that matches best, if any */
     double variant_ratio;
+    /* physical measurements of a failed (or focus-checked) image: blur, brightness,
+     * focus, field of view (docs/grading.md, "Measurements"); empty when none */
+    char measurements[1024];
 } lf_grade_check_result;
 
 typedef struct lf_grade_result {
@@ -103,6 +106,18 @@ double lf_grade_relmse(const lf_image *a, const lf_image *ref);
 double lf_grade_noise_ratio(const lf_image *x, const lf_image *ref, const lf_image *a, const lf_image *b);
 /* SSIM of sRGB-encoded luminance, 7x7 box windows. */
 double lf_grade_ssim(const lf_image *a, const lf_image *b);
+/* Contrast energy of [x0,x1) x [y0,y1): mean squared neighbour difference of
+ * luminance over the squared mean (the focus checks' local sharpness). */
+double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1);
+/* Mean over all pixels and channels. */
+double lf_grade_mean(const lf_image *im);
+/* Measurements for explaining a wrong image in physical terms:
+ * content magnification (> 1: the submission sees a wider field, tan of the
+ * half angle times it), extra disc blur in pixels (> 0 blurrier, < 0
+ * sharper), and the equivalent diameter of n highlights (bokeh discs). */
+double lf_grade_fit_scale(const lf_image *S, const lf_image *A);
+double lf_grade_fit_blur(const lf_image *S, const lf_image *A);
+double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n);
 
 /* Submission.md commands as data: splits a line into words (quotes group,
  * nothing is expanded).  Fails (-1, reason in why) on shell syntax. */

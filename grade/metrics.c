@@ -233,3 +233,230 @@ int lf_grade_post(const char *op, lf_image *img, lf_error *err)
     }
     return lf_error_set(err, LF_ERR_PARAM, "unknown post-processing op '%s'", op);
 }
+
+/* Contrast energy of a region: mean over pixels of the squared differences
+ * of Rec. 709 luminance to the right and lower neighbours, over the squared
+ * mean luminance (scale-free, so an exposure change does not move it).
+ * Defocus blur lowers it; noise raises it a little. */
+double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1)
+{
+    if (x0 < 0)
+        x0 = 0;
+    if (y0 < 0)
+        y0 = 0;
+    if (x1 > im->width)
+        x1 = im->width;
+    if (y1 > im->height)
+        y1 = im->height;
+    double e = 0, m = 0;
+    long n = 0;
+    int c = im->channels;
+    for (int y = y0; y < y1 - 1; y++)
+        for (int x = x0; x < x1 - 1; x++) {
+            const float *p = lf_image_px(im, x, y), *r = lf_image_px(im, x + 1, y), *d = lf_image_px(im, x, y + 1);
+            double l = c >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+            double lr = c >= 3 ? 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2] : r[0];
+            double ld = c >= 3 ? 0.2126 * d[0] + 0.7152 * d[1] + 0.0722 * d[2] : d[0];
+            e += (l - lr) * (l - lr) + (l - ld) * (l - ld);
+            m += l;
+            n++;
+        }
+    if (n == 0 || !(m > 0))
+        return 0;
+    m /= (double)n;
+    return e / (double)n / (m * m);
+}
+
+/* Mean of all channels (brightness ratios). */
+double lf_grade_mean(const lf_image *im)
+{
+    double s = 0;
+    size_t n = (size_t)im->width * im->height * im->channels;
+    for (size_t i = 0; i < n; i++)
+        s += isfinite(im->data[i]) ? im->data[i] : 0;
+    return n ? s / (double)n : 0;
+}
+
+/* ---- physical measurements of a wrong image (docs/grading.md, "Measurements") ---- */
+
+static double lum_at(const lf_image *im, int x, int y)
+{
+    const float *p = lf_image_px(im, x, y);
+    return im->channels >= 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
+}
+
+/* bilinear luminance at (x, y) in pixel-centre coordinates; -1 outside */
+static double lum_bilinear(const lf_image *im, double x, double y)
+{
+    x -= 0.5, y -= 0.5;
+    if (x < 0 || y < 0 || x > im->width - 1 || y > im->height - 1)
+        return -1;
+    int x0 = (int)x, y0 = (int)y, x1 = x0 + 1 < im->width ? x0 + 1 : x0, y1 = y0 + 1 < im->height ? y0 + 1 : y0;
+    double fx = x - x0, fy = y - y0;
+    return (1 - fy) * ((1 - fx) * lum_at(im, x0, y0) + fx * lum_at(im, x1, y0)) +
+           fy * ((1 - fx) * lum_at(im, x0, y1) + fx * lum_at(im, x1, y1));
+}
+
+/* relative residual of s ~ k a (k fitted) over the given pairs */
+static double fit_residual(const double *s, const double *a, long n)
+{
+    double sa = 0, aa = 0, ss = 0;
+    for (long i = 0; i < n; i++)
+        sa += s[i] * a[i], aa += a[i] * a[i], ss += s[i] * s[i];
+    if (!(aa > 0) || !(ss > 0))
+        return INFINITY;
+    double k = sa / aa;
+    return (ss - 2 * k * sa + k * k * aa) / ss;
+}
+
+static double scale_residual(const lf_image *S, const lf_image *A, double scale)
+{
+    long n = 0, cap = (long)S->width * S->height;
+    double *s = malloc(sizeof *s * (size_t)cap), *a = malloc(sizeof *a * (size_t)cap);
+    if (!s || !a) {
+        free(s), free(a);
+        return INFINITY;
+    }
+    double cx = 0.5 * S->width, cy = 0.5 * S->height;
+    /* the central 80 %: both images have content there for scales 0.8 .. 1.25 */
+    for (int y = S->height / 10; y < S->height - S->height / 10; y++)
+        for (int x = S->width / 10; x < S->width - S->width / 10; x++) {
+            double v = lum_bilinear(A, cx + (x + 0.5 - cx) * scale, cy + (y + 0.5 - cy) * scale);
+            if (v < 0)
+                continue;
+            s[n] = lum_at(S, x, y), a[n] = v, n++;
+        }
+    double r = n > 16 ? fit_residual(s, a, n) : INFINITY;
+    free(s), free(a);
+    return r;
+}
+
+/* The magnification of the submission's content against the reference's:
+ * the factor m with S(x) ~ k A(c + (x - c) m), m > 1 when the submission
+ * sees a wider field (tan of the half angle m times the reference's).
+ * Searched over 0.8 .. 1.25 in 1 % steps, then a parabola. */
+double lf_grade_fit_scale(const lf_image *S, const lf_image *A)
+{
+    enum { N = 45 };
+    double best = INFINITY, r[N], lm[N];
+    int bi = N / 2;
+    for (int i = 0; i < N; i++) {
+        lm[i] = log(0.8) + (log(1.25) - log(0.8)) * i / (N - 1);
+        r[i] = scale_residual(S, A, exp(lm[i]));
+        if (r[i] < best)
+            best = r[i], bi = i;
+    }
+    double l = lm[bi];
+    /* only a magnification that explains most of the difference counts */
+    if (!(best < 0.5 * scale_residual(S, A, 1.0)))
+        return 1.0;
+    if (bi > 0 && bi < N - 1) {
+        double den = r[bi - 1] - 2 * r[bi] + r[bi + 1];
+        if (den > 0)
+            l += 0.5 * (r[bi - 1] - r[bi + 1]) / den * (lm[1] - lm[0]);
+    }
+    return exp(l);
+}
+
+/* luminance of img blurred by a uniform disc of diameter d pixels */
+static void disc_blur(const lf_image *im, double d, double *out)
+{
+    int w = im->width, h = im->height, rad = (int)ceil(0.5 * d);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            if (d < 1) {
+                out[(size_t)y * w + x] = lum_at(im, x, y);
+                continue;
+            }
+            double s = 0, wsum = 0;
+            for (int dy = -rad; dy <= rad; dy++)
+                for (int dx = -rad; dx <= rad; dx++) {
+                    if (dx * dx + dy * dy > 0.25 * d * d)
+                        continue;
+                    int xx = x + dx, yy = y + dy;
+                    xx = xx < 0 ? 0 : xx >= w ? w - 1 : xx;
+                    yy = yy < 0 ? 0 : yy >= h ? h - 1 : yy;
+                    s += lum_at(im, xx, yy), wsum++;
+                }
+            out[(size_t)y * w + x] = s / wsum;
+        }
+}
+
+/* Extra blur: the disc diameter (pixels, 0..12) whose blur of the reference
+ * best matches the submission (> 0: the submission is blurrier), or minus
+ * the one whose blur of the submission best matches the reference (< 0: the
+ * submission is sharper).  Whole-image least squares with a fitted gain. */
+double lf_grade_fit_blur(const lf_image *S, const lf_image *A)
+{
+    size_t n = (size_t)S->width * S->height;
+    double *bs = malloc(sizeof *bs * n), *ba = malloc(sizeof *ba * n), *ls = malloc(sizeof *ls * n),
+           *la = malloc(sizeof *la * n);
+    if (!bs || !ba || !ls || !la) {
+        free(bs), free(ba), free(ls), free(la);
+        return 0;
+    }
+    disc_blur(S, 0, ls);
+    disc_blur(A, 0, la);
+    double r0 = fit_residual(ls, la, (long)n), best = r0, bd = 0;
+    for (double d = 1.5; d <= 12.01; d += 0.5) {
+        disc_blur(A, d, ba);
+        double r = fit_residual(ls, ba, (long)n);
+        if (r < best)
+            best = r, bd = d;
+        disc_blur(S, d, bs);
+        r = fit_residual(la, bs, (long)n);
+        if (r < best)
+            best = r, bd = -d;
+    }
+    free(bs), free(ba), free(ls), free(la);
+    return best < 0.5 * r0 ? bd : 0; /* only a blur that explains most of the difference */
+}
+
+/* Equivalent diameter (pixels) of n bright discs in [x0,x1) x [y0,y1): the
+ * pixels brighter than halfway from the region's median to its maximum,
+ * as n equal discs.  0 when the region holds no highlight. */
+double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n)
+{
+    if (x0 < 0)
+        x0 = 0;
+    if (y0 < 0)
+        y0 = 0;
+    if (x1 > im->width)
+        x1 = im->width;
+    if (y1 > im->height)
+        y1 = im->height;
+    if (x1 <= x0 || y1 <= y0 || n < 1)
+        return 0;
+    size_t m = (size_t)(x1 - x0) * (y1 - y0), k = 0;
+    double *v = malloc(sizeof *v * m), mx = 0;
+    if (!v)
+        return 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            v[k] = lum_at(im, x, y);
+            mx = fmax(mx, v[k]);
+            k++;
+        }
+    /* median by partial selection sort would do; a copy sorted is simpler */
+    double *c = malloc(sizeof *c * m);
+    if (!c) {
+        free(v);
+        return 0;
+    }
+    memcpy(c, v, sizeof *c * m);
+    for (size_t i = 0; i <= m / 2; i++) /* selection up to the median: regions are small */
+        for (size_t j = i + 1; j < m; j++)
+            if (c[j] < c[i]) {
+                double t = c[i];
+                c[i] = c[j], c[j] = t;
+            }
+    double med = c[m / 2], thr = 0.5 * (med + mx);
+    free(c);
+    size_t above = 0;
+    for (size_t i = 0; i < m; i++)
+        above += v[i] > thr;
+    free(v);
+    if (!(mx > 2 * med + 1e-6))
+        return 0;
+    return 2 * sqrt((double)above / (n * M_PI));
+}

@@ -72,6 +72,11 @@ int lf_grade_report_student(const char *dir, const char *title, const lf_grade_r
             fputs("pass", f);
         else
             html_escape(f, c->reason);
+        if (c->measurements[0] && (c->status == LF_GRADE_PASS || !strstr(c->reason, c->measurements))) {
+            fputs("<br><small>measured: ", f);
+            html_escape(f, c->measurements);
+            fputs("</small>", f);
+        }
         fputs("</td><td>", f);
         num(f, "%.2f&times;", c->noise_ratio);
         fputs("</td><td>", f);
@@ -185,6 +190,8 @@ char *lf_grade_result_json(const lf_grade_result *r)
         json_num(&b, &len, &cap, c->psnr_db);
         put(&b, &len, &cap, ", \"closest_mistake\": ");
         json_str(&b, &len, &cap, c->best_variant);
+        put(&b, &len, &cap, ", \"measurements\": ");
+        json_str(&b, &len, &cap, c->measurements);
         put(&b, &len, &cap, "}");
     }
     put(&b, &len, &cap, "]}");

@@ -87,7 +87,7 @@ void lf_grade_free_argv(char **argv, int argc)
     free(argv);
 }
 
-static const char *kinds[] = {"files", "sections", "size", "render", "synth", "refocus", "constraint", "answer"};
+static const char *kinds[] = {"files", "sections", "size", "render", "synth", "refocus", "constraint", "answer", "focus"};
 
 const char *lf_grade_check_get(const lf_grade_check *c, const char *key, const char *def)
 {
@@ -199,6 +199,15 @@ int lf_grade_rubric_parse(const char *path, lf_grade_rubric *r, lf_error *err)
                         snprintf(va->post, sizeof va->post, "%s", val);
                     else if (!strcmp(v[i], "set"))
                         snprintf(va->set, sizeof va->set, "%s", val);
+                    else if (!strcmp(v[i], "measure"))
+                        snprintf(va->measure, sizeof va->measure, "%s", val);
+                    else if (!strcmp(v[i], "base"))
+                        va->base = atof(val);
+                    else if (!strcmp(v[i], "range")) {
+                        if (sscanf(val, "%lf:%lf", &va->lo, &va->hi) != 2 || !(va->lo > 0) || !(va->hi > va->lo))
+                            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: range= wants LO:HI factors, 0 < LO < HI", path,
+                                              lineno);
+                    }
                     else if (!strcmp(v[i], "replace") && va->nedits < LF_GRADE_MAX_EDITS)
                         va->find[va->nedits] = strdup(val), va->replace[va->nedits] = NULL;
                     else if (!strcmp(v[i], "with") && va->find[va->nedits] && !va->replace[va->nedits])
@@ -208,6 +217,12 @@ int lf_grade_rubric_parse(const char *path, lf_grade_rubric *r, lf_error *err)
                 }
                 if (!rc && va->nedits < LF_GRADE_MAX_EDITS && va->find[va->nedits])
                     rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: replace= without with=", path, lineno);
+                for (int e = 0; !rc && e < va->nedits; e++)
+                    if (strstr(va->replace[e], "{v"))
+                        va->search = 1;
+                if (!rc && va->search && (!(va->base != 0) || !(va->hi > 0)))
+                    rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: a search variant ({v} in with=) needs base= and range=",
+                                      path, lineno);
                 if (!rc && !va->reason[0])
                     rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: a variant needs reason=", path, lineno);
             }

@@ -138,7 +138,8 @@ static void thinlens(void)
     render_to(flat, NULL, 0, 16, NULL, m, "flatfield.exr");
     write_text(m, "Submission.md", md_ok);
     if (!grade(g, m, &r)) {
-        EXPECT_FAIL(r, "bokeh", "focus distance off by +5%");
+        EXPECT_FAIL(r, "bokeh", "focus distance off by +");
+        EXPECT_FAIL(r, "bokeh", "the lens focused at 0.26");
         EXPECT_PASS(r, "flatfield");
         CHECK(r.score == 15);
         lf_grade_result_free(&r);
@@ -301,11 +302,68 @@ static void student_synth(const char *dir, const char *lfname, double lens_radiu
     lf_attrs_free(&a);
 }
 
+
+/* Part 3: a student's lftool refocus of their own plenoptic render at
+ * disparity d (aperture < 0: every view) */
+static void student_refocus(const char *dir, const char *rawname, double d, double aperture, const char *out)
+{
+    char p[512];
+    snprintf(p, sizeof p, "%s/%s", dir, rawname);
+    lf_image raw;
+    lf_attrs a = {0};
+    lf_error err = {0};
+    lf_lf_layout file, flags, lay;
+    lf_lf_layout_init(&flags);
+    lf_lightfield lf;
+    memset(&lf, 0, sizeof lf);
+    if (lf_image_read(p, &raw, &a, &err) || lf_lf_layout_from_attrs(&a, &file, &err) ||
+        lf_lf_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err) ||
+        lf_lf_decode(&raw, &lay, NULL, &lf, &err)) {
+        CHECK_MSG(0, "student refocus: %s", err.msg);
+        return;
+    }
+    lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+    o.disparity_px = d;
+    if (aperture >= 0)
+        o.aperture_radius = aperture;
+    lf_image img;
+    if (!lf_lf_refocus(&lf, &o, &img, &err)) {
+        snprintf(p, sizeof p, "%s/%s", dir, out);
+        lf_image_write(p, &img, NULL, NULL, &err);
+        lf_image_free(&img);
+    }
+    lf_lf_free(&lf);
+    lf_image_free(&raw);
+    lf_attrs_free(&a);
+}
+
+/* Disparity (px per view step) of depth z in assignments/4-lightfield/scenes/
+ * plenoptic.pbrt, from its design (docs/lightfield.md): f = 25 mm f/2
+ * focused at 0.5 m, 96 microlenses of 9 px over 5.76 mm, matched:
+ * P_m = p (1 + p/D); d = z_i (1/z - 1/z_o) D / (9 p). */
+static double a4_disparity(double z)
+{
+    double f = 25e-3, D = f / 2, zo = 0.5, zi = f * zo / (zo - f), Pm = 5.76e-3 / 96;
+    double p = 0.5 * D * (sqrt(1 + 4 * Pm / D) - 1);
+    return zi * (1 / z - 1 / zo) * D / (9 * p);
+}
+
+/* the depth in "looks focused at X m" of a reason */
+static double looks_focused_at(const char *reason)
+{
+    const char *q = strstr(reason, "looks focused at ");
+    double z = NAN;
+    if (!q || sscanf(q, "looks focused at %lf", &z) != 1)
+        return NAN;
+    return z;
+}
+
 static const char *md_lf =
     "# Submission\n## Answers\nRays meet the camera plane between four data cameras.\n## Commands\n"
     "lfrender lightfield.pbrt --spp 16 -o lightfield.exr\n"
     "`lftool synth lightfield.exr novel.png --camerapos 0.03 0.05 0 --lensradius %s --focaldistance 2.5 "
-    "--samplesperpixel 64 --outputdim 96 72 --outputfov 30`\n";
+    "--samplesperpixel 64 --outputdim 96 72 --outputfov 30`\n"
+    "lftool refocus plenoptic.exr --depth 0.3 -o refocused.png\n";
 
 static void lightfield(void)
 {
@@ -327,15 +385,52 @@ static void lightfield(void)
     char *ok = new_sub("l-correct");
     render_to(scene, NULL, 0, 16, NULL, ok, "lightfield.exr");
     student_synth(ok, "lightfield.exr", 0.1, "novel.png");
+    const char *pscene = "assignments/4-lightfield/scenes/plenoptic.pbrt";
+    render_to(pscene, NULL, 0, 8, NULL, ok, "plenoptic.exr");
+    student_refocus(ok, "plenoptic.exr", a4_disparity(0.3), -1, "refocused.png");
     snprintf(md, sizeof md, md_lf, "0.1");
     write_text(ok, "Submission.md", md);
     if (!grade(g, ok, &r)) {
         EXPECT_PASS(r, "lightfield");
         EXPECT_PASS(r, "novel");
         EXPECT_PASS(r, "lensradius");
-        EXPECT_FAIL(r, "refocused", "optional part not submitted");
-        CHECK_MSG(r.score == r.max - 3, "correct Parts 1 and 2: %d/%d", r.score, r.max);
+        EXPECT_PASS(r, "refocused");
+        CHECK_MSG(r.score == r.max && r.max == 25, "correct submission: %d/%d", r.score, r.max);
+        double z = looks_focused_at(check(&r, "refocused")->measurements);
+        CHECK_MSG(fabs(z - 0.3) < 0.03, "estimated focus %g m, refocused at 0.3 m", z);
         lf_grade_result_free(&r);
+    }
+    /* Part 3 mutants, each refocused from the correct submission's raw:
+     * not refocused (the plain mean of the views), refocused at the far card,
+     * at +10 % of the asked depth, and with a pinhole aperture (one view) */
+    struct {
+        const char *name;
+        double d, aperture;
+        const char *reason, *reason2;
+        double looks; /* expected focus estimate (m), 0: not asserted */
+    } p3[] = {
+        {"l-unrefocused", 0.0, -1, "the near card at 0.3 m is not in focus: sharpness 0.", "not refocused, the plain average", 0.5},
+        {"l-far", a4_disparity(1.2), -1, "the near card at 0.3 m is not in focus", "looks focused at", 1.2},
+        {"l-focus10", a4_disparity(0.33), -1, "focused near but not at the near card", "% in depth", 0.33},
+        {"l-focus-10", a4_disparity(0.27), -1, "focused near but not at the near card", "% in depth", 0.27},
+        {"l-pinhole-refocus", a4_disparity(0.3), 0, "more depth of field than asked", "sharper than any full-aperture", 0},
+    };
+    for (size_t k = 0; k < sizeof p3 / sizeof *p3; k++) {
+        char *q = new_sub(p3[k].name), rel[600];
+        snprintf(rel, sizeof rel, "../%s/refocused.png", p3[k].name);
+        student_refocus(ok, "plenoptic.exr", p3[k].d, p3[k].aperture, rel);
+        write_text(q, "Submission.md", md);
+        if (!grade(g, q, &r)) {
+            EXPECT_FAIL(r, "refocused", p3[k].reason);
+            EXPECT_FAIL(r, "refocused", p3[k].reason2);
+            if (p3[k].looks > 0) {
+                double z = looks_focused_at(check(&r, "refocused")->reason);
+                CHECK_MSG(fabs(z / p3[k].looks - 1) < 0.04, "%s: estimated focus %g m, refocused at %g m", p3[k].name,
+                          z, p3[k].looks);
+            }
+            printf("  %-18s refocused: %s\n", p3[k].name, check(&r, "refocused")->reason);
+            lf_grade_result_free(&r);
+        }
     }
     /* tiles in the wrong order (the grid flipped left-right) */
     char *m = new_sub("l-flipped");
@@ -354,7 +449,8 @@ static void lightfield(void)
     student_synth(ok, "lightfield.exr", 0.1, "../l-fov/novel.png");
     write_text(m, "Submission.md", md);
     if (!grade(g, m, &r)) {
-        EXPECT_FAIL(r, "lightfield", "field of view off by +2 degrees");
+        EXPECT_FAIL(r, "lightfield", "field of view off by +");
+        EXPECT_FAIL(r, "lightfield", "matches fov 3");
         lf_grade_result_free(&r);
     }
     /* lens radius 0 where blur is required (declared and used) */

@@ -566,6 +566,36 @@ static lf_lf_refocus_opts aperture_opts(const opts *o)
     return r;
 }
 
+/* Ng 2005's range of exact refocusing of a plenoptic raw (docs/lightfield.md,
+ * "Refocusable range"): |d| <= 1 px/view, i.e. |1 - 1/alpha| <= P p / D.
+ * Outside it the sub-aperture views are themselves blurred: warn, go on. */
+static void refocus_range_warning(const opts *o, const lf_lightfield *lf, double d)
+{
+    if (lf->disp_per_alpha == 0 || !(fabs(d) > 1.0 + 1e-9))
+        return;
+    double k = lf->disp_per_inv_m, d_inf = lf->disp_at_inf, b = 1.0 / lf->disp_per_alpha;
+    char asked[96], far[32], amax[32];
+    if (o->have_depth)
+        snprintf(asked, sizeof asked, "depth %g m", o->depth);
+    else if (o->have_alpha)
+        snprintf(asked, sizeof asked, "alpha %g", o->alpha);
+    else
+        snprintf(asked, sizeof asked, "disparity %g px/view", d);
+    if (k > 0 && -1.0 - d_inf > 0)
+        snprintf(far, sizeof far, "%.4g m", k / (-1.0 - d_inf));
+    else
+        snprintf(far, sizeof far, "infinity");
+    if (b < 1.0)
+        snprintf(amax, sizeof amax, "%.5g", 1.0 / (1.0 - b));
+    else
+        snprintf(amax, sizeof amax, "infinity");
+    fprintf(stderr,
+            "lftool: warning: %s: %s (disparity %.3g px/view) is outside the refocusable range (Ng 2005: "
+            "|disparity| <= 1 px/view, alpha %.5g .. %s, depths %.4g m .. %s): the sub-aperture views are blurred "
+            "there, so the result is softer than a photograph focused at that depth\n",
+            o->input, asked, d, 1.0 / (1.0 + b), amax, k > 0 && 1.0 - d_inf > 0 ? k / (1.0 - d_inf) : INFINITY, far);
+}
+
 static int cmd_refocus(const opts *o)
 {
     int rc = need_output(o);
@@ -581,6 +611,7 @@ static int cmd_refocus(const opts *o)
         unload(&l);
         return rc;
     }
+    refocus_range_warning(o, &l.lf, ro.disparity_px);
     lf_error err = {0};
     lf_image out = {0};
     if (o->method && !strcmp(o->method, "fourier")) {

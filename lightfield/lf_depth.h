@@ -21,7 +21,7 @@
  *      cost minimum and its neighbours;
  *   4. confidence from the aggregated cost curve, and a confidence- and
  *      colour-weighted median filter guided by the reference view.
- * No learned parts.  Runs in rows bands on o.threads threads. */
+ * No learned parts.  Runs on o.threads threads (bands of rows, cost slices). */
 #ifndef LF_DEPTH_H
 #define LF_DEPTH_H
 

@@ -1,15 +1,17 @@
-/* Depth-based view synthesis (lf_depth.h; docs/depth.md).
+/* Depth-based view synthesis (lf_depth.h; docs/depth.md has the details).
  *
  * 1. The reference view's disparity map is forward-warped ("splatted") to
  *    the target viewpoint and to each source view: every reference pixel
- *    lands on its nearest pixel there, the nearest surface (largest
- *    disparity) wins; holes (disocclusions, cracks) take the farthest
- *    disparity around them, as the background is what appears there.
- * 2. Every target pixel, with its disparity d, is looked up in the 4
- *    nearest views (bilinear in the view, bilinear weights in (u, v)); a
- *    view whose own warped disparity there is clearly nearer than d sees an
- *    occluder instead and gets (almost) no weight.
- * 3. Where the splatted confidence is low the result fades to the plane
+ *    covers the pixel centres within about half a pixel of where it lands,
+ *    the nearest surface (largest disparity) wins; holes (disocclusions)
+ *    take the farthest disparity around them, as the background is what
+ *    appears there.
+ * 2. Every target pixel is looked up (bicubic) in the 4 nearest views,
+ *    weighted bilinearly in (u, v); a view whose own warped disparity there
+ *    is clearly nearer sees an occluder instead and drops out.
+ * 3. Near depth edges the nearest disparity within a pixel is primary and
+ *    the others compete by photo-consistency (soft weights).
+ * 4. Where the splatted confidence is low the result fades to the plane
  *    blend at plane_disparity (lf_lf_view_at). */
 #include <float.h>
 #include <math.h>
@@ -191,28 +193,30 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
     for (int y = y0; y < y1; y++)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            float d = c->dt[i];
-            /* near a depth edge the splatted map is only pixel-accurate:
-             * the nearest and farthest disparity around are candidates too,
-             * the one the sources agree on best wins */
-            float dmin = d, dmax = d;
+            /* near a depth edge the splatted map is only pixel-accurate and the
+             * views' edge pixels are antialiased mixes, which travel with the
+             * occluding (nearer) surface: the nearest disparity within one
+             * pixel is the primary one; the pixel's own and the farthest
+             * around compete by photo-consistency */
+            float dpix = c->dt[i], dmin = dpix, dmax = dpix;
             for (int j = -1; j <= 1; j++)
                 for (int k = -1; k <= 1; k++) {
                     int xx = clampi(x + k, 0, w - 1), yy = clampi(y + j, 0, h - 1);
                     float v = c->dt[(size_t)yy * w + xx];
                     dmin = v < dmin ? v : dmin, dmax = v > dmax ? v : dmax;
                 }
+            float d = dmax;
             float px[3], all[3];
             double seen, seen2;
             double best = blend_at(c, x, y, d, px, all, &seen);
             if (dmax - dmin > 0.25f && best >= 0) {
                 /* soft choice: candidates weighted by 1 / (variance + floor);
-                 * a mixed (antialiased) edge pixel then gets a mix too */
+                 * a mixed edge pixel then gets a mix too */
                 const double floor_v = 1e-4;
                 double wsum = 1.0 / (best + floor_v), acc[3] = {px[0] * wsum, px[1] * wsum, px[2] * wsum};
-                float cand[2] = {dmin, dmax};
+                float cand[2] = {dpix, dmin};
                 for (int q = 0; q < 2; q++) {
-                    if (cand[q] == d)
+                    if (cand[q] == d || (q == 1 && cand[1] == cand[0]))
                         continue;
                     float p2[3], a2[3];
                     double v = blend_at(c, x, y, cand[q], p2, a2, &seen2);

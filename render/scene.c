@@ -573,6 +573,12 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
             snprintf(ctx, sizeof ctx, "Shape \"%s\"", sh->e.type);
             return lf_params_finish(&sh->e.params, ctx, b->err);
         }
+    /* The parser refuses these already; a description built otherwise
+     * gets the same rule. */
+    if (!b->d->allow_unsupported)
+        return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
+                            "%s: Shape \"%s\" is not supported (--allow-unsupported renders the scene without it)",
+                            where, sh->e.type);
     lf_warn_append(&b->s->warnings, "%s: warning: Shape \"%s\" is not supported; it is left out of the render", where,
                    sh->e.type);
     for (size_t i = 0; i < sh->e.params.count; i++)

@@ -4,11 +4,13 @@
  *                 [--seed S] [--crop x0 x1 y0 y1] [--quiet] [--explain] [--white]
  *                 [--spp-range A B] [--tile I/N] [--part]
  *                 [--checkpoint-every SECONDS] [--checkpoint PATH] [--resume]
- *                 [--camera-plugin LIB.so]...
+ *                 [--camera-plugin LIB.so]... [--allow-unsupported]
  *        lfrender merge PART.exr... -o OUT.exr
  *
  * Exit codes: 0 success; 1 the scene or the render failed (message names
- * file:line:column); 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
+ * file:line:column; a scene with several errors gets each, up to 20, and
+ * something lensfield cannot render is an error unless --allow-unsupported);
+ * 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
  * after writing a checkpoint that --resume continues from.  No output file is written on
  * failure, and outputs are replaced atomically.
  */
@@ -51,6 +53,8 @@ static void usage(FILE *f)
                "  --checkpoint PATH where checkpoints go\n"
                "  --resume          continue from the checkpoint (same scene and settings)\n"
                "  --camera-plugin L load camera types from the shared object L\n"
+               "  --allow-unsupported  render a scene whose shapes, lights or materials lensfield\n"
+               "                    cannot render, leaving them out with a warning (default: exit 1)\n"
                "\n"
                "       lfrender merge PART.exr... -o OUT.exr   sum parts into the unsplit image, bit for bit\n");
 }
@@ -203,7 +207,7 @@ int main(int argc, char **argv)
         return merge_main(argc, argv);
     const char *scene = NULL, *out = NULL, *checkpoint = NULL;
     lf_render_opts o = lf_render_opts_default();
-    int quiet = 0, explain = 0;
+    int quiet = 0, explain = 0, allow_unsupported = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         long v;
@@ -212,6 +216,8 @@ int main(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "-o") && i + 1 < argc) {
             out = argv[++i];
+        } else if (!strcmp(a, "--allow-unsupported")) {
+            allow_unsupported = 1;
         } else if (!strcmp(a, "--spp") && i + 1 < argc) {
             if (parse_int(argv[++i], 1, 1 << 24, &v)) {
                 fprintf(stderr, "lfrender: --spp expects an integer from 1 to 16777216, got \"%s\"\n", argv[i]);
@@ -312,8 +318,23 @@ int main(int argc, char **argv)
     }
     lf_error err = {0};
     lf_scene_desc desc;
-    if (lf_scene_parse_file(scene, &desc, &err)) {
-        fprintf(stderr, "lfrender: %s\n", err.msg);
+    lf_parse_opts popts = {allow_unsupported, 0};
+    char *errors = NULL;
+    if (lf_scene_parse_file_ex(scene, &popts, &desc, &err, &errors)) {
+        /* every problem the parser found, one per line */
+        int n = 0;
+        for (const char *line = errors; line && *line;) {
+            const char *nl = strchr(line, '\n');
+            int len = nl ? (int)(nl - line) : (int)strlen(line);
+            fprintf(stderr, "lfrender: %.*s\n", len, line);
+            n += line[0] != '(';
+            line += len + (nl != NULL);
+        }
+        if (!errors)
+            fprintf(stderr, "lfrender: %s\n", err.msg);
+        else if (n > 1)
+            fprintf(stderr, "lfrender: %d errors in %s; nothing written\n", n, scene);
+        free(errors);
         return 1;
     }
     o.scene_path = scene;

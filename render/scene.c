@@ -13,12 +13,14 @@
  * decomposed interpolation and rays traverse a static BVH.  Shapes that ask
  * for "motionsegments", emitters, full spheres and motions Embree's
  * decomposition cannot represent get keyframed vertices (or centres). */
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "lf_subdiv.h"
 #include "render_internal.h"
 
 void lf_warn_append(char **buf, const char *fmt, ...)
@@ -312,6 +314,43 @@ static int shape_plymesh(builder *b, lf_shape_desc *sh, const motion *mo)
     return finish_mesh(b, sh, mo, copy.P, (int)copy.n_vertices, copy.N, copy.uv, copy.indices, (int)copy.n_triangles);
 }
 
+/* pbrt-v4's "loopsubdiv": the limit surface of the control mesh after
+ * "levels" Loop subdivisions, with limit-surface normals (render/lf_subdiv.h). */
+static int shape_loopsubdiv(builder *b, lf_shape_desc *sh, const motion *mo)
+{
+    lf_paramset *ps = &sh->e.params;
+    size_t np = 0, ni = 0;
+    int levels = lf_params_int(ps, "levels", 3);
+    const double *P = lf_params_nums(ps, "P", LF_PT_POINT3, &np);
+    const double *I = lf_params_nums(ps, "indices", LF_PT_INTEGER, &ni);
+    char where[512];
+    loc_prefix(where, sizeof where, &sh->e.loc);
+    if (ps->error.code)
+        return lf_params_finish(ps, "Shape \"loopsubdiv\"", b->err);
+    if (!P || np < 9)
+        return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"loopsubdiv\" needs \"point3 P\" with at least 3 points",
+                            where);
+    if (!I || ni == 0 || ni % 3)
+        return lf_error_set(b->err, LF_ERR_PARAM,
+                            "%s: Shape \"loopsubdiv\" needs \"integer indices\", 3 per triangle (got %zu)", where, ni);
+    int *idx = malloc(ni * sizeof *idx);
+    if (!idx)
+        return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ni; i++)
+        idx[i] = I[i] < 0 || I[i] > INT_MAX ? -1 : (int)I[i];
+    lf_ply_mesh m;
+    lf_error e = {0};
+    int rc = lf_loop_subdivide(P, np / 3, idx, ni / 3, levels, &m, &e);
+    free(idx);
+    if (rc)
+        return lf_error_set(b->err, rc, "%s: Shape \"loopsubdiv\": %s", where, e.msg);
+    /* pbrt-v4 negates a mesh's normals under ReverseOrientation. */
+    if (sh->reverse_orientation)
+        for (size_t i = 0; i < 3 * m.n_vertices; i++)
+            m.N[i] = -m.N[i];
+    return finish_mesh(b, sh, mo, m.P, (int)m.n_vertices, m.N, NULL, m.indices, (int)m.n_triangles);
+}
+
 /* Tessellated parametric surface: f(u, v) -> object-space point, on a grid. */
 typedef void (*surface_fn)(const double *prm, double u, double v, double out[3], double nrm[3]);
 
@@ -554,7 +593,7 @@ static const struct {
     shape_fn fn;
 } shape_table[] = {
     {"trianglemesh", shape_trianglemesh}, {"plymesh", shape_plymesh}, {"sphere", shape_sphere},
-    {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh},
+    {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh}, {"loopsubdiv", shape_loopsubdiv},
 };
 
 static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)

@@ -1,6 +1,8 @@
 #include "lf_color.h"
+#include "lf_file.h"
 
 #include <pthread.h>
+#include <stdlib.h>
 
 #include <string.h>
 
@@ -226,4 +228,71 @@ lf_vec3 lf_wavelength_rgb_weight(double lambda_nm)
     lf_cie_xyz_bar(lambda_nm, xyz);
     lf_vec3 c = lf_xyz_to_linear_srgb(xyz[0], xyz[1], xyz[2]);
     return lf_v3((float)(c.x / norm[0]), (float)(c.y / norm[1]), (float)(c.z / norm[2]));
+}
+
+int lf_spectrum_file_read(const char *path, double **nums, size_t *n_pairs, lf_error *err)
+{
+    *nums = NULL;
+    *n_pairs = 0;
+    char *text;
+    size_t len;
+    /* Measured spectra have at most a few thousand samples; 64 MiB is far
+     * beyond any real file and keeps a wrong path from eating memory. */
+    int rc = lf_file_read(path, (size_t)64 << 20, &text, &len, NULL, err);
+    if (rc)
+        return rc;
+    size_t n = 0, cap = 0;
+    double *v = NULL;
+    int line = 1;
+    const char *p = text, *end = text + len;
+    while (p < end) {
+        char c = *p;
+        if (c == '\n') {
+            line++;
+            p++;
+        } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v' || c == ',') {
+            p++;
+        } else if (c == '#') {
+            while (p < end && *p != '\n')
+                p++;
+        } else {
+            char *e;
+            double x = strtod(p, &e);
+            if (e == p || !isfinite(x) || (e < end && !strchr(" \t\r\n\f\v,#", *e))) {
+                const char *w = p;
+                while (w < end && !strchr(" \t\r\n\f\v,#", *w))
+                    w++;
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: expected a number, got \"%.*s\"", path,
+                                  line, (int)((w - p) > 40 ? 40 : (w - p)), p);
+                break;
+            }
+            if (n == cap) {
+                cap = cap ? 2 * cap : 256;
+                double *nv = realloc(v, cap * sizeof *nv);
+                if (!nv) {
+                    rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", path);
+                    break;
+                }
+                v = nv;
+            }
+            if (n % 2 == 0 && n >= 2 && !(x > v[n - 2])) {
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: wavelengths must increase (%g after %g)",
+                                  path, line, x, v[n - 2]);
+                break;
+            }
+            v[n++] = x;
+            p = e;
+        }
+    }
+    free(text);
+    if (!rc && (n < 2 || n % 2))
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: spectrum file needs (wavelength, value) pairs, found %zu number%s",
+                          path, n, n == 1 ? "" : "s");
+    if (rc) {
+        free(v);
+        return rc;
+    }
+    *nums = v;
+    *n_pairs = n / 2;
+    return LF_OK;
 }

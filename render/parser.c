@@ -14,6 +14,7 @@
  * a warning.
  */
 #include "lf_scene_desc.h"
+#include "../base/lf_color.h"
 #include "../base/lf_file.h"
 
 #include <ctype.h>
@@ -629,6 +630,7 @@ static int set_coordsys(parser *P, const char *name, const lf_transform xf[2])
 /* Arguments and parameter lists                                            */
 
 static int is_nonfinite_word(const token *t);
+static int join_path(const char *dir, const char *rel, char **out);
 
 static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *out)
 {
@@ -818,6 +820,40 @@ static int check_count(parser *P, const lf_loc *loc, lf_param_type type, const c
     return LF_OK;
 }
 
+/* A "spectrum" parameter naming neither a built-in spectrum nor numbers
+ * names a spectrum file (pbrt-v4): it is read here, relative to the
+ * directory of the file the parameter was written in, and becomes the same
+ * (wavelength, value) pairs as if they had been written inline. */
+static int load_spectrum_file(parser *P, const token *t, lf_param_type type, const char *decl, value_acc *a)
+{
+    lf_vec3 dummy;
+    if (type != LF_PT_SPECTRUM || a->n_strs != 1 || a->n_nums || lf_named_spectrum_rgb(a->strs[0], &dummy) == 0)
+        return LF_OK;
+    char *path;
+    if (join_path(t->dir, a->strs[0], &path))
+        return nomem(P);
+    double *v;
+    size_t n;
+    lf_error fe = {0};
+    int rc = lf_spectrum_file_read(path, &v, &n, &fe);
+    free(path);
+    if (rc == LF_ERR_NOMEM)
+        return nomem(P);
+    if (rc)
+        return perr(P, rc, &t->loc,
+                    "parameter \"%s\": \"%s\" is not a named spectrum (see docs/scene-format.md), and as a spectrum "
+                    "file: %s",
+                    decl, a->strs[0], fe.msg);
+    free(a->strs[0]);
+    free(a->strs);
+    a->strs = NULL;
+    a->n_strs = a->cap_strs = 0;
+    free(a->nums);
+    a->nums = v;
+    a->n_nums = a->cap_nums = 2 * n;
+    return LF_OK;
+}
+
 /* Splits a "type name" declaration. */
 static int split_decl(parser *P, const token *t, const char *decl, lf_param_type *type, char **name)
 {
@@ -856,9 +892,10 @@ static directive_fn find_directive(const token *t);
 
 /* Puts back a directive name that ended a malformed construct, so that the
  * parse resumes at it after the error (only right after lex_next). */
+static int is_directive_like(const token *t);
 static void unget_directive(lexer *L, const token *t)
 {
-    if (!L->has_peek && find_directive(t)) {
+    if (!L->has_peek && is_directive_like(t)) {
         L->peeked = *t;
         L->has_peek = 1;
     }
@@ -925,6 +962,8 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
             goto fail;
         }
         if ((rc = check_count(P, &t.loc, type, decl, &a)))
+            goto fail;
+        if ((rc = load_spectrum_file(P, &t, type, decl, &a)))
             goto fail;
         lf_param p = {0};
         p.type = type;
@@ -1954,6 +1993,14 @@ static directive_fn find_directive(const token *t)
     return NULL;
 }
 
+/* A bare word that is not a value: a directive, or a misspelt one (which
+ * then gets its own "unknown directive" error). */
+static int is_directive_like(const token *t)
+{
+    return t->kind == TK_WORD && !tok_is(t, "true") && !tok_is(t, "false") && !is_nonfinite_word(t) &&
+           !tok_is(t, "StartTime") && !tok_is(t, "EndTime") && !tok_is(t, "All");
+}
+
 /* After an error: skips tokens up to the next directive name (or the end),
  * so one run reports every problem of a scene. */
 static void recover(parser *P, lexer *L)
@@ -1965,7 +2012,7 @@ static void recover(parser *P, lexer *L)
             return;
         if (rc) /* a malformed token: the lexer has moved past it */
             continue;
-        if (t.kind == TK_EOF || find_directive(&t))
+        if (t.kind == TK_EOF || is_directive_like(&t))
             return;
         lex_next(P, L, &t);
     }

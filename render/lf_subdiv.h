@@ -18,8 +18,11 @@
  *     sums of the ring weighted by cos and sin of 2 pi j / n; boundary: the
  *     boundary chord and Loop's/Hoppe's across-boundary mask).
  * Boundaries (edges used by one triangle) are the only creases: pbrt-v4 has
- * no crease tags.  The control mesh must be an oriented 2-manifold with
- * boundary; anything else is an error naming the offending edge or vertex.
+ * no crease tags.  The control mesh should be an oriented 2-manifold with
+ * boundary.  Where it is not (an edge used by three triangles, or by two
+ * that run it the same way) the edge is treated as two boundary edges, and
+ * triangles repeating a vertex are dropped, so real-world meshes still
+ * subdivide (pbrt-v4 leaves such edges unshared too).
  */
 #ifndef LF_SUBDIV_H
 #define LF_SUBDIV_H

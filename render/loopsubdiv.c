@@ -23,6 +23,7 @@ typedef struct topo {
     int *fe;               /* 3 per face: index of edge (v[k], v[k+1]) */
     int *vstart;           /* per vertex: a face that uses it, -1 if none */
     unsigned char *vbound; /* per vertex: on a boundary */
+    size_t cut;            /* edges left unshared (non-manifold or misoriented) */
 } topo;
 
 static void topo_free(topo *t)
@@ -78,7 +79,7 @@ static int topo_build(topo *t, size_t nv, size_t nf, const int *fv, lf_error *er
     for (size_t i = 0; i < nv; i++)
         t->vstart[i] = -1;
     int rc = LF_OK;
-    for (size_t f = 0; f < nf && !rc; f++) {
+    for (size_t f = 0; f < nf; f++) {
         for (int k = 0; k < 3; k++) {
             int a = fv[3 * f + k], b = fv[3 * f + NEXT(k)];
             t->vstart[a] = (int)f;
@@ -95,20 +96,17 @@ static int topo_build(topo *t, size_t nv, size_t nf, const int *fv, lf_error *er
                 continue;
             }
             int first = slot_fk[i];
-            if (first < 0) {
-                rc = lf_error_set(err, LF_ERR_PARAM,
-                                  "loopsubdiv: edge (%d, %d) is used by more than two triangles (the mesh must be "
-                                  "a 2-manifold)",
-                                  a, b);
-                break;
-            }
             int g = first / 3, gk = first % 3;
-            if (fv[3 * (size_t)g + gk] != b) {
-                rc = lf_error_set(err, LF_ERR_PARAM,
-                                  "loopsubdiv: triangles %d and %zu run edge (%d, %d) the same way (inconsistent "
-                                  "orientation)",
-                                  g, f, a, b);
-                break;
+            if (first < 0 || fv[3 * (size_t)g + gk] != b) {
+                /* A third triangle on an edge, or two that run it the same
+                 * way: not an oriented 2-manifold there.  The edge is cut
+                 * (this side gets an edge of its own, on the boundary), as
+                 * pbrt-v4 also leaves such edges unshared; the surface may
+                 * crease there but everything stays defined. */
+                t->fn[3 * f + k] = -1;
+                t->fe[3 * f + k] = (int)t->ne++;
+                t->cut++;
+                continue;
             }
             t->fn[3 * f + k] = g;
             t->fn[first] = (int)f;
@@ -350,12 +348,6 @@ int lf_loop_subdivide(const double *P, size_t nv, const int *indices, size_t nt,
         if (indices[i] < 0 || (size_t)indices[i] >= nv)
             return lf_error_set(err, LF_ERR_PARAM, "loopsubdiv: index %d (triangle %zu) is not a vertex (0..%zu)",
                                 indices[i], i / 3, nv - 1);
-    for (size_t f = 0; f < nt; f++) {
-        const int *w = indices + 3 * f;
-        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2])
-            return lf_error_set(err, LF_ERR_PARAM, "loopsubdiv: triangle %zu (%d %d %d) repeats a vertex", f, w[0],
-                                w[1], w[2]);
-    }
     double *curP = malloc(3 * nv * sizeof *curP);
     int *curF = malloc(3 * nt * sizeof *curF);
     int *ring = NULL;
@@ -365,8 +357,19 @@ int lf_loop_subdivide(const double *P, size_t nv, const int *indices, size_t nt,
         return lf_error_set(err, LF_ERR_NOMEM, "loopsubdiv: out of memory");
     }
     memcpy(curP, P, 3 * nv * sizeof *curP);
-    memcpy(curF, indices, 3 * nt * sizeof *curF);
-    size_t cv = nv, cf = nt;
+    /* Triangles that repeat a vertex have no area and no consistent
+     * neighbours: they are dropped. */
+    size_t cf = 0;
+    for (size_t f = 0; f < nt; f++) {
+        const int *w = indices + 3 * f;
+        if (w[0] != w[1] && w[1] != w[2] && w[0] != w[2])
+            memcpy(curF + 3 * cf++, w, 3 * sizeof *w);
+    }
+    if (cf == 0) {
+        free(curP), free(curF);
+        return lf_error_set(err, LF_ERR_PARAM, "loopsubdiv: every triangle repeats a vertex");
+    }
+    size_t cv = nv;
     topo t;
     int rc = topo_build(&t, cv, cf, curF, err);
     for (int level = 0; !rc && level < levels; level++) {

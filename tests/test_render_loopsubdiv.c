@@ -314,18 +314,39 @@ static void test_closed(void)
         lf_ply_free(&m[l]);
 }
 
+/* Not a 2-manifold, or misoriented: the offending edges become boundary
+ * edges (two boundary vertices at one place), so the result is still a
+ * finite surface whose vertex count shows the cut. */
+static void test_non_manifold(void)
+{
+    lf_ply_mesh m;
+    lf_error err = {0};
+    double P[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+    /* two triangles running edge (0,1) the same way: 5 edges + 1 for the cut -> 5 + 6 vertices after one level */
+    int bad_orient[6] = {0, 1, 2, 0, 1, 3};
+    CHECK(lf_loop_subdivide(P, 5, bad_orient, 2, 1, &m, &err) == 0);
+    CHECK(m.n_triangles == 8 && m.n_vertices == 5 + 6);
+    int finite = 1;
+    for (size_t i = 0; i < 3 * m.n_vertices; i++)
+        finite &= isfinite(m.P[i]) && isfinite(m.N[i]);
+    CHECK(finite);
+    lf_ply_free(&m);
+    /* three triangles on edge (0,1): the third's copy of the edge is its own */
+    int three[9] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
+    CHECK(lf_loop_subdivide(P, 5, three, 3, 2, &m, &err) == 0);
+    CHECK(m.n_triangles == 48);
+    lf_ply_free(&m);
+    /* a degenerate triangle is dropped */
+    int degen[6] = {0, 1, 2, 2, 2, 3};
+    CHECK(lf_loop_subdivide(P, 5, degen, 2, 1, &m, &err) == 0 && m.n_triangles == 4);
+    lf_ply_free(&m);
+}
+
 static void test_errors(void)
 {
     lf_ply_mesh m;
     lf_error err = {0};
     double P[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
-    int bad_orient[6] = {0, 1, 2, 0, 1, 3};
-    CHECK(lf_loop_subdivide(P, 4, bad_orient, 2, 1, &m, &err) == LF_ERR_PARAM);
-    CHECK(strstr(err.msg, "orientation") != NULL);
-    lf_error_clear(&err);
-    int three[9] = {0, 1, 2, 1, 0, 3, 0, 1, 3};
-    CHECK(lf_loop_subdivide(P, 4, three, 3, 1, &m, &err) == LF_ERR_PARAM);
-    lf_error_clear(&err);
     int oob[3] = {0, 1, 7};
     CHECK(lf_loop_subdivide(P, 4, oob, 1, 1, &m, &err) == LF_ERR_PARAM);
     CHECK(strstr(err.msg, "index 7") != NULL);
@@ -334,6 +355,9 @@ static void test_errors(void)
     CHECK(lf_loop_subdivide(P, 4, ok, 1, 11, &m, &err) == LF_ERR_PARAM);
     lf_error_clear(&err);
     CHECK(lf_loop_subdivide(P, 4, ok, 1, -1, &m, &err) == LF_ERR_PARAM);
+    lf_error_clear(&err);
+    int all_degenerate[3] = {1, 1, 2};
+    CHECK(lf_loop_subdivide(P, 4, all_degenerate, 1, 1, &m, &err) == LF_ERR_PARAM);
 }
 
 int main(void)
@@ -342,6 +366,7 @@ int main(void)
     test_regular_vertex_limit();
     test_boundary_independent_of_interior();
     test_closed();
+    test_non_manifold();
     test_errors();
     return lf_test_end();
 }

@@ -142,6 +142,22 @@ static void test_gzip_bit_identical(void)
     CHECK_MSG(run("%s gz/main2.pbrt.gz -o gz.exr --quiet --seed 3", LF_LFRENDER) == 0, "%s", out_text);
     CHECK_MSG(same_pixels("plain.exr", "gz.exr"), "gzipped scene differs from the plain one");
 
+    /* a gzipped lens prescription (realistic camera) */
+    CHECK(run("cp %s/scenes/lenses/dgauss.50mm.dat lens.dat && gzip -n -c lens.dat > lensz.dat", LF_SOURCE_DIR) == 0);
+    const char *cam = "LookAt 0 0.5 7  0 0 0  0 1 0\nCamera \"realistic\" \"string lensfile\" \"%s\" "
+                      "\"float aperturediameter\" 10 \"float focusdistance\" 7\n"
+                      "Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24 \"float diagonal\" 35\n"
+                      "Sampler \"sobol\" \"integer pixelsamples\" 4\nWorldBegin\n"
+                      "LightSource \"infinite\" \"rgb L\" [1 1 1]\nInclude \"geo.pbrt\"\n";
+    char lens_scene[1024];
+    snprintf(lens_scene, sizeof lens_scene, cam, "lens.dat");
+    write_file("lens.pbrt", lens_scene);
+    snprintf(lens_scene, sizeof lens_scene, cam, "lensz.dat");
+    write_file("lensz.pbrt", lens_scene);
+    CHECK_MSG(run("%s lens.pbrt -o lens.exr --quiet", LF_LFRENDER) == 0, "%s", out_text);
+    CHECK_MSG(run("%s lensz.pbrt -o lensz.exr --quiet", LF_LFRENDER) == 0, "%s", out_text);
+    CHECK_MSG(same_pixels("lens.exr", "lensz.exr"), "gzipped lens file renders differently");
+
     /* a corrupt gzipped PLY: exit 1, the file named, nothing written */
     CHECK(run("head -c 60 tet.ply.gz > gz/bad.ply.gz && sed 's/tet.ply.gz/bad.ply.gz/' geo.pbrt > gz/geo3.pbrt") == 0);
     snprintf(main_text, sizeof main_text, "%sInclude \"geo3.pbrt\"\n", HEAD);

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 int lf_is_gzip(const void *buf, size_t len)
@@ -127,6 +128,11 @@ int lf_file_read(const char *path, size_t max_bytes, char **data, size_t *len, i
     FILE *f = fopen(path, "rb");
     if (!f)
         return lf_error_set(err, LF_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot open: is a directory", path);
+    }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap + 1);
     int rc = LF_OK;

@@ -3,15 +3,24 @@
  * A hand-written tokenizer feeds a table of directive handlers that keep
  * pbrt-v4's graphics state (BasicSceneBuilder in pbrt-v4's scene.cpp): two
  * CTMs, attribute stack, named coordinate systems, materials, textures and
- * object instances.  Every error names file:line:col; the first error stops
- * the parse and everything built so far is freed.
+ * object instances.  Every error names file:line:col.  Errors are collected:
+ * after one, the parser skips to the next directive name and goes on, up to
+ * max_errors; if there was any, everything built is freed at the end.
+ *
+ * Files are read whole through lf_file_read (gzip detected by its magic
+ * bytes).  Include and Import push the file onto the lexer's stack of
+ * frames, so the token stream continues into the included file and back
+ * out of it, as pbrt-v4's tokenizer does: a parameter list may span the
+ * end of an included file.
  *
  * Where lensfield deliberately differs from pbrt-v4 (all documented at the
  * handler): Include paths are relative to the including file; TransformBegin
  * saves only the CTMs (pbrt-v3 semantics, which is what files that still use
  * it expect); WorldEnd, ColorSpace, Option, MakeNamedMedium and
  * MediumInterface are accepted with a warning; an unclosed AttributeBegin is
- * a warning.
+ * a warning.  Shapes, lights and materials lensfield cannot render are
+ * errors ("not supported") unless lf_parse_opts.allow_unsupported, which
+ * turns them into warnings (docs/scene-format.md).
  */
 #include "lf_scene_desc.h"
 #include "../base/lf_color.h"

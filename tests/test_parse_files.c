@@ -144,6 +144,8 @@ static void test_file_read(void)
     CHECK_MSG(strstr(err.msg, "decompressed") && strstr(err.msg, "limit of 10 bytes"), "%s", err.msg);
     lf_error_clear(&err);
     CHECK(lf_file_read(path_of("missing"), 10, &a, &na, NULL, &err) == LF_ERR_IO && strstr(err.msg, "missing"));
+    lf_error_clear(&err);
+    CHECK(lf_file_read(tmpdir, 10, &a, &na, NULL, &err) == LF_ERR_IO && strstr(err.msg, "is a directory"));
 }
 
 static const char *HEAD = "Camera \"perspective\"\nWorldBegin\n";

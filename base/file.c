@@ -128,10 +128,13 @@ int lf_file_read(const char *path, size_t max_bytes, char **data, size_t *len, i
     FILE *f = fopen(path, "rb");
     if (!f)
         return lf_error_set(err, LF_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* Directories and devices (/dev/zero would fill memory up to the limit)
+     * are refused; regular files and pipes are read. */
     struct stat st;
-    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+    if (fstat(fileno(f), &st) == 0 && (S_ISDIR(st.st_mode) || S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode))) {
         fclose(f);
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot open: is a directory", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot open: %s", path,
+                            S_ISDIR(st.st_mode) ? "is a directory" : "is a device, not a file");
     }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap + 1);

@@ -600,9 +600,21 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     char where[512];
     loc_prefix(where, sizeof where, &sh->e.loc);
-    if (sh->e.params.count && lf_params_peek(&sh->e.params, "alpha")) {
+    const lf_param *alpha = sh->e.params.count ? lf_params_peek(&sh->e.params, "alpha") : NULL;
+    if (alpha) {
+        /* "float alpha" 1 changes nothing; anything else cuts the shape,
+         * which lensfield cannot: the shape would show where the scene
+         * has a hole (the unsupported rule, docs/scene-format.md). */
+        int opaque = alpha->type == LF_PT_FLOAT && alpha->n_nums == 1 && alpha->nums[0] == 1.0;
         lf_params_find(&sh->e.params, "alpha");
-        lf_warn_append(&b->s->warnings, "%s: warning: \"alpha\" cut-outs are not supported; the shape is opaque", where);
+        if (!opaque && !b->d->allow_unsupported)
+            return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
+                                "%s: Shape \"%s\": \"alpha\" cut-outs are not supported (--allow-unsupported renders "
+                                "the shape opaque)",
+                                where, sh->e.type);
+        if (!opaque)
+            lf_warn_append(&b->s->warnings, "%s: warning: \"alpha\" cut-outs are not supported; the shape is opaque",
+                           where);
     }
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {

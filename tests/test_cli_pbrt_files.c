@@ -222,12 +222,13 @@ static void test_refused(void)
         "MakeNamedMaterial \"m\" \"string type\" \"hair\"\nShape \"sphere\"",
         "LightSource \"goniometric\" \"string filename\" \"x.exr\"",
         "LightSource \"projection\" \"string filename\" \"x.exr\"",
+        "Shape \"sphere\" \"float alpha\" 0.5",
         "Texture \"t\" \"float\" \"wrinkled\"\nShape \"sphere\"",
     };
     const char *directive[] = {"Shape \"curve\"", "Shape \"cylinder\"", "unknown shape \"teapot\"",
                                "Material \"hair\"", "Material \"measured\"", "Material \"subsurface\"",
                                "MakeNamedMaterial \"hair\"", "LightSource \"goniometric\"",
-                               "LightSource \"projection\"", "wrinkled"};
+                               "LightSource \"projection\"", "\"alpha\" cut-outs", "wrinkled"};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
         char text[2048];
         snprintf(text, sizeof text, "%s%s\n", HEAD, refused[i]);
@@ -241,7 +242,7 @@ static void test_refused(void)
         CHECK_MSG(!exists("refused.exr"), "%s: an output was written", refused[i]);
         /* --allow-unsupported renders the rest with a warning (except what
          * only the builder judges, textures, which stay errors) */
-        if (i < 9) {
+        if (i < 10) {
             rc = run("%s refused.pbrt -o refused.exr --quiet --allow-unsupported", LF_LFRENDER);
             CHECK_MSG(rc == 0 && exists("refused.exr") && strstr(out_text, "warning:") &&
                           strstr(out_text, "not supported"),

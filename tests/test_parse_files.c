@@ -146,6 +146,9 @@ static void test_file_read(void)
     CHECK(lf_file_read(path_of("missing"), 10, &a, &na, NULL, &err) == LF_ERR_IO && strstr(err.msg, "missing"));
     lf_error_clear(&err);
     CHECK(lf_file_read(tmpdir, 10, &a, &na, NULL, &err) == LF_ERR_IO && strstr(err.msg, "is a directory"));
+    lf_error_clear(&err);
+    CHECK(lf_file_read("/dev/zero", LF_FILE_MAX_DEFAULT, &a, &na, NULL, &err) == LF_ERR_IO &&
+          strstr(err.msg, "is a device"));
 }
 
 static const char *HEAD = "Camera \"perspective\"\nWorldBegin\n";

@@ -208,27 +208,27 @@ static int lx_push(lexer *X, char *owned, const char *text, size_t len, const ch
         X->fr = n;
         X->cap_fr = nc;
     }
+    /* Room in `done` for every open frame, so popping never allocates
+     * (and never has to free a text that tokens may still point into). */
+    if (X->cap_done < X->n_done + X->n_fr + 1) {
+        int nc = 2 * (X->n_done + X->n_fr + 1);
+        char **n = realloc(X->done, (size_t)nc * sizeof *n);
+        if (!n)
+            return -1;
+        X->done = n;
+        X->cap_done = nc;
+    }
     X->fr[X->n_fr++] = (lx_frame){owned, text, len, 0, 1, 1, file, dir};
     return 0;
 }
 
-/* Ends the innermost file; its text is freed at the next directive. */
+/* Ends the innermost file; its text is freed at the next directive (lx_push
+ * reserved the slot). */
 static int lx_pop(lexer *X)
 {
     lx_frame *F = &X->fr[--X->n_fr];
-    if (!F->owned)
-        return 0;
-    if (X->n_done == X->cap_done) {
-        int nc = X->cap_done ? 2 * X->cap_done : 8;
-        char **n = realloc(X->done, (size_t)nc * sizeof *n);
-        if (!n) {
-            free(F->owned); /* only reachable on an earlier allocation failure */
-            return -1;
-        }
-        X->done = n;
-        X->cap_done = nc;
-    }
-    X->done[X->n_done++] = F->owned;
+    if (F->owned)
+        X->done[X->n_done++] = F->owned;
     return 0;
 }
 

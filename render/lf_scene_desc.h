@@ -110,6 +110,9 @@ typedef struct lf_scene_desc {
      * docs/scene-format.md) were dropped with a warning instead of failing;
      * the scene builder does the same for what only it can judge. */
     int allow_unsupported;
+    /* Directory of the top-level scene file (kept in strings): where pbrt-v4
+     * resolves relative file names; the scene builder falls back to it. */
+    const char *scene_dir;
 
     /* Storage owned by the description (file names for lf_loc, base dirs). */
     char **strings; size_t n_strings;

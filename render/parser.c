@@ -34,6 +34,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #define MAX_INCLUDE_DEPTH 64
 
@@ -485,6 +486,7 @@ struct parser {
     size_t errors_len, errors_cap;
     int n_errors, max_errors, first_code;
     int allow_unsupported;
+    const char *main_dir; /* directory of the top-level file */
 };
 
 static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
@@ -640,6 +642,7 @@ static int set_coordsys(parser *P, const char *name, const lf_transform xf[2])
 
 static int is_nonfinite_word(const token *t);
 static int join_path(const char *dir, const char *rel, char **out);
+static int resolve_path(parser *P, const char *dir, const char *rel, char **out);
 
 static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *out)
 {
@@ -839,7 +842,7 @@ static int load_spectrum_file(parser *P, const token *t, lf_param_type type, con
     if (type != LF_PT_SPECTRUM || a->n_strs != 1 || a->n_nums || lf_named_spectrum_rgb(a->strs[0], &dummy) == 0)
         return LF_OK;
     char *path;
-    if (join_path(t->dir, a->strs[0], &path))
+    if (resolve_path(P, t->dir, a->strs[0], &path))
         return nomem(P);
     double *v;
     size_t n;
@@ -1405,6 +1408,29 @@ static int join_path(const char *dir, const char *rel, char **out)
     return *out ? 0 : -1;
 }
 
+/* A file named in a scene: relative to the directory of the file that names
+ * it (`dir`); if nothing is there, relative to the top-level file's
+ * directory, which is where pbrt-v4 looks (its scenes name nested files
+ * that way).  The first candidate is returned when neither exists, so the
+ * message names the path lensfield tried first. */
+static int resolve_path(parser *P, const char *dir, const char *rel, char **out)
+{
+    if (join_path(dir, rel, out))
+        return -1;
+    if (rel[0] == '/' || !P->main_dir || (dir && strcmp(dir, P->main_dir) == 0) || access(*out, F_OK) == 0)
+        return 0;
+    char *alt;
+    if (join_path(P->main_dir, rel, &alt))
+        return -1;
+    if (access(alt, F_OK) == 0) {
+        free(*out);
+        *out = alt;
+    } else {
+        free(alt);
+    }
+    return 0;
+}
+
 /* The directory part of path: "a/b/c.pbrt" -> "a/b", "c.pbrt" -> ".". */
 static char *dir_of(const char *path)
 {
@@ -1454,9 +1480,8 @@ static int push_file(parser *P, lexer *X, const char *path, const lf_loc *from)
 }
 
 /* Include and Import: pbrt-v4 resolves the name against the directory of the
- * main scene file; lensfield uses the directory of the including file,
- * which is the same for the common single-directory layout and also works
- * for nested directories.  Import is read like Include (pbrt-v4 parses it in
+ * main scene file; lensfield tries the directory of the including file
+ * first, then the main file's (resolve_path), so both layouts work.  Import is read like Include (pbrt-v4 parses it in
  * parallel; the result is the same). */
 static int d_include(parser *P, lexer *L, const token *dir)
 {
@@ -1474,7 +1499,7 @@ static int d_include(parser *P, lexer *L, const token *dir)
                     (int)dir->n, dir->s, MAX_INCLUDE_DEPTH);
     }
     char *path;
-    if (join_path(dir->dir, name, &path)) {
+    if (resolve_path(P, dir->dir, name, &path)) {
         free(name);
         return nomem(P);
     }
@@ -2203,6 +2228,8 @@ int lf_scene_parse_file_ex(const char *path, const lf_parse_opts *opts, lf_scene
     if (!rc)
         rc = push_file(&P, &L, path, NULL);
     if (!rc)
+        P.main_dir = out->scene_dir = L.fr[0].dir;
+    if (!rc)
         rc = parse_run(&P, &L, &eof);
     return parse_end(&P, &L, rc, &eof, errors);
 }
@@ -2232,6 +2259,8 @@ int lf_scene_parse_string_ex(const char *text, const char *name, const lf_parse_
     lf_loc eof = {name, 1, 1};
     if (!rc && lx_push(&L, NULL, text ? text : "", text ? strlen(text) : 0, file, dir))
         rc = nomem(&P);
+    if (!rc)
+        P.main_dir = out->scene_dir = dir;
     if (!rc)
         rc = parse_run(&P, &L, &eof);
     return parse_end(&P, &L, rc, &eof, errors);

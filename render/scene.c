@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "lf_subdiv.h"
 #include "render_internal.h"
@@ -306,6 +307,14 @@ static int shape_plymesh(builder *b, lf_shape_desc *sh, const motion *mo)
         snprintf(path, sizeof path, "%s", fn);
     else
         snprintf(path, sizeof path, "%s/%s", sh->base_dir, fn);
+    /* Not next to the file that names it: relative to the top-level file,
+     * where pbrt-v4 looks (nested geometry files name meshes that way). */
+    if (fn[0] != '/' && access(path, F_OK) != 0 && b->d->scene_dir && b->d->scene_dir[0]) {
+        char alt[4096];
+        snprintf(alt, sizeof alt, "%s/%s", b->d->scene_dir, fn);
+        if (access(alt, F_OK) == 0)
+            memcpy(path, alt, sizeof path);
+    }
     lf_ply_mesh pm;
     lf_error perr = {0};
     if (lf_ply_read(path, &pm, &perr))

@@ -142,6 +142,14 @@ static void test_gzip_bit_identical(void)
     CHECK_MSG(run("%s gz/main2.pbrt.gz -o gz.exr --quiet --seed 3", LF_LFRENDER) == 0, "%s", out_text);
     CHECK_MSG(same_pixels("plain.exr", "gz.exr"), "gzipped scene differs from the plain one");
 
+    /* a mesh named relative to the main file from a nested include (pbrt-v4's
+     * rule) renders like the flat layout */
+    CHECK(run("mkdir -p nest/geometry && cp tet.ply nest/geometry/ && cp au.spd.orig nest/au.spd && "
+              "sed 's|\"tet.ply\"|\"geometry/tet.ply\"|' geo.pbrt > nest/geometry/geo.pbrt && "
+              "sed 's|Include \"geo.pbrt\"|Include \"geometry/geo.pbrt\"|' main.pbrt > nest/main.pbrt") == 0);
+    CHECK_MSG(run("%s nest/main.pbrt -o nest.exr --quiet --seed 3", LF_LFRENDER) == 0, "%s", out_text);
+    CHECK_MSG(same_pixels("plain.exr", "nest.exr"), "nested layout renders differently");
+
     /* a gzipped lens prescription (realistic camera) */
     CHECK(run("cp %s/scenes/lenses/dgauss.50mm.dat lens.dat && gzip -n -c lens.dat > lensz.dat", LF_SOURCE_DIR) == 0);
     const char *cam = "LookAt 0 0.5 7  0 0 0  0 1 0\nCamera \"realistic\" \"string lensfile\" \"%s\" "

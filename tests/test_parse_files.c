@@ -213,6 +213,38 @@ static void test_include_tokens(void)
     CHECK_MSG(strstr(err.msg, "\\x01\\x02garbage"), "%s", err.msg);
 }
 
+/* pbrt-v4 resolves names against the main file's directory; lensfield tries
+ * the naming file's directory first, then the main one. */
+static void test_nested_paths(void)
+{
+    write_text("geometry/a.pbrt", "Include \"geometry/b.pbrt\"\n");      /* main-relative */
+    write_text("geometry/b.pbrt", "Include \"c.pbrt\"\n");               /* relative to itself */
+    write_text("geometry/c.pbrt", "Material \"dielectric\" \"spectrum eta\" \"spds/test.spd\"\nShape \"disk\"\n");
+    char text[256];
+    snprintf(text, sizeof text, "%sInclude \"geometry/a.pbrt\"\n", HEAD);
+    write_text("nested.pbrt", text);
+    lf_scene_desc d;
+    lf_error err = {0};
+    int rc = lf_scene_parse_file(path_of("nested.pbrt"), &d, &err);
+    CHECK_MSG(rc == 0, "%s", err.msg);
+    if (!rc) {
+        CHECK(d.n_shapes == 1 && d.n_materials == 1 && strstr(d.shapes[0].e.loc.file, "geometry/c.pbrt"));
+        const lf_param *p = lf_params_peek(&d.materials[0].e.params, "eta");
+        CHECK(p && p->n_nums == 8 && p->nums[0] == 300);
+        CHECK(d.scene_dir && strcmp(d.scene_dir, tmpdir) == 0);
+        lf_scene_desc_free(&d);
+    }
+    /* neither place: the message names the first candidate */
+    write_text("geometry/d.pbrt", "Include \"nowhere.pbrt\"\n");
+    snprintf(text, sizeof text, "%sInclude \"geometry/d.pbrt\"\n", HEAD);
+    write_text("nested2.pbrt", text);
+    lf_error_clear(&err);
+    CHECK(lf_scene_parse_file(path_of("nested2.pbrt"), &d, &err) == LF_ERR_IO);
+    CHECK_MSG(strstr(err.msg, "geometry/d.pbrt:1:1: cannot open included file") &&
+                  strstr(err.msg, "geometry/nowhere.pbrt"),
+              "%s", err.msg);
+}
+
 /* .spd files: the same numbers as inline pairs, gzipped or not. */
 static void test_spectrum_files(void)
 {
@@ -439,9 +471,12 @@ int main(void)
     char sub[300];
     snprintf(sub, sizeof sub, "%s/spds", tmpdir);
     mkdir(sub, 0755);
+    snprintf(sub, sizeof sub, "%s/geometry", tmpdir);
+    mkdir(sub, 0755);
     test_file_read();
     test_include_tokens();
     test_spectrum_files();
+    test_nested_paths();
     test_metal_spectrum_rgb();
     test_errors_collected();
     char cmd[300];

@@ -322,7 +322,32 @@ static int limit_surface(const topo *t, const double *P, float *outP, float *out
         double len = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
         for (int c = 0; c < 3; c++) {
             outP[3 * v + c] = (float)p[c];
-            outN[3 * v + c] = len > 0 ? (float)(N[c] / len) : 0.f;
+            outN[3 * v + c] = len > 0 && isfinite(len) ? (float)(N[c] / len) : 0.f;
+        }
+    }
+    /* Where the tangents are parallel (a collapsed neighbourhood), the
+     * normal of the surrounding triangles, on the same side as the tangent
+     * normals (against the winding, see lf_subdiv.h). */
+    for (size_t f = 0; f < t->nf; f++) {
+        const int *w = t->fv + 3 * f;
+        int needs = 0;
+        for (int k = 0; k < 3; k++)
+            needs |= t->vstart[w[k]] >= 0 && outN[3 * w[k]] == 0.f && outN[3 * w[k] + 1] == 0.f &&
+                     outN[3 * w[k] + 2] == 0.f;
+        if (!needs)
+            continue;
+        double u[3], e[3];
+        sub3(L + 3 * (size_t)w[1], L + 3 * (size_t)w[0], u);
+        sub3(L + 3 * (size_t)w[2], L + 3 * (size_t)w[0], e);
+        double n[3] = {-(u[1] * e[2] - u[2] * e[1]), -(u[2] * e[0] - u[0] * e[2]), -(u[0] * e[1] - u[1] * e[0])};
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 0))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            float *o = outN + 3 * (size_t)w[k];
+            if (o[0] == 0.f && o[1] == 0.f && o[2] == 0.f)
+                for (int c = 0; c < 3; c++)
+                    o[c] = (float)(n[c] / len);
         }
     }
     free(L);

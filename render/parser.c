@@ -1568,7 +1568,7 @@ static int d_option(parser *P, lexer *L, const token *dir)
     return rc;
 }
 
-/* pbrt-v4's shape, light and material types, and those of them lensfield
+/* pbrt-v4's shape, light, material and texture types, and those of them lensfield
  * cannot render (docs/scene-format.md has the whole table).  Leaving one out
  * changes what the image shows, so it is an error unless the user asked for
  * --allow-unsupported (lf_parse_opts.allow_unsupported). */
@@ -1581,6 +1581,11 @@ static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse",
                                              "diffusetransmission", "hair", "interface", "measured", "mix",
                                              "subsurface",      "thindielectric", "none", "", NULL};
 static const char *const refused_materials[] = {"hair", "measured", "subsurface", NULL};
+static const char *const pbrt_textures[] = {"bilerp", "checkerboard", "constant", "directionmix", "dots", "fbm",
+                                            "imagemap", "marble", "mix", "ptex", "scale", "windy", "wrinkled",
+                                            NULL};
+static const char *const refused_textures[] = {"directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled",
+                                               NULL};
 
 static int in_list(const char *const *list, const char *s)
 {
@@ -1598,7 +1603,10 @@ static int check_supported(parser *P, const token *dir, const char *type, const 
     if (in_list(known, type) && !in_list(refused, type))
         return 0;
     /* pbrt-v4 calls it unknown when it is not one of its own types. */
-    const char *what = known == pbrt_shapes ? "shape" : known == pbrt_lights ? "light" : "material";
+    const char *what = known == pbrt_shapes      ? "shape"
+                       : known == pbrt_lights    ? "light"
+                       : known == pbrt_textures  ? "texture"
+                                                 : "material";
     int is_known = in_list(known, type);
     if (P->allow_unsupported) {
         if (is_known)
@@ -1761,6 +1769,15 @@ static int d_texture(parser *P, lexer *L, const token *dir)
         rc = parse_params(P, L, &t->e.params);
     if (!rc)
         rc = merge_attrs(P, &t->e.params, ATTR_TEXTURE);
+    if (!rc) {
+        rc = check_supported(P, dir, t->e.type, pbrt_textures, refused_textures, "rendered as \"constant\" 1");
+        if (rc == 1) { /* pbrt's constant texture, value 1 */
+            free(t->e.type);
+            t->e.type = dup_cstr("constant");
+            lf_params_free(&t->e.params);
+            rc = t->e.type ? LF_OK : nomem(P);
+        }
+    }
     strmap *names = t->is_float ? &P->float_tex_map : &P->spectrum_tex_map;
     if (!rc) {
         int prev = strmap_get(names, t->name);

@@ -53,8 +53,9 @@ static void usage(FILE *f)
                "  --checkpoint PATH where checkpoints go\n"
                "  --resume          continue from the checkpoint (same scene and settings)\n"
                "  --camera-plugin L load camera types from the shared object L\n"
-               "  --allow-unsupported  render a scene whose shapes, lights or materials lensfield\n"
-               "                    cannot render, leaving them out with a warning (default: exit 1)\n"
+               "  --allow-unsupported  render a scene with shapes, lights, materials, textures or\n"
+               "                    alpha cut-outs lensfield cannot render: left out or substituted,\n"
+               "                    each with a warning (default: exit 1, docs/scene-format.md)\n"
                "\n"
                "       lfrender merge PART.exr... -o OUT.exr   sum parts into the unsplit image, bit for bit\n");
 }

@@ -1,6 +1,8 @@
 #include "lf_color.h"
+#include "lf_file.h"
 
 #include <pthread.h>
+#include <stdlib.h>
 
 #include <string.h>
 
@@ -137,6 +139,15 @@ lf_vec3 lf_spectrum_pairs_rgb(const double *lambdas, const double *values, size_
     return c;
 }
 
+/* CIE standard illuminant A: relative spectral power (CIE 15:2004 eq. 2.1). */
+static double illum_a_fn(double lambda_nm, const void *ctx)
+{
+    (void)ctx;
+    const double c2 = 1.435e7; /* nm K, the value that defines A */
+    return 100.0 * pow(560.0 / lambda_nm, 5.0) * (exp(c2 / (2848.0 * 560.0)) - 1.0) /
+           (exp(c2 / (2848.0 * lambda_nm)) - 1.0);
+}
+
 typedef struct named_spectrum {
     const char *name;
     float rgb[3];
@@ -183,18 +194,39 @@ int lf_named_spectrum_rgb(const char *name, lf_vec3 *out)
             *out = lf_v3(named_spectra[i].rgb[0], named_spectra[i].rgb[1], named_spectra[i].rgb[2]);
             return 0;
         }
-    /* Standard illuminants (stdillum-D65, stdillum-A, illum-acesD60, ...):
-     * lights are normalised to luminance 1 and the film does no white
-     * balance, so all of them are taken as the sRGB white (1,1,1).  This
-     * loses the tint of illuminant A or F-series lamps. */
-    static const char *const illuminants[] = {
-        "stdillum-A",   "stdillum-D50", "stdillum-D65", "stdillum-F1",  "stdillum-F2",
-        "stdillum-F3",  "stdillum-F4",  "stdillum-F5",  "stdillum-F6",  "stdillum-F7",
-        "stdillum-F8",  "stdillum-F9",  "stdillum-F10", "stdillum-F11", "stdillum-F12",
-        "illum-acesD60"};
+    /* Standard illuminants.  Lights are normalised to luminance 1, so an
+     * illuminant is fully described by its chromaticity: its RGB at Y = 1.
+     * Illuminant A is CIE's Planckian formula (CIE 15:2004, S_A with
+     * c2 = 1.435e-2 m K at 2848 K), integrated like any other spectrum; the
+     * daylight and fluorescent illuminants use the CIE 1931 2-degree
+     * chromaticities of their tabulated spectra (CIE 15:2004 tables T.3 and
+     * T.8; ACES D60 as SMPTE ST 2065-1 defines it).  D65 is the sRGB white,
+     * so it gives (1, 1, 1); A and the warm F lamps come out orange. */
+    if (strcmp(name, "stdillum-A") == 0) {
+        double xyz[3];
+        integrate_xyz(illum_a_fn, NULL, xyz);
+        *out = xyz_to_rgb_unit_luminance(xyz);
+        return 0;
+    }
+    static const struct {
+        const char *name;
+        double x, y;
+    } illuminants[] = {
+        {"stdillum-D50", 0.34567, 0.35850}, {"stdillum-D65", 0.31272, 0.32903}, {"illum-acesD60", 0.32168, 0.33767},
+        {"stdillum-F1", 0.31310, 0.33727},  {"stdillum-F2", 0.37208, 0.37529},  {"stdillum-F3", 0.40910, 0.39430},
+        {"stdillum-F4", 0.44018, 0.40329},  {"stdillum-F5", 0.31379, 0.34531},  {"stdillum-F6", 0.37790, 0.38835},
+        {"stdillum-F7", 0.31292, 0.32933},  {"stdillum-F8", 0.34588, 0.35875},  {"stdillum-F9", 0.37417, 0.37281},
+        {"stdillum-F10", 0.34609, 0.35986}, {"stdillum-F11", 0.38052, 0.37713}, {"stdillum-F12", 0.43695, 0.40441},
+    };
     for (size_t i = 0; i < sizeof illuminants / sizeof illuminants[0]; i++)
-        if (strcmp(illuminants[i], name) == 0) {
-            *out = lf_v3(1.f, 1.f, 1.f);
+        if (strcmp(illuminants[i].name, name) == 0) {
+            double x = illuminants[i].x, y = illuminants[i].y;
+            lf_vec3 c = lf_xyz_to_linear_srgb(x / y, 1.0, (1.0 - x - y) / y);
+            /* D65 is the sRGB white point: snap the 1e-4 rounding of the
+             * published chromaticities so it is exactly white. */
+            if (strcmp(name, "stdillum-D65") == 0)
+                c = lf_v3(1.f, 1.f, 1.f);
+            *out = c;
             return 0;
         }
     return -1;
@@ -226,4 +258,71 @@ lf_vec3 lf_wavelength_rgb_weight(double lambda_nm)
     lf_cie_xyz_bar(lambda_nm, xyz);
     lf_vec3 c = lf_xyz_to_linear_srgb(xyz[0], xyz[1], xyz[2]);
     return lf_v3((float)(c.x / norm[0]), (float)(c.y / norm[1]), (float)(c.z / norm[2]));
+}
+
+int lf_spectrum_file_read(const char *path, double **nums, size_t *n_pairs, lf_error *err)
+{
+    *nums = NULL;
+    *n_pairs = 0;
+    char *text;
+    size_t len;
+    /* Measured spectra have at most a few thousand samples; 64 MiB is far
+     * beyond any real file and keeps a wrong path from eating memory. */
+    int rc = lf_file_read(path, (size_t)64 << 20, &text, &len, NULL, err);
+    if (rc)
+        return rc;
+    size_t n = 0, cap = 0;
+    double *v = NULL;
+    int line = 1;
+    const char *p = text, *end = text + len;
+    while (p < end) {
+        char c = *p;
+        if (c == '\n') {
+            line++;
+            p++;
+        } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v' || c == ',') {
+            p++;
+        } else if (c == '#') {
+            while (p < end && *p != '\n')
+                p++;
+        } else {
+            char *e;
+            double x = strtod(p, &e);
+            if (e == p || !isfinite(x) || (e < end && !strchr(" \t\r\n\f\v,#", *e))) {
+                const char *w = p;
+                while (w < end && !strchr(" \t\r\n\f\v,#", *w))
+                    w++;
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: expected a number, got \"%.*s\"", path,
+                                  line, (int)((w - p) > 40 ? 40 : (w - p)), p);
+                break;
+            }
+            if (n == cap) {
+                cap = cap ? 2 * cap : 256;
+                double *nv = realloc(v, cap * sizeof *nv);
+                if (!nv) {
+                    rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", path);
+                    break;
+                }
+                v = nv;
+            }
+            if (n % 2 == 0 && n >= 2 && !(x > v[n - 2])) {
+                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: wavelengths must increase (%g after %g)",
+                                  path, line, x, v[n - 2]);
+                break;
+            }
+            v[n++] = x;
+            p = e;
+        }
+    }
+    free(text);
+    if (!rc && (n < 2 || n % 2))
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: spectrum file needs (wavelength, value) pairs, found %zu number%s",
+                          path, n, n == 1 ? "" : "s");
+    if (rc) {
+        free(v);
+        return rc;
+    }
+    *nums = v;
+    *n_pairs = n / 2;
+    return LF_OK;
 }

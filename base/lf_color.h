@@ -68,9 +68,16 @@ lf_vec3 lf_spectrum_pairs_rgb(const double *lambdas, const double *values, size_
 /* pbrt-v4's built-in named spectra as RGB triples: "metal-<M>-eta" and
  * "metal-<M>-k" for M in Ag Al Au Cu CuZn MgO TiO2, "glass-<G>" for G in BK7
  * BAF10 FK51A LASF9 F5 F10 F11 (their refractive index n_d, grey), and the
- * illuminants "stdillum-*" / "illum-*" (white, see color.c).
+ * illuminants "stdillum-A", "-D50", "-D65", "-F1".."-F12" and
+ * "illum-acesD60" (their colour at luminance 1, see color.c).
  * Returns 0 and sets *out, or -1 if the name is unknown. */
 int lf_named_spectrum_rgb(const char *name, lf_vec3 *out);
+
+/* Reads a pbrt spectrum file (".spd"): whitespace-separated (wavelength nm,
+ * value) pairs, '#' starts a comment to the end of the line; the file may be
+ * gzipped.  *nums receives 2 * *n_pairs numbers (malloc'ed).  Wavelengths
+ * must increase.  Errors name path:line. */
+int lf_spectrum_file_read(const char *path, double **nums, size_t *n_pairs, lf_error *err);
 
 /* Spectral camera rays (dispersion): a camera that samples wavelength picks
  * lambda uniformly in [LF_LAMBDA_MIN, LF_LAMBDA_MAX] nm; the radiance it

@@ -336,7 +336,7 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
             if (lf_named_spectrum_rgb(p->strs[0], &c)) {
                 lf_error_set(&ps->error, LF_ERR_PARAM,
                              "%s:%d:%d: spectrum parameter \"%s\": unknown named spectrum \"%s\" "
-                             "(spectrum files are not supported)",
+                             "(the scene parser reads spectrum files)",
                              f, p->loc.line, p->loc.col, p->name, p->strs[0]);
                 return 1;
             }

@@ -6,6 +6,7 @@
  * SampleExitPupil); W. Smith, Modern Lens Design (y-nu trace).
  */
 #include "lens.h"
+#include "../base/lf_file.h"
 
 #include <errno.h>
 #include <float.h>
@@ -168,32 +169,12 @@ fail:
 int lf_lens_load(const char *path, lf_lens *lens, char *err, size_t err_size)
 {
     memset(lens, 0, sizeof *lens);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, err_size, "%s: cannot open lens file: %s", path, strerror(errno));
-        return -1;
-    }
-    size_t cap = 4096, len = 0;
-    char *buf = malloc(cap);
-    size_t got;
-    while (buf && (got = fread(buf + len, 1, cap - len - 1, f)) > 0) {
-        len += got;
-        if (len + 1 >= cap) {
-            if (cap > (1u << 24))
-                break;
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    fclose(f);
-    if (!buf) {
-        snprintf(err, err_size, "%s: out of memory", path);
+    /* The prescription may be gzipped (the magic bytes decide). */
+    char *buf;
+    size_t len;
+    lf_error ferr = {0};
+    if (lf_file_read(path, (size_t)1 << 24, &buf, &len, NULL, &ferr)) {
+        snprintf(err, err_size, "lens file %s", ferr.msg);
         return -1;
     }
     buf[len] = 0;

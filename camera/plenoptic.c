@@ -665,11 +665,14 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
            c->image_pitch_px);
     {
         /* Ng 2005's range of exact refocusing (docs/lightfield.md, "Refocusable
-         * range"): a sub-aperture view sees the aperture through a slice D/P
-         * wide, so a point imaged at alpha z_i blurs on the MLA by
-         * |1 - 1/alpha| D / P; it stays within one microlens (one view pixel)
-         * while |1 - 1/alpha| <= P p / D.  In disparity: |d| <= 1 px/view. */
-        double b = c->image_pitch_px * c->pitch / D, zo = c->focus_distance;
+         * range"): a sub-aperture view sees the aperture through a slice
+         * (D + p)/P wide (the P pixels under a microlens span its image of the
+         * aperture, p (z_i + d_s)/z_i on the sensor), so a point imaged at
+         * alpha z_i blurs on the MLA by |1 - 1/alpha| (D + p)/P; it stays
+         * within one microlens (one view pixel) while
+         * |1 - 1/alpha| <= P p / (D + p) (Ng's P p / D for p << D).  In
+         * disparity: |d| <= 1 px/view. */
+        double b = c->image_pitch_px * c->pitch / (D + c->pitch), zo = c->focus_distance;
         double inv_near = (isinf(zo) ? 0.0 : 1.0 / zo) + b / zi, inv_far = (isinf(zo) ? 0.0 : 1.0 / zo) - b / zi;
         char far[64];
         if (inv_far > 0.0)
@@ -681,7 +684,7 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
             snprintf(amax, sizeof amax, "%.6g", 1.0 / (1.0 - b));
         else
             snprintf(amax, sizeof amax, "infinity");
-        LF_CAM_APPEND("refocusable range (Ng 2005, |1 - 1/alpha| <= P p / D = %.4g; disparity within +-1 px/view): "
+        LF_CAM_APPEND("refocusable range (Ng 2005, |1 - 1/alpha| <= P p / (D + p) = %.4g; disparity within +-1 px/view): "
                "alpha %.6g .. %s, depths %.4g m .. %s; each sub-aperture view has the depth of field of f/%.3g "
                "(f/N x %.4g views)%s\n",
                b, 1.0 / (1.0 + b), amax, 1.0 / inv_near, far, c->fstop * c->image_pitch_px, c->image_pitch_px,

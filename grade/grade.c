@@ -1025,8 +1025,6 @@ static int compare(compare_job *j, submission *s, lf_error *err)
             if (instantiate(v, v->base * exp(ll[q]), &inst))
                 continue;
             rr[q] = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
-            if (getenv("LF_GRADE_DEBUG"))
-                fprintf(stderr, "search %s %s factor %.4f [%s]: %.3f\n", j->c->id, v->name, exp(ll[q]), inst.replace[0], rr[q]);
             free_instance(&inst);
             if (rr[q] < bestr)
                 bestr = rr[q], bi = q;

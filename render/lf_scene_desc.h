@@ -118,6 +118,14 @@ typedef struct lf_scene_desc {
      * "file:line:col: warning: ...".  NULL if none. */
     char *warnings;
 
+    /* Set from lf_parse_opts: directives lensfield refuses (see
+     * docs/scene-format.md) were dropped with a warning instead of failing;
+     * the scene builder does the same for what only it can judge. */
+    int allow_unsupported;
+    /* Directory of the top-level scene file (kept in strings): where pbrt-v4
+     * resolves relative file names; the scene builder falls back to it. */
+    const char *scene_dir;
+
     /* Storage owned by the description (file names for lf_loc, base dirs). */
     char **strings; size_t n_strings;
 } lf_scene_desc;
@@ -130,6 +138,23 @@ int lf_scene_parse_file(const char *path, lf_scene_desc *out, lf_error *err);
  * Include paths (its directory). */
 int lf_scene_parse_string(const char *text, const char *name, lf_scene_desc *out, lf_error *err);
 void lf_scene_desc_free(lf_scene_desc *d);
+
+/* Errors are collected: after an error the parser goes on at the next
+ * directive, so one run reports every problem (up to max_errors). */
+#define LF_PARSE_MAX_ERRORS 20
+typedef struct lf_parse_opts {
+    int allow_unsupported; /* shapes, lights, materials lensfield cannot render
+                              are left out with a warning instead of failing */
+    int max_errors;        /* 0: LF_PARSE_MAX_ERRORS */
+} lf_parse_opts;
+
+/* As above; opts may be NULL (defaults).  On failure, err holds the first
+ * error and *errors (when errors is not NULL) every error found, one per
+ * line, malloc'ed (free it); on success *errors is NULL. */
+int lf_scene_parse_file_ex(const char *path, const lf_parse_opts *opts, lf_scene_desc *out, lf_error *err,
+                           char **errors);
+int lf_scene_parse_string_ex(const char *text, const char *name, const lf_parse_opts *opts, lf_scene_desc *out,
+                             lf_error *err, char **errors);
 
 /* A triangle mesh as read from a PLY file (plymesh) - quads are split into
  * two triangles, as pbrt does. Arrays are malloc'ed; free with lf_ply_free. */

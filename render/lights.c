@@ -331,7 +331,8 @@ double lf_light_power(const lf_scene *s, const lf_light *l)
 
 /* ---- LightSource directives ---- */
 
-static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *skip, lf_error *err)
+static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *skip, int allow_unsupported,
+                           lf_error *err)
 {
     lf_paramset *ps = &ld->e.params;
     char where[512];
@@ -436,6 +437,11 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
                 l->L = lf_scale(L, (float)(scale * E / (LF_PI * lf_luminance(L))));
         }
     } else {
+        if (!allow_unsupported)
+            return lf_error_set(err, LF_ERR_UNSUPPORTED,
+                                "%s: LightSource \"%s\" is not supported (--allow-unsupported renders the scene "
+                                "without it)",
+                                where, type);
         lf_warn_append(&s->warnings, "%s: warning: LightSource \"%s\" is not supported; it is left out", where, type);
         for (size_t i = 0; i < ps->count; i++)
             ps->items[i].used = 1;
@@ -456,7 +462,7 @@ int lf_scene_build_lights(lf_scene_desc *d, lf_scene *s, lf_error *err)
     for (size_t i = 0; i < d->n_lights; i++) {
         lf_light l;
         int skip;
-        if (light_from_desc(s, &d->lights[i], &l, &skip, err))
+        if (light_from_desc(s, &d->lights[i], &l, &skip, d->allow_unsupported, err))
             return err ? err->code : LF_ERR_PARAM;
         if (skip)
             continue;

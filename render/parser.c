@@ -3,16 +3,28 @@
  * A hand-written tokenizer feeds a table of directive handlers that keep
  * pbrt-v4's graphics state (BasicSceneBuilder in pbrt-v4's scene.cpp): two
  * CTMs, attribute stack, named coordinate systems, materials, textures and
- * object instances.  Every error names file:line:col; the first error stops
- * the parse and everything built so far is freed.
+ * object instances.  Every error names file:line:col.  Errors are collected:
+ * after one, the parser skips to the next directive name and goes on, up to
+ * max_errors; if there was any, everything built is freed at the end.
+ *
+ * Files are read whole through lf_file_read (gzip detected by its magic
+ * bytes).  Include and Import push the file onto the lexer's stack of
+ * frames, so the token stream continues into the included file and back
+ * out of it, as pbrt-v4's tokenizer does: a parameter list may span the
+ * end of an included file.
  *
  * Where lensfield deliberately differs from pbrt-v4 (all documented at the
  * handler): Include paths are relative to the including file; TransformBegin
  * saves only the CTMs (pbrt-v3 semantics, which is what files that still use
  * it expect); WorldEnd, ColorSpace and Option are accepted with a warning;
- * an unclosed AttributeBegin is a warning.
+ * an unclosed AttributeBegin is a warning.  Shapes, lights, materials and
+ * media lensfield cannot render are errors ("not supported") unless
+ * lf_parse_opts.allow_unsupported, which turns them into warnings
+ * (docs/scene-format.md).
  */
 #include "lf_scene_desc.h"
+#include "../base/lf_color.h"
+#include "../base/lf_file.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -22,6 +34,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #define MAX_INCLUDE_DEPTH 64
 
@@ -136,26 +149,41 @@ typedef struct token {
     double num;    /* TK_NUMBER */
     int escaped;   /* TK_STRING contains a backslash */
     lf_loc loc;
+    const char *dir; /* directory of the file it was read from (Include, plymesh paths) */
 } token;
 
-typedef struct lexer {
+/* One file being read.  Include pushes a frame and the lexer pops it at its
+ * end, so the token stream runs on into the including file as in pbrt-v4:
+ * a parameter list may start in one file and continue in the other. */
+typedef struct lx_frame {
+    char *owned;      /* malloc'ed text (NULL for lf_scene_parse_string) */
     const char *text;
     size_t len, pos;
     int line, col;
     const char *file; /* kept in the description's strings */
-    const char *dir;  /* directory of file, for Include and plymesh paths */
+    const char *dir;  /* directory of file */
+} lx_frame;
+
+typedef struct lexer {
+    lx_frame *fr;
+    int n_fr, cap_fr;
+    /* Texts of files already finished: tokens of the directive being read
+     * may still point into them, so they are freed between directives. */
+    char **done;
+    int n_done, cap_done;
     token peeked;
     int has_peek;
 } lexer;
 
 typedef struct parser parser;
+static int nomem(parser *P);
 static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 4, 5)))
 #endif
     ;
 
-static int lx_getc(lexer *L)
+static int lx_getc(lx_frame *L)
 {
     if (L->pos >= L->len)
         return EOF;
@@ -169,20 +197,79 @@ static int lx_getc(lexer *L)
     return c;
 }
 
-static int lx_peekc(const lexer *L) { return L->pos < L->len ? (unsigned char)L->text[L->pos] : EOF; }
+static int lx_peekc(const lx_frame *L) { return L->pos < L->len ? (unsigned char)L->text[L->pos] : EOF; }
+
+static int lx_push(lexer *X, char *owned, const char *text, size_t len, const char *file, const char *dir)
+{
+    if (X->n_fr == X->cap_fr) {
+        int nc = X->cap_fr ? 2 * X->cap_fr : 8;
+        lx_frame *n = realloc(X->fr, (size_t)nc * sizeof *n);
+        if (!n)
+            return -1;
+        X->fr = n;
+        X->cap_fr = nc;
+    }
+    /* Room in `done` for every open frame, so popping never allocates
+     * (and never has to free a text that tokens may still point into). */
+    if (X->cap_done < X->n_done + X->n_fr + 1) {
+        int nc = 2 * (X->n_done + X->n_fr + 1);
+        char **n = realloc(X->done, (size_t)nc * sizeof *n);
+        if (!n)
+            return -1;
+        X->done = n;
+        X->cap_done = nc;
+    }
+    X->fr[X->n_fr++] = (lx_frame){owned, text, len, 0, 1, 1, file, dir};
+    return 0;
+}
+
+/* Ends the innermost file; its text is freed at the next directive (lx_push
+ * reserved the slot). */
+static int lx_pop(lexer *X)
+{
+    lx_frame *F = &X->fr[--X->n_fr];
+    if (F->owned)
+        X->done[X->n_done++] = F->owned;
+    return 0;
+}
+
+static void lx_release_done(lexer *X)
+{
+    for (int i = 0; i < X->n_done; i++)
+        free(X->done[i]);
+    X->n_done = 0;
+}
+
+static void lx_free(lexer *X)
+{
+    while (X->n_fr)
+        lx_pop(X);
+    lx_release_done(X);
+    free(X->done);
+    free(X->fr);
+    memset(X, 0, sizeof *X);
+}
 
 static int is_space(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
 static int is_escape_char(int c) { return c && strchr("bfnrt\\'\"", c) != NULL; }
 
-static int lex_scan(parser *P, lexer *L, token *t)
+static int lex_scan(parser *P, lexer *X, token *t)
 {
+    lx_frame *L = &X->fr[X->n_fr - 1];
     for (;;) {
         int c = lx_peekc(L);
         if (c == EOF) {
+            if (X->n_fr > 1) { /* end of an included file: continue in the includer */
+                if (lx_pop(X))
+                    return nomem(P);
+                L = &X->fr[X->n_fr - 1];
+                continue;
+            }
             memset(t, 0, sizeof *t);
             t->kind = TK_EOF;
             t->loc = (lf_loc){L->file, L->line, L->col};
+            t->dir = L->dir;
             return LF_OK;
         }
         if (is_space(c)) {
@@ -198,6 +285,7 @@ static int lex_scan(parser *P, lexer *L, token *t)
     }
     memset(t, 0, sizeof *t);
     t->loc = (lf_loc){L->file, L->line, L->col};
+    t->dir = L->dir;
     size_t start = L->pos;
     int c = lx_getc(L);
     if (c == '[' || c == ']') {
@@ -313,13 +401,25 @@ static int tok_is(const token *t, const char *word)
 /* What a token is, for messages: `string "abc"`, `number 3`, `"Shape"`. */
 static const char *describe(const token *t, char *buf, size_t size)
 {
-    int n = t->n > 40 ? 40 : (int)t->n;
+    /* Up to 40 characters; bytes that are not printable ASCII (binary or
+     * compressed data read as text) are shown as \xNN. */
+    char text[4 * 40 + 1];
+    size_t k = 0, lim = t->n > 40 ? 40 : t->n;
+    for (size_t i = 0; i < lim; i++) {
+        unsigned char c = (unsigned char)t->s[i];
+        if (c >= 0x20 && c < 0x7f)
+            text[k++] = (char)c;
+        else
+            k += (size_t)snprintf(text + k, sizeof text - k, "\\x%02x", c);
+    }
+    text[k] = '\0';
+    int n = (int)k;
     const char *more = t->n > 40 ? "..." : "";
     switch (t->kind) {
     case TK_EOF: snprintf(buf, size, "end of file"); break;
-    case TK_STRING: snprintf(buf, size, "string \"%.*s%s\"", n, t->s, more); break;
-    case TK_NUMBER: snprintf(buf, size, "number %.*s%s", n, t->s, more); break;
-    case TK_WORD: snprintf(buf, size, "\"%.*s%s\"", n, t->s, more); break;
+    case TK_STRING: snprintf(buf, size, "string \"%.*s%s\"", n, text, more); break;
+    case TK_NUMBER: snprintf(buf, size, "number %.*s%s", n, text, more); break;
+    case TK_WORD: snprintf(buf, size, "\"%.*s%s\"", n, text, more); break;
     case TK_LBRACK: snprintf(buf, size, "'['"); break;
     case TK_RBRACK: snprintf(buf, size, "']'"); break;
     }
@@ -380,21 +480,46 @@ struct parser {
     size_t cap_strings, cap_textures, cap_materials, cap_lights, cap_area_lights, cap_shapes, cap_objects,
         cap_instances, cap_media;
     size_t warnings_len, warnings_cap;
-    int include_depth;
     int warned_transform_begin;
+    /* Errors are collected: the parse goes on at the next directive, and
+     * every message (up to max_errors) is kept here, one per line. */
+    char *errors;
+    size_t errors_len, errors_cap;
+    int n_errors, max_errors, first_code;
+    int allow_unsupported;
+    const char *main_dir; /* directory of the top-level file */
 };
 
 static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
 {
-    char msg[900];
+    char msg[900], line[1100];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     if (loc)
-        return lf_error_set(P->err, code, "%s:%d:%d: %s", loc->file ? loc->file : "<unknown>", loc->line,
-                            loc->col, msg);
-    return lf_error_set(P->err, code, "%s", msg);
+        snprintf(line, sizeof line, "%s:%d:%d: %s", loc->file ? loc->file : "<unknown>", loc->line, loc->col, msg);
+    else
+        snprintf(line, sizeof line, "%s", msg);
+    if (P->n_errors++ == 0)
+        P->first_code = code;
+    lf_error_set(P->err, code, "%s", line);
+    size_t len = strlen(line);
+    if (P->errors_len + len + 2 > P->errors_cap) {
+        size_t cap = P->errors_cap ? P->errors_cap : 1024;
+        while (cap < P->errors_len + len + 2)
+            cap *= 2;
+        char *e = realloc(P->errors, cap);
+        if (!e)
+            return code; /* the first message is in P->err regardless */
+        P->errors = e;
+        P->errors_cap = cap;
+    }
+    memcpy(P->errors + P->errors_len, line, len);
+    P->errors[P->errors_len + len] = '\n';
+    P->errors[P->errors_len + len + 1] = '\0';
+    P->errors_len += len + 1;
+    return code;
 }
 
 static int nomem(parser *P) { return lf_error_set(P->err, LF_ERR_NOMEM, "out of memory while parsing the scene"); }
@@ -517,6 +642,8 @@ static int set_coordsys(parser *P, const char *name, const lf_transform xf[2])
 /* Arguments and parameter lists                                            */
 
 static int is_nonfinite_word(const token *t);
+static int join_path(const char *dir, const char *rel, char **out);
+static int resolve_path(parser *P, const char *dir, const char *rel, char **out);
 
 static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *out)
 {
@@ -525,7 +652,7 @@ static int expect_numbers(parser *P, lexer *L, const token *dir, int n, double *
         int rc = lex_next(P, L, &t);
         if (rc)
             return rc;
-        char b[96];
+        char b[200];
         if (t.kind == TK_WORD && is_nonfinite_word(&t))
             return perr(P, LF_ERR_NUMERIC, &t.loc, "non-finite number %s in %.*s", describe(&t, b, sizeof b),
                         (int)dir->n, dir->s);
@@ -545,7 +672,7 @@ static int expect_string(parser *P, lexer *L, const token *dir, const char *what
     if (rc)
         return rc;
     if (t.kind != TK_STRING) {
-        char b[96];
+        char b[200];
         return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects a quoted string (%s), got %s", (int)dir->n, dir->s, what,
                     describe(&t, b, sizeof b));
     }
@@ -602,7 +729,7 @@ static int is_nonfinite_word(const token *t)
  * declared type. */
 static int add_value(parser *P, const token *t, lf_param_type type, const char *decl, value_acc *a)
 {
-    char b[96];
+    char b[200];
     value_class vc = class_of(type);
     if (t->kind == TK_WORD && is_nonfinite_word(t))
         return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%.*s\" in parameter \"%s\"", (int)t->n, t->s,
@@ -706,6 +833,40 @@ static int check_count(parser *P, const lf_loc *loc, lf_param_type type, const c
     return LF_OK;
 }
 
+/* A "spectrum" parameter naming neither a built-in spectrum nor numbers
+ * names a spectrum file (pbrt-v4): it is read here, relative to the
+ * directory of the file the parameter was written in, and becomes the same
+ * (wavelength, value) pairs as if they had been written inline. */
+static int load_spectrum_file(parser *P, const token *t, lf_param_type type, const char *decl, value_acc *a)
+{
+    lf_vec3 dummy;
+    if (type != LF_PT_SPECTRUM || a->n_strs != 1 || a->n_nums || lf_named_spectrum_rgb(a->strs[0], &dummy) == 0)
+        return LF_OK;
+    char *path;
+    if (resolve_path(P, t->dir, a->strs[0], &path))
+        return nomem(P);
+    double *v;
+    size_t n;
+    lf_error fe = {0};
+    int rc = lf_spectrum_file_read(path, &v, &n, &fe);
+    free(path);
+    if (rc == LF_ERR_NOMEM)
+        return nomem(P);
+    if (rc)
+        return perr(P, rc, &t->loc,
+                    "parameter \"%s\": \"%s\" is not a named spectrum (see docs/scene-format.md), and as a spectrum "
+                    "file: %s",
+                    decl, a->strs[0], fe.msg);
+    free(a->strs[0]);
+    free(a->strs);
+    a->strs = NULL;
+    a->n_strs = a->cap_strs = 0;
+    free(a->nums);
+    a->nums = v;
+    a->n_nums = a->cap_nums = 2 * n;
+    return LF_OK;
+}
+
 /* Splits a "type name" declaration. */
 static int split_decl(parser *P, const token *t, const char *decl, lf_param_type *type, char **name)
 {
@@ -737,6 +898,20 @@ static int split_decl(parser *P, const token *t, const char *decl, lf_param_type
     if (!(*name = dup_range(name_b, (size_t)(name_e - name_b))))
         return nomem(P);
     return LF_OK;
+}
+
+typedef int (*directive_fn)(parser *P, lexer *L, const token *dir);
+static directive_fn find_directive(const token *t);
+
+/* Puts back a directive name that ended a malformed construct, so that the
+ * parse resumes at it after the error (only right after lex_next). */
+static int is_directive_like(const token *t);
+static void unget_directive(lexer *L, const token *t)
+{
+    if (!L->has_peek && is_directive_like(t)) {
+        L->peeked = *t;
+        L->has_peek = 1;
+    }
 }
 
 /* Reads the parameter list that follows a directive's fixed arguments:
@@ -779,7 +954,8 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
                 }
                 if (v.kind == TK_LBRACK || (v.kind == TK_WORD && !tok_is(&v, "true") && !tok_is(&v, "false") &&
                                             !is_nonfinite_word(&v))) {
-                    char b[96];
+                    unget_directive(L, &v); /* the parse goes on there */
+                    char b[200];
                     rc = perr(P, LF_ERR_PARSE, &v.loc, "expected a value or ']' to close the '[' at %d:%d, got %s",
                               open.loc.line, open.loc.col, describe(&v, b, sizeof b));
                     goto fail;
@@ -792,12 +968,15 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
             if ((rc = add_value(P, &v, type, decl, &a)))
                 goto fail;
         } else {
-            char b[96];
+            unget_directive(L, &v);
+            char b[200];
             rc = perr(P, LF_ERR_PARSE, &v.loc, "parameter \"%s\" has no value: expected a value or '[', got %s", decl,
                       describe(&v, b, sizeof b));
             goto fail;
         }
         if ((rc = check_count(P, &t.loc, type, decl, &a)))
+            goto fail;
+        if ((rc = load_spectrum_file(P, &t, type, decl, &a)))
             goto fail;
         lf_param p = {0};
         p.type = type;
@@ -874,10 +1053,6 @@ static int require_world(parser *P, const token *dir)
 /* ------------------------------------------------------------------------ */
 /* Directive handlers                                                       */
 
-typedef int (*directive_fn)(parser *P, lexer *L, const token *dir);
-
-static int parse_text(parser *P, const char *text, size_t len, const char *file, const char *dir, lf_loc *eof);
-
 static int d_identity(parser *P, lexer *L, const token *dir)
 {
     (void)L;
@@ -946,7 +1121,7 @@ static int read_matrix(parser *P, lexer *L, const token *dir, lf_transform *out)
     if (bracketed)
         lex_next(P, L, &t);
     double v[16];
-    char b[96];
+    char b[200];
     for (int i = 0; i < 16; i++) {
         if ((rc = lex_next(P, L, &t)))
             return rc;
@@ -1059,7 +1234,7 @@ static int d_active_transform(parser *P, lexer *L, const token *dir)
         P->gs.active[0] = 0;
         P->gs.active[1] = 1;
     } else {
-        char b[96];
+        char b[200];
         return perr(P, LF_ERR_PARSE, &t.loc, "%.*s expects StartTime, EndTime or All, got %s", (int)dir->n, dir->s,
                     describe(&t, b, sizeof b));
     }
@@ -1234,6 +1409,29 @@ static int join_path(const char *dir, const char *rel, char **out)
     return *out ? 0 : -1;
 }
 
+/* A file named in a scene: relative to the directory of the file that names
+ * it (`dir`); if nothing is there, relative to the top-level file's
+ * directory, which is where pbrt-v4 looks (its scenes name nested files
+ * that way).  The first candidate is returned when neither exists, so the
+ * message names the path lensfield tried first. */
+static int resolve_path(parser *P, const char *dir, const char *rel, char **out)
+{
+    if (join_path(dir, rel, out))
+        return -1;
+    if (rel[0] == '/' || !P->main_dir || (dir && strcmp(dir, P->main_dir) == 0) || access(*out, F_OK) == 0)
+        return 0;
+    char *alt;
+    if (join_path(P->main_dir, rel, &alt))
+        return -1;
+    if (access(alt, F_OK) == 0) {
+        free(*out);
+        *out = alt;
+    } else {
+        free(alt);
+    }
+    return 0;
+}
+
 /* The directory part of path: "a/b/c.pbrt" -> "a/b", "c.pbrt" -> ".". */
 static char *dir_of(const char *path)
 {
@@ -1245,69 +1443,46 @@ static char *dir_of(const char *path)
     return dup_range(path, (size_t)(slash - path));
 }
 
-static int read_whole_file(const char *path, char **text, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return -1;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    for (;;) {
-        if (!buf) {
-            fclose(f);
-            errno = ENOMEM;
-            return -1;
-        }
-        n += fread(buf + n, 1, cap - n, f);
-        if (n < cap)
-            break;
-        cap *= 2;
-        char *nb = realloc(buf, cap);
-        if (!nb)
-            free(buf);
-        buf = nb;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        errno = EIO;
-        return -1;
-    }
-    *text = buf;
-    *len = n;
-    return 0;
-}
-
-/* Parses `path` with the current graphics state, as if its text stood in
- * place of the directive.  `from` is where the Include was written (NULL for
- * the top-level file). */
-static int parse_path(parser *P, const char *path, const lf_loc *from, lf_loc *eof)
+/* Pushes the file at `path` onto the lexer: its tokens come next, then the
+ * rest of the including file (pbrt-v4 includes tokens, not statements).
+ * The file may be gzipped.  `from` is where the Include was written (NULL
+ * for the top-level file). */
+static int push_file(parser *P, lexer *X, const char *path, const lf_loc *from)
 {
     char *text;
     size_t len;
-    if (read_whole_file(path, &text, &len)) {
+    lf_error fe = {0};
+    if (lf_file_read(path, LF_FILE_MAX_DEFAULT, &text, &len, NULL, &fe)) {
+        if (fe.code == LF_ERR_NOMEM)
+            return nomem(P);
+        /* fe.msg is "path: what"; say which kind of file it was. */
+        const char *what = fe.msg;
+        size_t pl = strlen(path);
+        if (strncmp(what, path, pl) == 0 && what[pl] == ':' && what[pl + 1] == ' ')
+            what += pl + 2;
+        int open_failed = strncmp(what, "cannot open: ", 13) == 0;
+        if (open_failed)
+            what += 13;
         if (from)
-            return perr(P, LF_ERR_IO, from, "cannot open included file \"%s\": %s", path, strerror(errno));
-        return perr(P, LF_ERR_IO, NULL, "cannot open scene file \"%s\": %s", path, strerror(errno));
+            return perr(P, fe.code, from, "%s included file \"%s\": %s", open_failed ? "cannot open" : "cannot read",
+                        path, what);
+        return perr(P, fe.code, NULL, "%s scene file \"%s\": %s", open_failed ? "cannot open" : "cannot read", path,
+                    what);
     }
     char *dir = dir_of(path);
     const char *kept_file = keep_string(P, path);
     const char *kept_dir = dir ? keep_string(P, dir) : NULL;
     free(dir);
-    int rc;
-    if (!kept_file || !kept_dir)
-        rc = nomem(P);
-    else
-        rc = parse_text(P, text, len, kept_file, kept_dir, eof);
-    free(text);
-    return rc;
+    if (!kept_file || !kept_dir || lx_push(X, text, text, len, kept_file, kept_dir)) {
+        free(text);
+        return nomem(P);
+    }
+    return LF_OK;
 }
 
 /* Include and Import: pbrt-v4 resolves the name against the directory of the
- * main scene file; lensfield uses the directory of the including file,
- * which is the same for the common single-directory layout and also works
- * for nested directories.  Import is read like Include (pbrt-v4 parses it in
+ * main scene file; lensfield tries the directory of the including file
+ * first, then the main file's (resolve_path), so both layouts work.  Import is read like Include (pbrt-v4 parses it in
  * parallel; the result is the same). */
 static int d_include(parser *P, lexer *L, const token *dir)
 {
@@ -1319,20 +1494,18 @@ static int d_include(parser *P, lexer *L, const token *dir)
         free(name);
         return perr(P, LF_ERR_PARSE, &dir->loc, "Import is only allowed inside the world block");
     }
-    if (P->include_depth >= MAX_INCLUDE_DEPTH) {
+    if (L->n_fr > MAX_INCLUDE_DEPTH) {
         free(name);
         return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s nested more than %d deep (does a file include itself?)",
                     (int)dir->n, dir->s, MAX_INCLUDE_DEPTH);
     }
     char *path;
-    if (join_path(L->dir, name, &path)) {
+    if (resolve_path(P, dir->dir, name, &path)) {
         free(name);
         return nomem(P);
     }
     free(name);
-    P->include_depth++;
-    rc = parse_path(P, path, &dir->loc, NULL);
-    P->include_depth--;
+    rc = push_file(P, L, path, &dir->loc);
     free(path);
     return rc;
 }
@@ -1386,7 +1559,7 @@ static int d_option(parser *P, lexer *L, const token *dir)
     int rc = parse_params(P, L, &ps);
     if (!rc && ps.count == 0) {
         token t;
-        char b[96];
+        char b[200];
         lex_peek(P, L, &t);
         rc = perr(P, LF_ERR_PARSE, &t.loc, "Option expects a \"type name\" value pair, got %s",
                   describe(&t, b, sizeof b));
@@ -1395,6 +1568,72 @@ static int d_option(parser *P, lexer *L, const token *dir)
         pwarn(P, &dir->loc, "Option \"%s\" ignored", ps.items[0].name);
     lf_params_free(&ps);
     return rc;
+}
+
+/* pbrt-v4's shape, light, material and texture types, and those of them lensfield
+ * cannot render (docs/scene-format.md has the whole table).  Leaving one out
+ * changes what the image shows, so it is an error unless the user asked for
+ * --allow-unsupported (lf_parse_opts.allow_unsupported). */
+static const char *const pbrt_shapes[] = {"bilinearmesh", "curve",  "cylinder", "disk", "loopsubdiv",
+                                          "plymesh",      "sphere", "trianglemesh", NULL};
+static const char *const refused_shapes[] = {"curve", "cylinder", NULL};
+static const char *const pbrt_lights[] = {"distant", "goniometric", "infinite", "point", "projection", "spot", NULL};
+static const char *const refused_lights[] = {"goniometric", "projection", NULL};
+static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse", "conductor",   "dielectric", "diffuse",
+                                             "diffusetransmission", "hair", "interface", "measured", "mix",
+                                             "subsurface",      "thindielectric", "none", "", NULL};
+static const char *const refused_materials[] = {"hair", "measured", "subsurface", NULL};
+static const char *const pbrt_textures[] = {"bilerp", "checkerboard", "constant", "directionmix", "dots", "fbm",
+                                            "imagemap", "marble", "mix", "ptex", "scale", "windy", "wrinkled",
+                                            NULL};
+static const char *const refused_textures[] = {"directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled",
+                                               NULL};
+
+static int in_list(const char *const *list, const char *s)
+{
+    for (; *list; list++)
+        if (strcmp(*list, s) == 0)
+            return 1;
+    return 0;
+}
+
+/* 0: supported; 1: not supported but allowed (a warning was written, the
+ * caller leaves it out or substitutes `instead`); otherwise an error code. */
+static int check_supported(parser *P, const token *dir, const char *type, const char *const *known,
+                           const char *const *refused, const char *instead)
+{
+    if (in_list(known, type) && !in_list(refused, type))
+        return 0;
+    /* pbrt-v4 calls it unknown when it is not one of its own types. */
+    const char *what = known == pbrt_shapes      ? "shape"
+                       : known == pbrt_lights    ? "light"
+                       : known == pbrt_textures  ? "texture"
+                                                 : "material";
+    int is_known = in_list(known, type);
+    if (P->allow_unsupported) {
+        if (is_known)
+            pwarn(P, &dir->loc, "%.*s \"%s\" is not supported; %s (--allow-unsupported)", (int)dir->n, dir->s,
+                  type, instead);
+        else
+            pwarn(P, &dir->loc, "%.*s: unknown %s \"%s\" is not supported; %s (--allow-unsupported)", (int)dir->n,
+                  dir->s, what, type, instead);
+        return 1;
+    }
+    if (!is_known)
+        return perr(P, LF_ERR_UNSUPPORTED, &dir->loc,
+                    "%.*s: unknown %s \"%s\" is not supported (--allow-unsupported renders the scene without it)",
+                    (int)dir->n, dir->s, what, type);
+    return perr(P, LF_ERR_UNSUPPORTED, &dir->loc,
+                "%.*s \"%s\" is not supported (--allow-unsupported renders the scene without it)", (int)dir->n,
+                dir->s, type);
+}
+
+/* An allowed unsupported material is rendered as pbrt's default material. */
+static void make_default_material(lf_entity *e)
+{
+    free(e->type);
+    e->type = dup_cstr("diffuse");
+    lf_params_free(&e->params);
 }
 
 static int merge_attrs(parser *P, lf_paramset *ps, int which)
@@ -1415,6 +1654,13 @@ static int d_material(parser *P, lexer *L, const token *dir)
     rc = parse_entity(P, L, dir, "a material type", &m->e);
     if (!rc)
         rc = merge_attrs(P, &m->e.params, ATTR_MATERIAL);
+    if (!rc) {
+        rc = check_supported(P, dir, m->e.type, pbrt_materials, refused_materials, "rendered as \"diffuse\" 0.5");
+        if (rc == 1) {
+            make_default_material(&m->e);
+            rc = m->e.type ? LF_OK : nomem(P);
+        }
+    }
     if (rc) {
         entity_free(&m->e);
         return rc;
@@ -1465,6 +1711,12 @@ static int d_make_named_material(parser *P, lexer *L, const token *dir)
             param_release(tp);
             memmove(tp, tp + 1, (m->e.params.count - i - 1) * sizeof *tp);
             m->e.params.count--;
+            rc = check_supported(P, dir, m->e.type, pbrt_materials, refused_materials,
+                                 "rendered as \"diffuse\" 0.5");
+            if (rc == 1) {
+                make_default_material(&m->e);
+                rc = m->e.type ? LF_OK : nomem(P);
+            }
         }
     }
     if (!rc && strmap_put(&P->material_map, m->name, (int)d->n_materials))
@@ -1519,6 +1771,15 @@ static int d_texture(parser *P, lexer *L, const token *dir)
         rc = parse_params(P, L, &t->e.params);
     if (!rc)
         rc = merge_attrs(P, &t->e.params, ATTR_TEXTURE);
+    if (!rc) {
+        rc = check_supported(P, dir, t->e.type, pbrt_textures, refused_textures, "rendered as \"constant\" 1");
+        if (rc == 1) { /* pbrt's constant texture, value 1 */
+            free(t->e.type);
+            t->e.type = dup_cstr("constant");
+            lf_params_free(&t->e.params);
+            rc = t->e.type ? LF_OK : nomem(P);
+        }
+    }
     strmap *names = t->is_float ? &P->float_tex_map : &P->spectrum_tex_map;
     if (!rc) {
         int prev = strmap_get(names, t->name);
@@ -1554,9 +1815,11 @@ static int d_light_source(parser *P, lexer *L, const token *dir)
     rc = parse_entity(P, L, dir, "a light type", &l->e);
     if (!rc)
         rc = merge_attrs(P, &l->e.params, ATTR_LIGHT);
+    if (!rc)
+        rc = check_supported(P, dir, l->e.type, pbrt_lights, refused_lights, "it is left out");
     if (rc) {
         entity_free(&l->e);
-        return rc;
+        return rc == 1 ? LF_OK : rc;
     }
     l->light_to_world = current_xform(P);
     l->reverse_orientation = P->gs.reverse_orientation;
@@ -1597,16 +1860,18 @@ static int d_shape(parser *P, lexer *L, const token *dir)
     rc = parse_entity(P, L, dir, "a shape type", &s->e);
     if (!rc)
         rc = merge_attrs(P, &s->e.params, ATTR_SHAPE);
+    if (!rc)
+        rc = check_supported(P, dir, s->e.type, pbrt_shapes, refused_shapes, "it is left out");
     if (rc) {
         entity_free(&s->e);
-        return rc;
+        return rc == 1 ? LF_OK : rc;
     }
     s->object_to_world = current_xform(P);
     s->material = P->gs.material;
     s->area_light = P->gs.area_light;
     s->reverse_orientation = P->gs.reverse_orientation;
     s->object = P->current_object;
-    s->base_dir = L->dir;
+    s->base_dir = dir->dir;
     s->medium_inside = P->gs.medium_inside;
     s->medium_outside = P->gs.medium_outside;
     if (s->object >= 0 && s->area_light >= 0)
@@ -1811,33 +2076,87 @@ static const struct directive {
     {"WorldEnd", d_world_end},
 };
 
-/* Parses one file's text; *eof (if not NULL) receives where it ended. */
-static int parse_text(parser *P, const char *text, size_t len, const char *file, const char *dir, lf_loc *eof)
+static directive_fn find_directive(const token *t)
 {
-    lexer L = {text, len, 0, 1, 1, file, dir, {0}, 0};
+    if (t->kind != TK_WORD)
+        return NULL;
+    for (size_t i = 0; i < sizeof directives / sizeof directives[0]; i++)
+        if (tok_is(t, directives[i].name))
+            return directives[i].fn;
+    return NULL;
+}
+
+/* A bare word that is not a value: a directive, or a misspelt one (which
+ * then gets its own "unknown directive" error). */
+static int is_directive_like(const token *t)
+{
+    return t->kind == TK_WORD && !tok_is(t, "true") && !tok_is(t, "false") && !is_nonfinite_word(t) &&
+           !tok_is(t, "StartTime") && !tok_is(t, "EndTime") && !tok_is(t, "All");
+}
+
+/* After an error: skips tokens up to the next directive name (or the end),
+ * so one run reports every problem of a scene. */
+static void recover(parser *P, lexer *L)
+{
     for (;;) {
         token t;
-        int rc = lex_next(P, &L, &t);
-        if (rc)
-            return rc;
-        if (t.kind == TK_EOF) {
-            if (eof)
-                *eof = t.loc;
-            return LF_OK;
-        }
-        char b[96];
-        if (t.kind != TK_WORD)
-            return perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
-        directive_fn fn = NULL;
-        for (size_t i = 0; i < sizeof directives / sizeof directives[0]; i++)
-            if (tok_is(&t, directives[i].name)) {
-                fn = directives[i].fn;
-                break;
+        int rc = lex_peek(P, L, &t);
+        if (rc == LF_ERR_NOMEM || P->n_errors >= P->max_errors)
+            return;
+        if (rc) /* a malformed token: the lexer has moved past it */
+            continue;
+        if (t.kind == TK_EOF || is_directive_like(&t))
+            return;
+        lex_next(P, L, &t);
+    }
+}
+
+/* Reads directives until the end of the top-level file; *eof receives
+ * where it ended. */
+static int parse_run(parser *P, lexer *L, lf_loc *eof)
+{
+    for (;;) {
+        lx_release_done(L);
+        if (P->n_errors >= P->max_errors) {
+            char line[64];
+            snprintf(line, sizeof line, "(stopped after %d errors)\n", P->n_errors);
+            size_t n = strlen(line);
+            char *e = realloc(P->errors, P->errors_len + n + 1);
+            if (e) {
+                memcpy(e + P->errors_len, line, n + 1);
+                P->errors = e;
+                P->errors_len += n;
+                P->errors_cap = P->errors_len + 1;
             }
-        if (!fn)
-            return perr(P, LF_ERR_PARSE, &t.loc, "unknown directive %s", describe(&t, b, sizeof b));
-        if ((rc = fn(P, &L, &t)))
+            return P->first_code;
+        }
+        token t;
+        int rc = lex_next(P, L, &t);
+        if (rc == LF_ERR_NOMEM)
             return rc;
+        if (rc) {
+            recover(P, L);
+            continue;
+        }
+        if (t.kind == TK_EOF) {
+            *eof = t.loc;
+            return P->n_errors ? P->first_code : LF_OK;
+        }
+        char b[200];
+        directive_fn fn = find_directive(&t);
+        if (!fn) {
+            if (t.kind != TK_WORD)
+                perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
+            else
+                perr(P, LF_ERR_PARSE, &t.loc, "unknown directive %s", describe(&t, b, sizeof b));
+            recover(P, L);
+            continue;
+        }
+        rc = fn(P, L, &t);
+        if (rc == LF_ERR_NOMEM)
+            return rc;
+        if (rc)
+            recover(P, L);
     }
 }
 
@@ -1890,14 +2209,16 @@ static int finish(parser *P, const lf_loc *eof)
         if (!resolved)
             return nomem(P);
     }
+    int rc = LF_OK;
     for (size_t i = 0; i < P->n_material_refs; i++) {
         resolved[i] = strmap_get(&P->material_map, P->material_refs[i].name);
-        if (resolved[i] < 0) {
-            int rc = perr(P, LF_ERR_PARSE, &P->material_refs[i].loc, "NamedMaterial \"%s\" is not defined",
-                          P->material_refs[i].name);
-            free(resolved);
-            return rc;
-        }
+        if (resolved[i] < 0 && P->n_errors < P->max_errors)
+            rc = perr(P, LF_ERR_PARSE, &P->material_refs[i].loc, "NamedMaterial \"%s\" is not defined",
+                      P->material_refs[i].name);
+    }
+    if (rc) {
+        free(resolved);
+        return P->first_code;
     }
     for (size_t i = 0; i < d->n_shapes; i++)
         if (d->shapes[i].material <= -2)
@@ -1905,20 +2226,23 @@ static int finish(parser *P, const lf_loc *eof)
     free(resolved);
     for (size_t i = 0; i < d->n_instances; i++) {
         int o = strmap_get(&P->object_map, P->instance_refs[i].name);
-        if (o < 0)
-            return perr(P, LF_ERR_PARSE, &P->instance_refs[i].loc, "ObjectInstance \"%s\": no such object",
-                        P->instance_refs[i].name);
+        if (o < 0 && P->n_errors < P->max_errors)
+            rc = perr(P, LF_ERR_PARSE, &P->instance_refs[i].loc, "ObjectInstance \"%s\": no such object",
+                      P->instance_refs[i].name);
         d->instances[i].object = o;
     }
-    return LF_OK;
+    return rc ? P->first_code : LF_OK;
 }
 
-static int parse_begin(parser *P, lf_scene_desc *out, lf_error *err)
+static int parse_begin(parser *P, const lf_parse_opts *o, lf_scene_desc *out, lf_error *err)
 {
     memset(out, 0, sizeof *out);
     memset(P, 0, sizeof *P);
     P->d = out;
     P->err = err;
+    P->max_errors = o && o->max_errors > 0 ? o->max_errors : LF_PARSE_MAX_ERRORS;
+    P->allow_unsupported = o ? o->allow_unsupported : 0;
+    out->allow_unsupported = P->allow_unsupported;
     out->transform_start_time = 0.0;
     out->transform_end_time = 1.0;
     P->gs.ctm[0] = P->gs.ctm[1] = lf_transform_identity();
@@ -1929,10 +2253,11 @@ static int parse_begin(parser *P, lf_scene_desc *out, lf_error *err)
     return set_coordsys(P, "world", P->gs.ctm);
 }
 
-static int parse_end(parser *P, int rc, const lf_loc *eof)
+static int parse_end(parser *P, lexer *L, int rc, const lf_loc *eof, char **errors)
 {
     if (!rc)
         rc = finish(P, eof);
+    lx_free(L);
     parser_free(P);
     if (rc) {
         /* Make sure the caller sees a message even for a bare status. */
@@ -1940,25 +2265,47 @@ static int parse_end(parser *P, int rc, const lf_loc *eof)
             lf_error_set(P->err, rc, "scene parse failed");
         lf_scene_desc_free(P->d);
     }
+    if (errors) {
+        *errors = rc ? P->errors : NULL;
+        if (rc && !P->errors && P->err)
+            *errors = dup_cstr(P->err->msg);
+        if (!rc)
+            free(P->errors);
+    } else {
+        free(P->errors);
+    }
     return rc;
+}
+
+int lf_scene_parse_file_ex(const char *path, const lf_parse_opts *opts, lf_scene_desc *out, lf_error *err,
+                           char **errors)
+{
+    parser P;
+    lexer L = {0};
+    lf_loc eof = {path, 1, 1};
+    int rc = parse_begin(&P, opts, out, err);
+    if (!rc)
+        rc = push_file(&P, &L, path, NULL);
+    if (!rc)
+        P.main_dir = out->scene_dir = L.fr[0].dir;
+    if (!rc)
+        rc = parse_run(&P, &L, &eof);
+    return parse_end(&P, &L, rc, &eof, errors);
 }
 
 int lf_scene_parse_file(const char *path, lf_scene_desc *out, lf_error *err)
 {
-    parser P;
-    lf_loc eof = {path, 1, 1};
-    int rc = parse_begin(&P, out, err);
-    if (!rc)
-        rc = parse_path(&P, path, NULL, &eof);
-    return parse_end(&P, rc, &eof);
+    return lf_scene_parse_file_ex(path, NULL, out, err, NULL);
 }
 
-int lf_scene_parse_string(const char *text, const char *name, lf_scene_desc *out, lf_error *err)
+int lf_scene_parse_string_ex(const char *text, const char *name, const lf_parse_opts *opts, lf_scene_desc *out,
+                             lf_error *err, char **errors)
 {
     parser P;
+    lexer L = {0};
     if (!name)
         name = "<string>";
-    int rc = parse_begin(&P, out, err);
+    int rc = parse_begin(&P, opts, out, err);
     const char *file = NULL, *dir = NULL;
     if (!rc) {
         char *dname = dir_of(name);
@@ -1969,9 +2316,18 @@ int lf_scene_parse_string(const char *text, const char *name, lf_scene_desc *out
             rc = nomem(&P);
     }
     lf_loc eof = {name, 1, 1};
+    if (!rc && lx_push(&L, NULL, text ? text : "", text ? strlen(text) : 0, file, dir))
+        rc = nomem(&P);
     if (!rc)
-        rc = parse_text(&P, text ? text : "", text ? strlen(text) : 0, file, dir, &eof);
-    return parse_end(&P, rc, &eof);
+        P.main_dir = out->scene_dir = dir;
+    if (!rc)
+        rc = parse_run(&P, &L, &eof);
+    return parse_end(&P, &L, rc, &eof, errors);
+}
+
+int lf_scene_parse_string(const char *text, const char *name, lf_scene_desc *out, lf_error *err)
+{
+    return lf_scene_parse_string_ex(text, name, NULL, out, err, NULL);
 }
 
 void lf_scene_desc_free(lf_scene_desc *d)

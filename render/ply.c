@@ -7,9 +7,10 @@
  * "face" element: the list "vertex_indices" (or "vertex_index"); triangles
  * are kept, quads split into (0,1,2) (0,2,3) as pbrt does, larger polygons
  * fan-triangulated; faces with fewer than 3 vertices are dropped (pbrt-v4
- * ignores them too).  Other elements are skipped.
+ * ignores them too).  Other elements are skipped.  The file may be gzipped.
  */
 #include "lf_scene_desc.h"
+#include "../base/lf_file.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -64,41 +65,6 @@ typedef struct ply_reader {
     ply_format format;
     lf_error *err;
 } ply_reader;
-
-static int read_file(const char *path, char **out, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return -1;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap + 1);
-    for (;;) {
-        if (!buf) {
-            fclose(f);
-            errno = ENOMEM;
-            return -1;
-        }
-        n += fread(buf + n, 1, cap - n, f);
-        if (n < cap)
-            break;
-        cap *= 2;
-        char *nb = realloc(buf, cap + 1);
-        if (!nb)
-            free(buf);
-        buf = nb;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        errno = EIO;
-        return -1;
-    }
-    buf[n] = '\0';
-    *out = buf;
-    *len = n;
-    return 0;
-}
 
 /* Where an error happened: path:line for ascii and the header, path (byte
  * offset) for binary data. */
@@ -401,8 +367,11 @@ int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
     memset(out, 0, sizeof *out);
     char *buf;
     size_t len;
-    if (read_file(path, &buf, &len))
-        return lf_error_set(err, LF_ERR_IO, "cannot open PLY file \"%s\": %s", path, strerror(errno));
+    /* A gzipped PLY (".ply.gz", or any name: the magic bytes decide) is
+     * decompressed whole first. */
+    lf_error ferr = {0};
+    if (lf_file_read(path, LF_FILE_MAX_DEFAULT, &buf, &len, NULL, &ferr))
+        return lf_error_set(err, ferr.code, "PLY file %s", ferr.msg);
     ply_reader r = {path, buf, len, 0, 0, PLY_ASCII, err};
     ply_element *els = NULL;
     size_t n_els = 0;

@@ -13,13 +13,16 @@
  * decomposed interpolation and rays traverse a static BVH.  Shapes that ask
  * for "motionsegments", emitters, full spheres and motions Embree's
  * decomposition cannot represent get keyframed vertices (or centres). */
-#include <stdatomic.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "lf_subdiv.h"
 #include "render_internal.h"
 
 void lf_warn_append(char **buf, const char *fmt, ...)
@@ -326,12 +329,57 @@ static int shape_plymesh(builder *b, lf_shape_desc *sh, const motion *mo)
         snprintf(path, sizeof path, "%s", fn);
     else
         snprintf(path, sizeof path, "%s/%s", sh->base_dir, fn);
+    /* Not next to the file that names it: relative to the top-level file,
+     * where pbrt-v4 looks (nested geometry files name meshes that way). */
+    if (fn[0] != '/' && access(path, F_OK) != 0 && b->d->scene_dir && b->d->scene_dir[0]) {
+        char alt[4096];
+        snprintf(alt, sizeof alt, "%s/%s", b->d->scene_dir, fn);
+        if (access(alt, F_OK) == 0)
+            memcpy(path, alt, sizeof path);
+    }
     lf_ply_mesh pm;
     lf_error perr = {0};
     if (lf_ply_read(path, &pm, &perr))
         return lf_error_set(b->err, perr.code, "%s: Shape \"plymesh\": %s", where, perr.msg);
     lf_ply_mesh copy = pm;
     return finish_mesh(b, sh, mo, copy.P, (int)copy.n_vertices, copy.N, copy.uv, copy.indices, (int)copy.n_triangles);
+}
+
+/* pbrt-v4's "loopsubdiv": the limit surface of the control mesh after
+ * "levels" Loop subdivisions, with limit-surface normals (render/lf_subdiv.h). */
+static int shape_loopsubdiv(builder *b, lf_shape_desc *sh, const motion *mo)
+{
+    lf_paramset *ps = &sh->e.params;
+    size_t np = 0, ni = 0;
+    int levels = lf_params_int(ps, "levels", 3);
+    const double *P = lf_params_nums(ps, "P", LF_PT_POINT3, &np);
+    const double *I = lf_params_nums(ps, "indices", LF_PT_INTEGER, &ni);
+    char where[512];
+    loc_prefix(where, sizeof where, &sh->e.loc);
+    if (ps->error.code)
+        return lf_params_finish(ps, "Shape \"loopsubdiv\"", b->err);
+    if (!P || np < 9)
+        return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"loopsubdiv\" needs \"point3 P\" with at least 3 points",
+                            where);
+    if (!I || ni == 0 || ni % 3)
+        return lf_error_set(b->err, LF_ERR_PARAM,
+                            "%s: Shape \"loopsubdiv\" needs \"integer indices\", 3 per triangle (got %zu)", where, ni);
+    int *idx = malloc(ni * sizeof *idx);
+    if (!idx)
+        return lf_error_set(b->err, LF_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ni; i++)
+        idx[i] = I[i] < 0 || I[i] > INT_MAX ? -1 : (int)I[i];
+    lf_ply_mesh m;
+    lf_error e = {0};
+    int rc = lf_loop_subdivide(P, np / 3, idx, ni / 3, levels, &m, &e);
+    free(idx);
+    if (rc)
+        return lf_error_set(b->err, rc, "%s: Shape \"loopsubdiv\": %s", where, e.msg);
+    /* pbrt-v4 negates a mesh's normals under ReverseOrientation. */
+    if (sh->reverse_orientation)
+        for (size_t i = 0; i < 3 * m.n_vertices; i++)
+            m.N[i] = -m.N[i];
+    return finish_mesh(b, sh, mo, m.P, (int)m.n_vertices, m.N, NULL, m.indices, (int)m.n_triangles);
 }
 
 /* Tessellated parametric surface: f(u, v) -> object-space point, on a grid. */
@@ -581,16 +629,28 @@ static const struct {
     shape_fn fn;
 } shape_table[] = {
     {"trianglemesh", shape_trianglemesh}, {"plymesh", shape_plymesh}, {"sphere", shape_sphere},
-    {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh},
+    {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh}, {"loopsubdiv", shape_loopsubdiv},
 };
 
 static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     char where[512];
     loc_prefix(where, sizeof where, &sh->e.loc);
-    if (sh->e.params.count && lf_params_peek(&sh->e.params, "alpha")) {
+    const lf_param *alpha = sh->e.params.count ? lf_params_peek(&sh->e.params, "alpha") : NULL;
+    if (alpha) {
+        /* "float alpha" 1 changes nothing; anything else cuts the shape,
+         * which lensfield cannot: the shape would show where the scene
+         * has a hole (the unsupported rule, docs/scene-format.md). */
+        int opaque = alpha->type == LF_PT_FLOAT && alpha->n_nums == 1 && alpha->nums[0] == 1.0;
         lf_params_find(&sh->e.params, "alpha");
-        lf_warn_append(&b->s->warnings, "%s: warning: \"alpha\" cut-outs are not supported; the shape is opaque", where);
+        if (!opaque && !b->d->allow_unsupported)
+            return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
+                                "%s: Shape \"%s\": \"alpha\" cut-outs are not supported (--allow-unsupported renders "
+                                "the shape opaque)",
+                                where, sh->e.type);
+        if (!opaque)
+            lf_warn_append(&b->s->warnings, "%s: warning: \"alpha\" cut-outs are not supported; the shape is opaque",
+                           where);
     }
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {
@@ -600,6 +660,12 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
             snprintf(ctx, sizeof ctx, "Shape \"%s\"", sh->e.type);
             return lf_params_finish(&sh->e.params, ctx, b->err);
         }
+    /* The parser refuses these already; a description built otherwise
+     * gets the same rule. */
+    if (!b->d->allow_unsupported)
+        return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
+                            "%s: Shape \"%s\" is not supported (--allow-unsupported renders the scene without it)",
+                            where, sh->e.type);
     lf_warn_append(&b->s->warnings, "%s: warning: Shape \"%s\" is not supported; it is left out of the render", where,
                    sh->e.type);
     for (size_t i = 0; i < sh->e.params.count; i++)

@@ -272,6 +272,30 @@ static void test_color_functions(void)
     CHECK_NEAR(n.z, 1.5168, 1e-4);
     CHECK(lf_named_spectrum_rgb("stdillum-D65", &n) == 0 && n.x == 1.f && n.y == 1.f && n.z == 1.f);
     CHECK(lf_named_spectrum_rgb("metal-Xx-eta", &n) == -1);
+    /* Illuminant A is a Planckian radiator at 2848 K with CIE's old
+     * c2 = 1.435e-2 m K, i.e. at 2848 * 1.4388 / 1.435 = 2855.5 K with
+     * today's c2: the independent route is the black body. */
+    lf_vec3 bb = lf_blackbody_rgb(2848.0 * 1.438777 / 1.435);
+    CHECK(lf_named_spectrum_rgb("stdillum-A", &n) == 0);
+    CHECK_NEAR(n.x, bb.x, 2e-3);
+    CHECK_NEAR(n.y, bb.y, 2e-3);
+    CHECK_NEAR(n.z, bb.z, 2e-3);
+    CHECK(n.x > 1.2f && n.z < 0.5f); /* orange */
+    /* The chromaticity route: D65's published (x, y) is the sRGB white to
+     * 1e-3 before the snap; luminance is 1 for every illuminant. */
+    const char *ill[] = {"stdillum-D50", "illum-acesD60", "stdillum-F1", "stdillum-F4", "stdillum-F7",
+                         "stdillum-F11", "stdillum-F12"};
+    for (size_t i = 0; i < sizeof ill / sizeof ill[0]; i++) {
+        CHECK(lf_named_spectrum_rgb(ill[i], &n) == 0);
+        CHECK_NEAR(0.2126 * n.x + 0.7152 * n.y + 0.0722 * n.z, 1.0, 1e-3);
+    }
+    lf_vec3 d65c = lf_xyz_to_linear_srgb(0.31272 / 0.32903, 1.0, (1 - 0.31272 - 0.32903) / 0.32903);
+    CHECK_NEAR(d65c.x, 1.0, 2e-3);
+    CHECK_NEAR(d65c.z, 1.0, 2e-3);
+    lf_vec3 f7, f12;
+    lf_named_spectrum_rgb("stdillum-F7", &f7); /* a D65 simulator: near white */
+    lf_named_spectrum_rgb("stdillum-F12", &f12); /* 3000 K: warm */
+    CHECK(fabsf(f7.x - 1.f) < 0.02f && fabsf(f7.z - 1.f) < 0.03f && f12.x > 1.2f && f12.z < 0.6f);
 }
 
 static void test_params_rgb(void)

@@ -395,7 +395,7 @@ static void test_objects(void)
     if (parse_ok("WorldBegin\nObjectInstance \"early\"\n"
                  "ObjectBegin \"tree\"\nShape \"sphere\"\nShape \"disk\"\nObjectEnd\n"
                  "ObjectBegin \"early\"\nShape \"sphere\"\nObjectEnd\n"
-                 "Shape \"cylinder\"\nTranslate 5 0 0\nObjectInstance \"tree\"\n",
+                 "Shape \"bilinearmesh\"\nTranslate 5 0 0\nObjectInstance \"tree\"\n",
                  &d)) {
         CHECK(d.n_objects == 2 && d.n_instances == 2 && d.n_shapes == 4);
         CHECK(strcmp(d.objects[0].name, "tree") == 0 && strcmp(d.objects[1].name, "early") == 0);

@@ -12,9 +12,9 @@
  * Expected numbers come from the thin-lens design, computed here:
  *   z_i = f z_o / (z_o - f); D = f/N; the matched design's image spacing is
  *   P_m = p (1 + p/D) (docs/lightfield.md), solved for p;
- *   Ng 2005's exact-refocus bound b = P p / D (P = 9 views): alpha in
- *   [1/(1+b), 1/(1-b)], depths 1/z = 1/z_o +- b/z_i;
- *   disparity of depth z: d = z_i (1/z - 1/z_o) D / (P p);
+ *   Ng 2005's exact-refocus bound b = P p / (D + p) (P = 9 views; his
+ *   P p / D for p << D): alpha in [1/(1+b), 1/(1-b)], depths
+ *   1/z = 1/z_o +- b/z_i; disparity of depth z: d = z_i (1/z - 1/z_o) / b;
  *   a point (X, Y, Z) appears in the views at column
  *   s = (X/Z (z_i + f_mla) + w/2) / P_m (the chief ray through the lens centre).
  * Sharpness of a region: mean squared difference of neighbouring pixels'
@@ -140,10 +140,12 @@ int main(void)
     const double fl = 12e-3, N = 2, zo = 0.5, sw = 5.76e-3, Wpx = 2160, Hpx = 1458, count = 240, P = 9;
     double zi = fl * zo / (zo - fl), D = fl / N, Pm = sw / count;
     double p = 0.5 * D * (sqrt(1 + 4 * Pm / D) - 1), fmla = p * zi / D;
-    double b = P * p / D;
+    /* P pixels span the microlens' image of the aperture, (D + p) / P of
+     * the aperture per view (Ng's P p / D for p << D) */
+    double b = P * p / (D + p);
     double a_lo = 1 / (1 + b), a_hi = 1 / (1 - b);
     double z_near = 1 / (1 / zo + b / zi), inv_far = 1 / zo - b / zi;
-    printf("design: z_i %.6g mm, p %.6g um, bound b = P p / D = %.6g: alpha %.6g .. %.6g, depths %.5g m .. %s\n",
+    printf("design: z_i %.6g mm, p %.6g um, bound b = P p / (D + p) = %.6g: alpha %.6g .. %.6g, depths %.5g m .. %s\n",
            zi * 1e3, p * 1e6, b, a_lo, a_hi, z_near, inv_far > 0 ? "finite" : "infinity");
 
     /* ---- --explain prints Ng's range ---- */
@@ -152,8 +154,8 @@ int main(void)
     CHECK_MSG(r != NULL, "%s", out_text);
     if (r) {
         double bb = 0, lo = 0, hi = 0, zn = 0;
-        const char *q = strstr(r, "P p / D = ");
-        CHECK(q && sscanf(q, "P p / D = %lf", &bb) == 1);
+        const char *q = strstr(r, "P p / (D + p) = ");
+        CHECK(q && sscanf(q, "P p / (D + p) = %lf", &bb) == 1);
         q = strstr(r, "alpha ");
         CHECK(q && sscanf(q, "alpha %lf .. %lf", &lo, &hi) == 2);
         q = strstr(r, "depths ");
@@ -183,7 +185,7 @@ int main(void)
         snprintf(out, sizeof out, "%s/refocus%d.exr", dir, k);
         CHECK(run("%s refocus %s --depth %g -o %s", LFTOOL, raw, subj[k].z, out) == 0);
         /* the disparity lftool used, against the design's */
-        double d = 0, want = zi * (1 / subj[k].z - 1 / zo) * D / (P * p);
+        double d = 0, want = zi * (1 / subj[k].z - 1 / zo) / b;
         const char *q = strstr(out_text, "refocused at disparity ");
         CHECK(q && sscanf(q, "refocused at disparity %lf", &d) == 1);
         CHECK_NEAR(d, want, 1e-6 + 1e-6 * fabs(want));

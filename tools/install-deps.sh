@@ -4,7 +4,7 @@
 # gets exactly what the build uses.
 set -euo pipefail
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config zlib1g-dev
   libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools
   clang libclang-rt-14-dev
   chromium nodejs

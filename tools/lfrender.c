@@ -4,7 +4,9 @@
  *   lfrender merge PART.exr... -o OUT.exr
  *
  * Exit codes: 0 success; 1 the scene or the render failed (message names
- * file:line:column); 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
+ * file:line:column; a scene with several errors gets each, up to 20, and
+ * something lensfield cannot render is an error unless --allow-unsupported);
+ * 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
  * after writing a checkpoint that --resume continues from.  No output file is
  * written on failure, and outputs are replaced atomically.
  */
@@ -29,7 +31,7 @@
 enum { MAX_PLUGINS = 16 };
 static struct {
     const char *out, *checkpoint, *tile, *aov, *tonemap, *plugins[MAX_PLUGINS];
-    int spp, threads, crop[4], spp_range[2], quiet, explain, white, part, resume, n_plugins;
+    int spp, threads, crop[4], spp_range[2], quiet, explain, white, part, resume, n_plugins, allow_unsupported;
     int have_seed, have_crop, have_spp_range;
     long long seed;
     double checkpoint_every, exposure;
@@ -251,8 +253,23 @@ static int run_render(int n, char **pos)
     }
     lf_error err = {0};
     lf_scene_desc desc;
-    if (lf_scene_parse_file(scene, &desc, &err)) {
-        fprintf(stderr, "lfrender: %s\n", err.msg);
+    lf_parse_opts popts = {opt.allow_unsupported, 0};
+    char *errors = NULL;
+    if (lf_scene_parse_file_ex(scene, &popts, &desc, &err, &errors)) {
+        /* every problem the parser found, one per line */
+        int count = 0;
+        for (const char *line = errors; line && *line;) {
+            const char *nl = strchr(line, '\n');
+            int len = nl ? (int)(nl - line) : (int)strlen(line);
+            fprintf(stderr, "lfrender: %.*s\n", len, line);
+            count += line[0] != '(';
+            line += len + (nl != NULL);
+        }
+        if (!errors)
+            fprintf(stderr, "lfrender: %s\n", err.msg);
+        else if (count > 1)
+            fprintf(stderr, "lfrender: %d errors in %s; nothing written\n", count, scene);
+        free(errors);
         return 1;
     }
     o.scene_path = scene;
@@ -376,6 +393,9 @@ static const lf_arg render_args[] = {
     {"--resume", NULL, LF_ARG_FLAG, &opt.resume, NULL, "continue from the checkpoint (same scene and settings)"},
     {"--camera-plugin", NULL, LF_ARG_LIST, opt.plugins, "LIB.so", "load camera types from a shared object",
      .count = MAX_PLUGINS, .count_out = &opt.n_plugins},
+    {"--allow-unsupported", NULL, LF_ARG_FLAG, &opt.allow_unsupported, NULL,
+     "render a scene with shapes, lights, materials, textures or alpha cut-outs lensfield cannot render: left out "
+     "or substituted, each with a warning (default: exit 1, docs/scene-format.md)"},
     {"--aov", NULL, LF_ARG_CHOICE, &opt.aov, "disparity",
      "light-field cameras: also write OUT.disparity.exr, the ground-truth disparity (px per view step) of every "
      "pixel's view (docs/lightfield-format.md)",

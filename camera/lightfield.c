@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "camera_internal.h"
 
 typedef struct lightfield {
@@ -186,16 +187,16 @@ static int lightfield_describe(const void *state, char *buf, size_t size)
 static void lightfield_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const lightfield *c = state;
-    sink->set_string(sink->ctx, "lensfield:kind", "camera-array");
+    sink->set_string(sink->ctx, LF_KEY_KIND, "camera-array");
     double dims[2] = {c->nx, c->ny};
-    sink->set_doubles(sink->ctx, "lensfield:cameras_per_dim", dims, 2);
-    sink->set_doubles(sink->ctx, "lensfield:camera_grid_bounds", c->bounds, 4);
-    sink->set_double(sink->ctx, "lensfield:fov_deg", c->fov_deg);
+    sink->set_doubles(sink->ctx, LF_KEY_CAMERAS_PER_DIM, dims, 2);
+    sink->set_doubles(sink->ctx, LF_KEY_CAMERA_GRID_BOUNDS, c->bounds, 4);
+    sink->set_double(sink->ctx, LF_KEY_FOV_DEG, c->fov_deg);
     double tile[2] = {c->tile_w, c->tile_h};
-    sink->set_doubles(sink->ctx, "lensfield:tile_size", tile, 2);
+    sink->set_doubles(sink->ctx, LF_KEY_TILE_SIZE, tile, 2);
     if (c->lens_radius > 0.0) {
-        sink->set_double(sink->ctx, "lensfield:lens_radius", c->lens_radius);
-        sink->set_double(sink->ctx, "lensfield:focal_distance", c->focal_distance);
+        sink->set_double(sink->ctx, LF_KEY_LENS_RADIUS, c->lens_radius);
+        sink->set_double(sink->ctx, LF_KEY_FOCAL_DISTANCE, c->focal_distance);
     }
 }
 

@@ -62,6 +62,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "camera_internal.h"
 #include "lens.h"
 
@@ -698,27 +699,27 @@ static int plenoptic_describe(const void *state, char *buf, size_t size)
 static void plenoptic_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const plenoptic *c = state;
-    sink->set_string(sink->ctx, "lensfield:kind", "plenoptic");
-    sink->set_string(sink->ctx, "lensfield:grid", c->hex ? "hex" : "square");
-    sink->set_double(sink->ctx, "lensfield:microlens_pitch_px", c->image_pitch_px);
-    sink->set_double(sink->ctx, "lensfield:microlens_rotation_rad", c->rotation_rad);
-    sink->set_doubles(sink->ctx, "lensfield:microlens_offset_px", c->origin_px, 2);
+    sink->set_string(sink->ctx, LF_KEY_KIND, "plenoptic");
+    sink->set_string(sink->ctx, LF_KEY_GRID, c->hex ? "hex" : "square");
+    sink->set_double(sink->ctx, LF_KEY_MICROLENS_PITCH_PX, c->image_pitch_px);
+    sink->set_double(sink->ctx, LF_KEY_MICROLENS_ROTATION_RAD, c->rotation_rad);
+    sink->set_doubles(sink->ctx, LF_KEY_MICROLENS_OFFSET_PX, c->origin_px, 2);
     double count[2] = {c->nx, c->ny};
-    sink->set_doubles(sink->ctx, "lensfield:microlens_count", count, 2);
-    sink->set_double(sink->ctx, "lensfield:microlens_pitch_um", c->pitch * 1e6);
-    sink->set_double(sink->ctx, "lensfield:microlens_focal_mm", c->mla_focal * 1e3);
-    sink->set_double(sink->ctx, "lensfield:main_focal_mm", c->focal_length * 1e3);
-    sink->set_double(sink->ctx, "lensfield:main_fstop", c->fstop);
-    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance);
-    sink->set_double(sink->ctx, "lensfield:mla_distance_mm", c->mla_distance * 1e3);
+    sink->set_doubles(sink->ctx, LF_KEY_MICROLENS_COUNT, count, 2);
+    sink->set_double(sink->ctx, LF_KEY_MICROLENS_PITCH_UM, c->pitch * 1e6);
+    sink->set_double(sink->ctx, LF_KEY_MICROLENS_FOCAL_MM, c->mla_focal * 1e3);
+    sink->set_double(sink->ctx, LF_KEY_MAIN_FOCAL_MM, c->focal_length * 1e3);
+    sink->set_double(sink->ctx, LF_KEY_MAIN_FSTOP, c->fstop);
+    sink->set_double(sink->ctx, LF_KEY_FOCUS_DISTANCE_M, c->focus_distance);
+    sink->set_double(sink->ctx, LF_KEY_MLA_DISTANCE_MM, c->mla_distance * 1e3);
     double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
-    sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
-    sink->set_double(sink->ctx, "lensfield:sensor_offset_mm", c->sensor_offset * 1e3);
+    sink->set_doubles(sink->ctx, LF_KEY_SENSOR_SIZE_MM, wh, 2);
+    sink->set_double(sink->ctx, LF_KEY_SENSOR_OFFSET_MM, c->sensor_offset * 1e3);
     if (c->compound) {
-        sink->set_string(sink->ctx, "lensfield:lens_file", c->lens.path);
-        sink->set_double(sink->ctx, "lensfield:lens_efl_mm", c->px.efl_mm);
-        sink->set_double(sink->ctx, "lensfield:lens_working_fnumber", c->working_fnumber);
-        sink->set_double(sink->ctx, "lensfield:lens_film_distance_mm", c->lens.film_distance_mm);
+        sink->set_string(sink->ctx, LF_KEY_LENS_FILE, c->lens.path);
+        sink->set_double(sink->ctx, LF_KEY_LENS_EFL_MM, c->px.efl_mm);
+        sink->set_double(sink->ctx, LF_KEY_LENS_WORKING_FNUMBER, c->working_fnumber);
+        sink->set_double(sink->ctx, LF_KEY_LENS_FILM_DISTANCE_MM, c->lens.film_distance_mm);
     }
 }
 

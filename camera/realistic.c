@@ -29,6 +29,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "../base/lf_keys.h"
 #include "../base/lf_color.h"
 #include "aperture.h"
 #include "camera_internal.h"
@@ -388,16 +389,16 @@ static int realistic_describe(const void *state, char *buf, size_t size)
 static void realistic_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const realistic *c = state;
-    sink->set_string(sink->ctx, "lensfield:lens_file", c->lens.path);
-    sink->set_double(sink->ctx, "lensfield:lens_efl_mm", c->px.efl_mm);
-    sink->set_double(sink->ctx, "lensfield:lens_working_fnumber", c->working_fnumber);
-    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance_mm * 1e-3);
-    sink->set_double(sink->ctx, "lensfield:lens_film_distance_mm", c->lens.film_distance_mm);
-    sink->set_int(sink->ctx, "lensfield:lens_dispersion", c->lens.dispersive);
-    sink->set_string(sink->ctx, "lensfield:lens_model", c->use_poly ? "polynomial" : "traced");
+    sink->set_string(sink->ctx, LF_KEY_LENS_FILE, c->lens.path);
+    sink->set_double(sink->ctx, LF_KEY_LENS_EFL_MM, c->px.efl_mm);
+    sink->set_double(sink->ctx, LF_KEY_LENS_WORKING_FNUMBER, c->working_fnumber);
+    sink->set_double(sink->ctx, LF_KEY_FOCUS_DISTANCE_M, c->focus_distance_mm * 1e-3);
+    sink->set_double(sink->ctx, LF_KEY_LENS_FILM_DISTANCE_MM, c->lens.film_distance_mm);
+    sink->set_int(sink->ctx, LF_KEY_LENS_DISPERSION, c->lens.dispersive);
+    sink->set_string(sink->ctx, LF_KEY_LENS_MODEL, c->use_poly ? "polynomial" : "traced");
     /* film to the front principal plane H: where a thin lens standing in for
      * this lens goes (bench/accuracy.sh) */
-    sink->set_double(sink->ctx, "lensfield:lens_front_principal_from_film_mm",
+    sink->set_double(sink->ctx, LF_KEY_LENS_FRONT_PRINCIPAL_FROM_FILM_MM,
                      c->lens.film_distance_mm + c->px.total_length_mm - c->px.front_principal_mm);
 }
 

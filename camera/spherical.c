@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "camera_internal.h"
 
 typedef struct spherical {
@@ -150,7 +151,7 @@ static int spherical_describe(const void *state, char *buf, size_t size)
 static void spherical_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const spherical *c = state;
-    sink->set_string(sink->ctx, "lensfield:projection", c->equal_area ? "equalarea" : "equirectangular");
+    sink->set_string(sink->ctx, LF_KEY_PROJECTION, c->equal_area ? "equalarea" : "equirectangular");
 }
 
 const lf_camera_type lf_camera_spherical = {

@@ -37,6 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "aperture.h"
 #include "camera_internal.h"
 
@@ -279,13 +280,13 @@ static int thinlens_describe(const void *state, char *buf, size_t size)
 static void thinlens_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const thinlens *c = state;
-    sink->set_double(sink->ctx, "lensfield:focal_length_mm", c->focal_length * 1e3);
-    sink->set_double(sink->ctx, "lensfield:fstop", c->fstop);
-    sink->set_double(sink->ctx, "lensfield:focus_distance_m", c->focus_distance);
-    sink->set_double(sink->ctx, "lensfield:sensor_distance_mm", c->sensor_distance * 1e3);
+    sink->set_double(sink->ctx, LF_KEY_FOCAL_LENGTH_MM, c->focal_length * 1e3);
+    sink->set_double(sink->ctx, LF_KEY_FSTOP, c->fstop);
+    sink->set_double(sink->ctx, LF_KEY_FOCUS_DISTANCE_M, c->focus_distance);
+    sink->set_double(sink->ctx, LF_KEY_SENSOR_DISTANCE_MM, c->sensor_distance * 1e3);
     double wh[2] = {c->sensor_w * 1e3, c->sensor_h * 1e3};
-    sink->set_doubles(sink->ctx, "lensfield:sensor_size_mm", wh, 2);
-    sink->set_string(sink->ctx, "lensfield:aperture", lf_aperture_name(&c->aperture));
+    sink->set_doubles(sink->ctx, LF_KEY_SENSOR_SIZE_MM, wh, 2);
+    sink->set_string(sink->ctx, LF_KEY_APERTURE, lf_aperture_name(&c->aperture));
 }
 
 const lf_camera_type lf_camera_thinlens = {

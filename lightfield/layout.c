@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "lf_lightfield.h"
 
 void lf_lf_layout_init(lf_lf_layout *lay)
@@ -64,7 +65,7 @@ static int finite_within(const double *v, int n, double limit)
 int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
 {
     lf_lf_layout_init(lay);
-    const lf_attr *k = lf_attrs_get(a, "lensfield:kind");
+    const lf_attr *k = lf_attrs_get(a, LF_KEY_KIND);
     if (k) {
         if (k->type != LF_ATTR_STRING)
             return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:kind: expected a string");
@@ -79,7 +80,7 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
     }
     double v[4];
     int r;
-    if ((r = attr_vec(a, "lensfield:cameras_per_dim", 2, v, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_CAMERAS_PER_DIM, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 4096) || !whole_in(v[1], 1, 4096))
@@ -90,17 +91,17 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
         lay->cams_y = (int)v[1];
         lay->have |= LF_LF_HAVE_CAMS;
     }
-    if ((r = attr_vec(a, "lensfield:camera_grid_bounds", 4, lay->grid_bounds, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_CAMERA_GRID_BOUNDS, 4, lay->grid_bounds, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && !finite_within(lay->grid_bounds, 4, 1e12))
         return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:camera_grid_bounds: values must be finite");
     if (r)
         lay->have |= LF_LF_HAVE_BOUNDS;
-    if ((r = attr_num(a, "lensfield:fov_deg", &lay->fov_deg, err)) < 0)
+    if ((r = attr_num(a, LF_KEY_FOV_DEG, &lay->fov_deg, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LF_HAVE_FOV;
-    if ((r = attr_vec(a, "lensfield:tile_size", 2, v, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_TILE_SIZE, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
@@ -109,33 +110,33 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
         lay->tile_h = (int)v[1];
         lay->have |= LF_LF_HAVE_TILE;
     }
-    int lr = attr_num(a, "lensfield:lens_radius", &lay->lens_radius, err);
-    int fd = attr_num(a, "lensfield:focal_distance", &lay->focal_distance, err);
+    int lr = attr_num(a, LF_KEY_LENS_RADIUS, &lay->lens_radius, err);
+    int fd = attr_num(a, LF_KEY_FOCAL_DISTANCE, &lay->focal_distance, err);
     if (lr < 0 || fd < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (lr || fd)
         lay->have |= LF_LF_HAVE_CAM_LENS;
 
-    const lf_attr *g = lf_attrs_get(a, "lensfield:grid");
+    const lf_attr *g = lf_attrs_get(a, LF_KEY_GRID);
     if (g) {
         if (g->type != LF_ATTR_STRING || (strcmp(g->s, "square") && strcmp(g->s, "hex")))
             return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:grid: expected \"square\" or \"hex\"");
         lay->grid = strcmp(g->s, "hex") ? LF_LF_GRID_SQUARE : LF_LF_GRID_HEX;
         lay->have |= LF_LF_HAVE_GRID;
     }
-    if ((r = attr_num(a, "lensfield:microlens_pitch_px", &lay->pitch_px, err)) < 0)
+    if ((r = attr_num(a, LF_KEY_MICROLENS_PITCH_PX, &lay->pitch_px, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LF_HAVE_PITCH;
-    if ((r = attr_num(a, "lensfield:microlens_rotation_rad", &lay->rotation_rad, err)) < 0)
+    if ((r = attr_num(a, LF_KEY_MICROLENS_ROTATION_RAD, &lay->rotation_rad, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LF_HAVE_ROTATION;
-    if ((r = attr_vec(a, "lensfield:microlens_offset_px", 2, lay->offset_px, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_MICROLENS_OFFSET_PX, 2, lay->offset_px, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LF_HAVE_OFFSET;
-    if ((r = attr_vec(a, "lensfield:microlens_count", 2, v, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_MICROLENS_COUNT, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
@@ -146,22 +147,22 @@ int lf_lf_layout_from_attrs(const lf_attrs *a, lf_lf_layout *lay, lf_error *err)
         lay->have |= LF_LF_HAVE_LENS_COUNT;
     }
     int n = 0;
-    n += attr_num(a, "lensfield:main_focal_mm", &lay->main_focal_mm, err) > 0;
-    n += attr_num(a, "lensfield:main_fstop", &lay->main_fstop, err) > 0;
-    n += attr_num(a, "lensfield:mla_distance_mm", &lay->mla_distance_mm, err) > 0;
-    n += attr_num(a, "lensfield:microlens_pitch_um", &lay->pitch_um, err) > 0;
-    attr_num(a, "lensfield:focus_distance_m", &lay->focus_distance_m, err);
-    attr_num(a, "lensfield:microlens_focal_mm", &lay->microlens_focal_mm, err);
-    attr_num(a, "lensfield:sensor_offset_mm", &lay->sensor_offset_mm, err);
+    n += attr_num(a, LF_KEY_MAIN_FOCAL_MM, &lay->main_focal_mm, err) > 0;
+    n += attr_num(a, LF_KEY_MAIN_FSTOP, &lay->main_fstop, err) > 0;
+    n += attr_num(a, LF_KEY_MLA_DISTANCE_MM, &lay->mla_distance_mm, err) > 0;
+    n += attr_num(a, LF_KEY_MICROLENS_PITCH_UM, &lay->pitch_um, err) > 0;
+    attr_num(a, LF_KEY_FOCUS_DISTANCE_M, &lay->focus_distance_m, err);
+    attr_num(a, LF_KEY_MICROLENS_FOCAL_MM, &lay->microlens_focal_mm, err);
+    attr_num(a, LF_KEY_SENSOR_OFFSET_MM, &lay->sensor_offset_mm, err);
     if (!(isfinite(lay->microlens_focal_mm) && lay->microlens_focal_mm >= 0 && lay->microlens_focal_mm < 1e6 &&
           isfinite(lay->sensor_offset_mm) && fabs(lay->sensor_offset_mm) < 1e6))
         lay->microlens_focal_mm = 0, lay->sensor_offset_mm = 0;
     double rng[2];
-    if ((r = attr_vec(a, "lensfield:disparity_range", 2, rng, err)) < 0)
+    if ((r = attr_vec(a, LF_KEY_DISPARITY_RANGE, 2, rng, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && finite_within(rng, 2, 1e9) && rng[0] <= rng[1])
         lay->disp_min = rng[0], lay->disp_max = rng[1], lay->have |= LF_LF_HAVE_DISP_RANGE;
-    if ((r = attr_num(a, "lensfield:convergence_distance", &lay->convergence_m, err)) < 0)
+    if ((r = attr_num(a, LF_KEY_CONVERGENCE_DISTANCE, &lay->convergence_m, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && isfinite(lay->convergence_m) && lay->convergence_m > 0)
         lay->have |= LF_LF_HAVE_CONVERGENCE;
@@ -303,39 +304,39 @@ int lf_lf_layout_to_attrs(const lf_lf_layout *lay, lf_attrs *a, lf_error *err)
     int r = 0;
     float v[4];
     if (lay->kind == LF_LF_CAMERA_ARRAY) {
-        r |= lf_attrs_set_string(a, "lensfield:kind", "camera-array");
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, "camera-array");
         v[0] = (float)lay->cams_x, v[1] = (float)lay->cams_y;
-        r |= lf_attrs_set_floats(a, "lensfield:cameras_per_dim", v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_CAMERAS_PER_DIM, v, 2);
         if (lay->have & LF_LF_HAVE_BOUNDS) {
             for (int i = 0; i < 4; i++)
                 v[i] = (float)lay->grid_bounds[i];
-            r |= lf_attrs_set_floats(a, "lensfield:camera_grid_bounds", v, 4);
+            r |= lf_attrs_set_floats(a, LF_KEY_CAMERA_GRID_BOUNDS, v, 4);
         }
         if (lay->have & LF_LF_HAVE_FOV)
-            r |= lf_attrs_set_double(a, "lensfield:fov_deg", lay->fov_deg);
+            r |= lf_attrs_set_double(a, LF_KEY_FOV_DEG, lay->fov_deg);
         v[0] = (float)lay->tile_w, v[1] = (float)lay->tile_h;
-        r |= lf_attrs_set_floats(a, "lensfield:tile_size", v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_TILE_SIZE, v, 2);
         if (lay->have & LF_LF_HAVE_CONVERGENCE)
-            r |= lf_attrs_set_double(a, "lensfield:convergence_distance", lay->convergence_m);
+            r |= lf_attrs_set_double(a, LF_KEY_CONVERGENCE_DISTANCE, lay->convergence_m);
     } else if (lay->kind == LF_LF_PLENOPTIC) {
-        r |= lf_attrs_set_string(a, "lensfield:kind", "plenoptic");
-        r |= lf_attrs_set_string(a, "lensfield:grid", lay->grid == LF_LF_GRID_HEX ? "hex" : "square");
-        r |= lf_attrs_set_double(a, "lensfield:microlens_pitch_px", lay->pitch_px);
-        r |= lf_attrs_set_double(a, "lensfield:microlens_rotation_rad", lay->rotation_rad);
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, "plenoptic");
+        r |= lf_attrs_set_string(a, LF_KEY_GRID, lay->grid == LF_LF_GRID_HEX ? "hex" : "square");
+        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_PX, lay->pitch_px);
+        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_ROTATION_RAD, lay->rotation_rad);
         v[0] = (float)lay->offset_px[0], v[1] = (float)lay->offset_px[1];
-        r |= lf_attrs_set_floats(a, "lensfield:microlens_offset_px", v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_OFFSET_PX, v, 2);
         v[0] = (float)lay->lens_x, v[1] = (float)lay->lens_y;
-        r |= lf_attrs_set_floats(a, "lensfield:microlens_count", v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_COUNT, v, 2);
         if (lay->have & LF_LF_HAVE_MAIN_LENS) {
-            r |= lf_attrs_set_double(a, "lensfield:main_focal_mm", lay->main_focal_mm);
-            r |= lf_attrs_set_double(a, "lensfield:main_fstop", lay->main_fstop);
-            r |= lf_attrs_set_double(a, "lensfield:mla_distance_mm", lay->mla_distance_mm);
-            r |= lf_attrs_set_double(a, "lensfield:microlens_pitch_um", lay->pitch_um);
+            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FOCAL_MM, lay->main_focal_mm);
+            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FSTOP, lay->main_fstop);
+            r |= lf_attrs_set_double(a, LF_KEY_MLA_DISTANCE_MM, lay->mla_distance_mm);
+            r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_UM, lay->pitch_um);
         }
     }
     if (lay->have & LF_LF_HAVE_DISP_RANGE) {
         v[0] = (float)lay->disp_min, v[1] = (float)lay->disp_max;
-        r |= lf_attrs_set_floats(a, "lensfield:disparity_range", v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_DISPARITY_RANGE, v, 2);
     }
     return r ? lf_error_set(err, LF_ERR_NOMEM, "out of memory writing layout attributes") : LF_OK;
 }

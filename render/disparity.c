@@ -25,6 +25,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "render_internal.h"
 
 static int get_num(const lf_attrs *m, const char *name, double *v)
@@ -59,7 +60,7 @@ static int get_vec(const lf_attrs *m, const char *name, int n, double *v)
 int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparity_geom *g, lf_error *err)
 {
     memset(g, 0, sizeof *g);
-    const lf_attr *k = lf_attrs_get(meta, "lensfield:kind");
+    const lf_attr *k = lf_attrs_get(meta, LF_KEY_KIND);
     if (!k || k->type != LF_ATTR_STRING)
         return lf_error_set(err, LF_ERR_PARAM,
                             "the disparity AOV needs a light-field camera (Camera \"lightfield\" or \"plenoptic\", or a "
@@ -67,8 +68,8 @@ int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparit
     g->xres = xres, g->yres = yres;
     if (!strcmp(k->s, "camera-array")) {
         double dims[2], tile[2], fov;
-        if (!get_vec(meta, "lensfield:cameras_per_dim", 2, dims) || !get_vec(meta, "lensfield:tile_size", 2, tile) ||
-            !get_vec(meta, "lensfield:camera_grid_bounds", 4, g->bounds) || !get_num(meta, "lensfield:fov_deg", &fov))
+        if (!get_vec(meta, LF_KEY_CAMERAS_PER_DIM, 2, dims) || !get_vec(meta, LF_KEY_TILE_SIZE, 2, tile) ||
+            !get_vec(meta, LF_KEY_CAMERA_GRID_BOUNDS, 4, g->bounds) || !get_num(meta, LF_KEY_FOV_DEG, &fov))
             return lf_error_set(err, LF_ERR_PARAM,
                                 "disparity AOV: the camera array's attributes are incomplete (cameras_per_dim, "
                                 "tile_size, camera_grid_bounds, fov_deg)");
@@ -93,19 +94,19 @@ int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparit
     }
     if (!strcmp(k->s, "plenoptic")) {
         double sensor[2], off[2], count[2], rot = 0;
-        const lf_attr *grid = lf_attrs_get(meta, "lensfield:grid");
-        if (!get_num(meta, "lensfield:microlens_pitch_px", &g->pitch_px) ||
-            !get_vec(meta, "lensfield:microlens_offset_px", 2, off) ||
-            !get_vec(meta, "lensfield:microlens_count", 2, count) ||
-            !get_vec(meta, "lensfield:sensor_size_mm", 2, sensor) ||
-            !get_num(meta, "lensfield:microlens_focal_mm", &g->fmla_mm) ||
-            !get_num(meta, "lensfield:mla_distance_mm", &g->zi_mm) ||
-            !get_num(meta, "lensfield:main_focal_mm", &g->f_mm))
+        const lf_attr *grid = lf_attrs_get(meta, LF_KEY_GRID);
+        if (!get_num(meta, LF_KEY_MICROLENS_PITCH_PX, &g->pitch_px) ||
+            !get_vec(meta, LF_KEY_MICROLENS_OFFSET_PX, 2, off) ||
+            !get_vec(meta, LF_KEY_MICROLENS_COUNT, 2, count) ||
+            !get_vec(meta, LF_KEY_SENSOR_SIZE_MM, 2, sensor) ||
+            !get_num(meta, LF_KEY_MICROLENS_FOCAL_MM, &g->fmla_mm) ||
+            !get_num(meta, LF_KEY_MLA_DISTANCE_MM, &g->zi_mm) ||
+            !get_num(meta, LF_KEY_MAIN_FOCAL_MM, &g->f_mm))
             return lf_error_set(err, LF_ERR_PARAM,
                                 "disparity AOV: the plenoptic camera's attributes are incomplete (microlens pitch, "
                                 "offset, count and focal length, sensor size, main lens)");
-        get_num(meta, "lensfield:microlens_rotation_rad", &rot);
-        get_num(meta, "lensfield:sensor_offset_mm", &g->sensor_offset_mm);
+        get_num(meta, LF_KEY_MICROLENS_ROTATION_RAD, &rot);
+        get_num(meta, LF_KEY_SENSOR_OFFSET_MM, &g->sensor_offset_mm);
         g->kind = LF_LF_PLENOPTIC_KIND;
         g->hex = grid && grid->type == LF_ATTR_STRING && !strcmp(grid->s, "hex");
         g->cos_r = cos(rot), g->sin_r = sin(rot);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_keys.h"
 #include "film.h"
 #include "lf_render.h"
 
@@ -41,13 +42,13 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
             rc = lf_error_set(err, e.code, "merge: %s", e.msg);
             break;
         }
-        const lf_attr *st = lf_attrs_get(&p->attrs, "lensfield:settings");
-        const lf_attr *pb = lf_attrs_get(&p->attrs, "lensfield:pixel_bounds");
+        const lf_attr *st = lf_attrs_get(&p->attrs, LF_KEY_SETTINGS);
+        const lf_attr *pb = lf_attrs_get(&p->attrs, LF_KEY_PIXEL_BOUNDS);
         int is_part = 0, total = 0;
-        if (get_int(&p->attrs, "lensfield:part", &is_part) || !is_part || !st || st->type != LF_ATTR_STRING || !pb ||
-            pb->n != 4 || get_int(&p->attrs, "lensfield:spp_begin", &p->spp_begin) ||
-            get_int(&p->attrs, "lensfield:spp_end", &p->spp_end) ||
-            get_int(&p->attrs, "lensfield:spp_total", &total) || p->img.channels != 3 + LF_ACC_CHANNELS) {
+        if (get_int(&p->attrs, LF_KEY_PART, &is_part) || !is_part || !st || st->type != LF_ATTR_STRING || !pb ||
+            pb->n != 4 || get_int(&p->attrs, LF_KEY_SPP_BEGIN, &p->spp_begin) ||
+            get_int(&p->attrs, LF_KEY_SPP_END, &p->spp_end) ||
+            get_int(&p->attrs, LF_KEY_SPP_TOTAL, &total) || p->img.channels != 3 + LF_ACC_CHANNELS) {
             rc = lf_error_set(err, LF_ERR_PARAM,
                               "merge: %s is not a render part (render parts with --spp-range, --tile or --part)",
                               paths[i]);
@@ -72,7 +73,7 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
         bx1 = p->bounds[1] > bx1 ? p->bounds[1] : bx1;
         by0 = p->bounds[2] < by0 ? p->bounds[2] : by0;
         by1 = p->bounds[3] > by1 ? p->bounds[3] : by1;
-        const lf_attr *t = lf_attrs_get(&p->attrs, "lensfield:render_time_s");
+        const lf_attr *t = lf_attrs_get(&p->attrs, LF_KEY_RENDER_TIME_S);
         if (t && t->type == LF_ATTR_DOUBLE)
             seconds += t->d;
     }
@@ -110,8 +111,8 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
             const lf_attrs *a0 = &parts[0].attrs;
             for (size_t j = 0; j < a0->count; j++) {
                 const lf_attr *x = &a0->items[j];
-                if (strncmp(x->name, "lensfield:", 10) != 0 || !strcmp(x->name, "lensfield:part") ||
-                    !strcmp(x->name, "lensfield:spp_begin") || !strcmp(x->name, "lensfield:spp_end"))
+                if (strncmp(x->name, LF_KEY_PREFIX, sizeof LF_KEY_PREFIX - 1) != 0 || !strcmp(x->name, LF_KEY_PART) ||
+                    !strcmp(x->name, LF_KEY_SPP_BEGIN) || !strcmp(x->name, LF_KEY_SPP_END))
                     continue;
                 switch (x->type) {
                 case LF_ATTR_STRING: lf_attrs_set_string(meta, x->name, x->s); break;
@@ -122,11 +123,11 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
                 case LF_ATTR_M44D: lf_attrs_set_m44d(meta, x->name, x->m); break;
                 }
             }
-            lf_attrs_set_int(meta, "lensfield:spp", spp_total);
-            lf_attrs_set_int(meta, "lensfield:merged_parts", n);
-            lf_attrs_set_double(meta, "lensfield:render_time_s", seconds);
+            lf_attrs_set_int(meta, LF_KEY_SPP, spp_total);
+            lf_attrs_set_int(meta, LF_KEY_MERGED_PARTS, n);
+            lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, seconds);
             float b[4] = {(float)bx0, (float)bx1, (float)by0, (float)by1};
-            lf_attrs_set_floats(meta, "lensfield:pixel_bounds", b, 4);
+            lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, b, 4);
         }
     } else if (!rc) {
         rc = err->code;

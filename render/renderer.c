@@ -16,6 +16,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "../base/lf_keys.h"
 #include "../base/lf_color.h"
 #include "film.h"
 #include "render_internal.h"
@@ -1094,14 +1095,14 @@ static void done_tiles_hex(const job *jb, const unsigned char *done, char *buf, 
 
 static void part_attrs(const lf_renderer *r, lf_attrs *meta)
 {
-    lf_attrs_set_string(meta, "lensfield:settings", r->settings);
-    lf_attrs_set_int(meta, "lensfield:spp_begin", r->spp_begin);
-    lf_attrs_set_int(meta, "lensfield:spp_end", r->spp_end);
-    lf_attrs_set_int(meta, "lensfield:spp_total", r->sampler.spp);
+    lf_attrs_set_string(meta, LF_KEY_SETTINGS, r->settings);
+    lf_attrs_set_int(meta, LF_KEY_SPP_BEGIN, r->spp_begin);
+    lf_attrs_set_int(meta, LF_KEY_SPP_END, r->spp_end);
+    lf_attrs_set_int(meta, LF_KEY_SPP_TOTAL, r->sampler.spp);
     float res[2] = {(float)r->xres, (float)r->yres};
-    lf_attrs_set_floats(meta, "lensfield:full_resolution", res, 2);
+    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
     float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
-    lf_attrs_set_floats(meta, "lensfield:pixel_bounds", crop, 4);
+    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
 }
 
 static int write_checkpoint(const lf_renderer *r, const job *jb, lf_error *err)
@@ -1132,8 +1133,8 @@ static int write_checkpoint(const lf_renderer *r, const job *jb, lf_error *err)
     }
     done_tiles_hex(jb, done, hex, (size_t)total / 4 + 2);
     free(done);
-    lf_attrs_set_string(&a, "lensfield:done_tiles", hex);
-    lf_attrs_set_int(&a, "lensfield:checkpoint", 1);
+    lf_attrs_set_string(&a, LF_KEY_DONE_TILES, hex);
+    lf_attrs_set_int(&a, LF_KEY_CHECKPOINT, 1);
     free(hex);
     lf_write_opts wo = {0};
     int rc = lf_image_write(r->opts.checkpoint_path, &ck, &a, &wo, err);
@@ -1151,9 +1152,9 @@ static int load_checkpoint(lf_renderer *r, job *jb, lf_error *err)
     lf_error e = {0};
     if (lf_image_read(r->opts.checkpoint_path, &ck, &a, &e))
         return lf_error_set(err, e.code, "cannot resume: %s", e.msg);
-    const lf_attr *st = lf_attrs_get(&a, "lensfield:settings"), *hex = lf_attrs_get(&a, "lensfield:done_tiles");
-    const lf_attr *b0 = lf_attrs_get(&a, "lensfield:spp_begin"), *b1 = lf_attrs_get(&a, "lensfield:spp_end");
-    const lf_attr *pb = lf_attrs_get(&a, "lensfield:pixel_bounds");
+    const lf_attr *st = lf_attrs_get(&a, LF_KEY_SETTINGS), *hex = lf_attrs_get(&a, LF_KEY_DONE_TILES);
+    const lf_attr *b0 = lf_attrs_get(&a, LF_KEY_SPP_BEGIN), *b1 = lf_attrs_get(&a, LF_KEY_SPP_END);
+    const lf_attr *pb = lf_attrs_get(&a, LF_KEY_PIXEL_BOUNDS);
     int ok = st && st->type == LF_ATTR_STRING && !strcmp(st->s, r->settings) && hex && hex->type == LF_ATTR_STRING &&
              b0 && b1 && b0->i == r->spp_begin && b1->i == r->spp_end && pb && pb->n == 4 && pb->v[0] == r->px0 &&
              pb->v[1] == r->px1 && pb->v[2] == r->py0 && pb->v[3] == r->py1 && ck.width == jb->img->width &&
@@ -1310,47 +1311,47 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     r->stats.nonfinite_samples = jb.nonfinite;
     r->stats.zero_weight_camera_rays = jb.zero_weight;
     if (meta) {
-        lf_attrs_set_string(meta, "lensfield:version", LF_VERSION_STRING);
-        lf_attrs_set_string(meta, "lensfield:camera", r->camera_name);
+        lf_attrs_set_string(meta, LF_KEY_VERSION, LF_VERSION_STRING);
+        lf_attrs_set_string(meta, LF_KEY_CAMERA, r->camera_name);
         if (r->scene_path)
-            lf_attrs_set_string(meta, "lensfield:scene", r->scene_path);
-        lf_attrs_set_int(meta, "lensfield:spp", r->spp_end - r->spp_begin);
-        lf_attrs_set_string(meta, "lensfield:scene_hash", r->scene_hash);
-        lf_attrs_set_int(meta, "lensfield:savefp16", r->save_half);
+            lf_attrs_set_string(meta, LF_KEY_SCENE, r->scene_path);
+        lf_attrs_set_int(meta, LF_KEY_SPP, r->spp_end - r->spp_begin);
+        lf_attrs_set_string(meta, LF_KEY_SCENE_HASH, r->scene_hash);
+        lf_attrs_set_int(meta, LF_KEY_SAVEFP16, r->save_half);
         if (r->opts.part) {
-            lf_attrs_set_int(meta, "lensfield:part", 1);
+            lf_attrs_set_int(meta, LF_KEY_PART, 1);
             part_attrs(r, meta);
         }
-        lf_attrs_set_int(meta, "lensfield:seed", (int)r->sampler.seed);
-        lf_attrs_set_string(meta, "lensfield:sampler", r->sampler_name);
-        lf_attrs_set_string(meta, "lensfield:filter", r->filter_name);
-        lf_attrs_set_int(meta, "lensfield:maxdepth", r->integrator.max_depth);
-        lf_attrs_set_double(meta, "lensfield:render_time_s", r->stats.seconds);
-        lf_attrs_set_int(meta, "lensfield:threads", r->threads);
+        lf_attrs_set_int(meta, LF_KEY_SEED, (int)r->sampler.seed);
+        lf_attrs_set_string(meta, LF_KEY_SAMPLER, r->sampler_name);
+        lf_attrs_set_string(meta, LF_KEY_FILTER, r->filter_name);
+        lf_attrs_set_int(meta, LF_KEY_MAXDEPTH, r->integrator.max_depth);
+        lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, r->stats.seconds);
+        lf_attrs_set_int(meta, LF_KEY_THREADS, r->threads);
         float res[2] = {(float)r->xres, (float)r->yres};
-        lf_attrs_set_floats(meta, "lensfield:full_resolution", res, 2);
+        lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
         float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
-        lf_attrs_set_floats(meta, "lensfield:pixel_bounds", crop, 4);
-        lf_attrs_set_double(meta, "lensfield:film_diagonal_mm", r->diagonal_mm);
-        lf_attrs_set_double(meta, "lensfield:shutter_open", r->shutter_open);
-        lf_attrs_set_double(meta, "lensfield:shutter_close", r->shutter_close);
-        lf_attrs_set_double(meta, "lensfield:imaging_ratio", r->imaging_ratio);
-        lf_attrs_set_int(meta, "lensfield:nonfinite_samples", (int)r->stats.nonfinite_samples);
+        lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
+        lf_attrs_set_double(meta, LF_KEY_FILM_DIAGONAL_MM, r->diagonal_mm);
+        lf_attrs_set_double(meta, LF_KEY_SHUTTER_OPEN, r->shutter_open);
+        lf_attrs_set_double(meta, LF_KEY_SHUTTER_CLOSE, r->shutter_close);
+        lf_attrs_set_double(meta, LF_KEY_IMAGING_RATIO, r->imaging_ratio);
+        lf_attrs_set_int(meta, LF_KEY_NONFINITE_SAMPLES, (int)r->stats.nonfinite_samples);
         double m[16];
         for (int i = 0; i < 16; i++)
             m[i] = r->world_to_camera.m[i / 4][i % 4];
-        lf_attrs_set_m44d(meta, "lensfield:world_to_camera", m);
+        lf_attrs_set_m44d(meta, LF_KEY_WORLD_TO_CAMERA, m);
         if (r->white)
-            lf_attrs_set_int(meta, "lensfield:white", 1);
-        lf_attrs_set_string(meta, "lensfield:shutter", r->rolling ? "rolling" : "global");
+            lf_attrs_set_int(meta, LF_KEY_WHITE, 1);
+        lf_attrs_set_string(meta, LF_KEY_SHUTTER, r->rolling ? "rolling" : "global");
         if (r->rolling) {
-            lf_attrs_set_double(meta, "lensfield:readout_time", r->readout);
-            lf_attrs_set_string(meta, "lensfield:readout_direction",
+            lf_attrs_set_double(meta, LF_KEY_READOUT_TIME, r->readout);
+            lf_attrs_set_string(meta, LF_KEY_READOUT_DIRECTION,
                                 (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir]);
         }
         if (r->has_curve)
-            lf_attrs_set_double(meta, "lensfield:shutter_efficiency", r->curve_mean);
-        lf_attrs_set_int(meta, "lensfield:motion_blur", r->time_needed);
+            lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean);
+        lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed);
         if (r->camera_type->metadata) {
             lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
             r->camera_type->metadata(r->camera, &sink);

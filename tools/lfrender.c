@@ -22,6 +22,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/lf_keys.h"
 #include "camera/lf_camera.h"
 #include "cli.h"
 #include "image/lf_image.h"
@@ -128,8 +129,8 @@ static int write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, int 
     float range[2] = {INFINITY, -INFINITY};
     for (size_t i = 0; i < (size_t)d.width * d.height; i++)
         range[0] = d.data[i] < range[0] ? d.data[i] : range[0], range[1] = d.data[i] > range[1] ? d.data[i] : range[1];
-    lf_attrs_set_string(meta, "lensfield:disparity_file", base);
-    lf_attrs_set_floats(meta, "lensfield:disparity_range", range, 2);
+    lf_attrs_set_string(meta, LF_KEY_DISPARITY_FILE, base);
+    lf_attrs_set_floats(meta, LF_KEY_DISPARITY_RANGE, range, 2);
     lf_attrs a = {0};
     for (size_t k = 0; k < meta->count && !rc; k++) {
         const lf_attr *at = &meta->items[k];
@@ -143,7 +144,7 @@ static int write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, int 
         }
     }
     if (!rc)
-        rc = lf_attrs_set_string(&a, "lensfield:aov", "disparity");
+        rc = lf_attrs_set_string(&a, LF_KEY_AOV, "disparity");
     if (rc)
         rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the disparity AOV's attributes");
     else
@@ -172,7 +173,7 @@ static int run_merge(int n, char **parts)
     if (!rc) {
         /* write as the unsplit render would: Film "savefp16" travels in the parts */
         lf_write_opts wo = {0};
-        const lf_attr *h = lf_attrs_get(&meta, "lensfield:savefp16");
+        const lf_attr *h = lf_attrs_get(&meta, LF_KEY_SAVEFP16);
         wo.half = h && h->type == LF_ATTR_INT && h->i;
         for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
             if (img.data[k] > 65504.f)

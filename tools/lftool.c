@@ -30,6 +30,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include "base/lf_keys.h"
 #include "cli.h"
 #include "image/lf_image.h"
 #include "lightfield/lf_depth.h"
@@ -440,7 +441,7 @@ static int centre_disparity(const opts *o, const loaded *l, lf_image *gt)
         }
         return EXIT_OK;
     }
-    const lf_attr *a = lf_attrs_get(&l->attrs, "lensfield:disparity_file");
+    const lf_attr *a = lf_attrs_get(&l->attrs, LF_KEY_DISPARITY_FILE);
     if (!a || a->type != LF_ATTR_STRING || !a->s[0])
         return EXIT_OK;
     if (l->lf.nu % 2 == 0 || l->lf.nv % 2 == 0) {
@@ -628,7 +629,7 @@ static int cmd_refocus(const opts *o)
         return EXIT_INPUT;
     }
     lf_attrs a = {0};
-    lf_attrs_set_double(&a, "lensfield:refocus_disparity_px", ro.disparity_px);
+    lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
     rc = write_image(o->output, &out, &a);
     if (!rc)
         printf("%s: refocused at disparity %.6g px/view -> %s\n", o->input, ro.disparity_px, o->output);
@@ -678,7 +679,7 @@ static int cmd_stack(const opts *o)
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
         lf_attrs a = {0};
-        lf_attrs_set_double(&a, "lensfield:refocus_disparity_px", ro.disparity_px);
+        lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
         rc = write_image(path, &out, &a);
         lf_attrs_free(&a);
         lf_image_free(&out);
@@ -723,14 +724,18 @@ static int cmd_allfocus(const opts *o) { return cmd_allfocus_depth(o, 0); }
 /* Disparity range for depth: --from/--to, else lensfield:disp_min/max of
  * the input (a benchmark folder's [meta] disp_min/disp_max), else 0 0
  * (estimated from the data).  Returns the source's name. */
-static const char *depth_range(const opts *o, const lf_attrs *attrs, double *d0, double *d1)
+static const char *depth_range(const opts *o, const lf_attrs *attrs, const lf_lf_layout *lay, double *d0, double *d1)
 {
     *d0 = *d1 = 0;
     if (o->have_from && o->have_to) {
         *d0 = o->from, *d1 = o->to;
         return "--from/--to";
     }
-    const lf_attr *a = lf_attrs_get(attrs, "lensfield:disp_min"), *b = lf_attrs_get(attrs, "lensfield:disp_max");
+    if ((lay->have & LF_LF_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
+        *d0 = lay->disp_min, *d1 = lay->disp_max;
+        return "the folder's disp_min/disp_max";
+    }
+    const lf_attr *a = lf_attrs_get(attrs, LF_KEY_DISP_MIN), *b = lf_attrs_get(attrs, LF_KEY_DISP_MAX);
     if (a && b) {
         double x = a->type == LF_ATTR_INT ? a->i : a->d, y = b->type == LF_ATTR_INT ? b->i : b->d;
         if (isfinite(x) && isfinite(y) && x < y) {
@@ -757,7 +762,7 @@ static int cmd_depth(const opts *o)
         return rc;
     lf_lf_depth_opts d = lf_lf_depth_defaults();
     d.threads = o->threads;
-    const char *src = depth_range(o, &l.attrs, &d.d0, &d.d1);
+    const char *src = depth_range(o, &l.attrs, &l.lf.layout, &d.d0, &d.d1);
     lf_error err = {0};
     if (d.d0 >= d.d1 && lf_lf_depth_range(&l.lf, o->threads, &d.d0, &d.d1, &err)) {
         fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
@@ -779,8 +784,8 @@ static int cmd_depth(const opts *o)
     }
     lf_attrs a = {0};
     float range[2] = {(float)d.d0, (float)d.d1};
-    lf_attrs_set_floats(&a, "lensfield:disparity_search_range", range, 2);
-    lf_attrs_set_string(&a, "lensfield:disparity_convention",
+    lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2);
+    lf_attrs_set_string(&a, LF_KEY_DISPARITY_CONVENTION,
                         "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step");
     const char *dot = strrchr(o->output, '.');
     if (dot && (!strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg"))) {
@@ -992,7 +997,7 @@ static int cmd_calibrate(const opts *o)
         lf_image_free(&white), lf_attrs_free(&a);
         return EXIT_INPUT;
     }
-    lf_attrs_set_int(&a, "lensfield:white", 1);
+    lf_attrs_set_int(&a, LF_KEY_WHITE, 1);
     rc = write_image(o->output, &white, &a);
     if (!rc) {
         char buf[1024];

@@ -10,10 +10,11 @@
 #       [--fisheye-model equisolid|polynomial]
 # CASE: pinhole (default), thinlens (lens radius 0.08, focus 6), motion (one
 # sphere moves 0.5 units during the shutter), rolling (panning camera, rolling
-# shutter over half the frame), fisheye (equisolid, fitted to the traced 10 mm
-# fisheye prescription, or with --fisheye-model polynomial Cycles' polynomial
-# fisheye fitted to its whole mapping: see the fisheye block below) - the variants of
-# scenes/bench/plane-spheres-CASE.pbrt.  There is no "realistic" case: Cycles
+# shutter over half the frame), fisheye (equisolid 10.6 mm, 156 deg: the same
+# ideal camera as lensfield's "fisheye"), fisheye-lens (equisolid, fitted to
+# the traced 10 mm fisheye prescription, or with --fisheye-model polynomial
+# Cycles' polynomial fisheye fitted to its whole mapping: see the fisheye-lens
+# block below) - the variants of scenes/bench/plane-spheres-CASE.pbrt.  There is no "realistic" case: Cycles
 # has no traced lens.
 # --out writes the render as a linear float RGB OpenEXR (scene-referred, no
 # view transform); the time printed is that of bpy.ops.render.render alone
@@ -44,7 +45,7 @@ spp = int(pos[0]) if len(pos) > 0 else 64
 threads = int(pos[1]) if len(pos) > 1 else 2
 case = pos[2] if len(pos) > 2 else "pinhole"
 width, height = opts["--res"] or (640, 426)
-if case not in ("pinhole", "thinlens", "motion", "rolling", "fisheye"):
+if case not in ("pinhole", "thinlens", "motion", "rolling", "fisheye", "fisheye-lens"):
     sys.exit(f"cycles_plane_spheres.py: no Cycles equivalent of case '{case}'")
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -161,8 +162,22 @@ if case == "rolling":
         for kp in fc.keyframe_points:
             kp.interpolation = "LINEAR"
 if case == "fisheye":
+    # Like for like with lensfield's ideal "fisheye" camera in
+    # scenes/bench/plane-spheres-fisheye.pbrt: equisolid, f = 10.6 mm, field
+    # 156 deg, on the film of a 28 mm diagonal at this image's aspect.
+    film_w = 28.0 * width / math.hypot(width, height)
+    cam.type = "PANO"
+    cam.sensor_fit = "HORIZONTAL"
+    cam.sensor_width = film_w
+    cam.sensor_height = film_w * height / width
+    pano = cam if hasattr(cam, "panorama_type") else cam.cycles  # cam.cycles in Blender 3.x
+    pano.panorama_type = "FISHEYE_EQUISOLID"
+    pano.fisheye_lens = 10.6
+    pano.fisheye_fov = math.radians(156.0)
+    print(f"cycles: fisheye equisolid 10.6 mm, field 156 deg, sensor {film_w:.3f} mm wide")
+if case == "fisheye-lens":
     # Fitted to what lensfield's fisheye scene frames (scenes/bench/
-    # plane-spheres-fisheye.pbrt: 10 mm prescription, 2 mm stop, focus 6 m,
+    # plane-spheres-fisheye-lens.pbrt: 10 mm prescription, 2 mm stop, focus 6 m,
     # film diagonal 28 mm).  `lflens info scenes/lenses/fisheye.10mm.dat
     # --aperture 2 --focus 6 --diagonal D` gives the traced field and the
     # image circle: 26.878 mm across, and 66.39 deg off axis at the film's

@@ -341,6 +341,15 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM,
                             "%s: \"lightsampler\" must be \"bvh\", \"power\", \"uniform\" or \"all\", got \"%s\"", where,
                             ls);
+    /* Extension: the Russian roulette rule (docs/scene-format.md). */
+    const char *rr = lf_params_string(ps, "russianroulette", "sqrt");
+    if (!strcmp(rr, "sqrt"))
+        r->integrator.rr_rule = LF_RR_SQRT, r->integrator.rr_depth = 2;
+    else if (!strcmp(rr, "pbrt"))
+        r->integrator.rr_rule = LF_RR_PBRT, r->integrator.rr_depth = 1;
+    else
+        return lf_error_set(err, LF_ERR_PARAM, "%s: \"russianroulette\" must be \"sqrt\" or \"pbrt\", got \"%s\"",
+                            where, rr);
     lf_params_find(ps, "strategy");
     lf_params_find(ps, "bidirectional");
     lf_params_find(ps, "visualizestrategies");
@@ -703,8 +712,11 @@ char *lf_renderer_explain(const lf_renderer *r)
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
     appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
-    appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette\n",
-            r->integrator_name, r->integrator.max_depth);
+    appendf(&b, &len, &cap,
+            "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette %s after depth %d\n",
+            r->integrator_name, r->integrator.max_depth,
+            r->integrator.rr_rule == LF_RR_SQRT ? "p = sqrt(max throughput)" : "p = max throughput (pbrt-v4)",
+            r->integrator.rr_depth);
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");

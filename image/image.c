@@ -493,6 +493,8 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
         rc = lf_exr_write(tmp, path, img, attrs, opts->half, err);
     else if (as_float)
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_FLOAT, img->data, err);
+    else if (strcasecmp(ext, "png") == 0 && img->channels <= 4)
+        rc = lf_png_write(tmp, path, img->width, img->height, img->channels, bytes, err);
     else
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_UINT8, bytes, err);
     free(bytes);

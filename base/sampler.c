@@ -2,22 +2,6 @@
 
 #include <pthread.h>
 
-/* 32-bit integer hash (Chris Wellons' "lowbias32" finaliser). */
-uint32_t lf_hash_u32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
-uint32_t lf_hash_combine(uint32_t a, uint32_t b)
-{
-    return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));
-}
-
 static inline uint32_t reverse_bits(uint32_t x)
 {
     x = __builtin_bswap32(x);
@@ -89,15 +73,25 @@ static inline uint32_t seed_b(uint32_t h)
     return h * 0x297a2d39u + 0xb5297a4du;
 }
 
-void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
+uint32_t lf_sample_pixel_hash(const lf_sampler *s, int px, int py)
 {
     if (s->kind == LF_SAMPLER_SOBOL)
         pthread_once(&sobol_once, sobol_tables_init);
+    return lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
+}
+
+void lf_sample_start_pixel(lf_sample_stream *st, const lf_sampler *s, uint32_t pixel_hash, uint32_t index)
+{
     st->s = s;
-    st->pixel_hash = lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
+    st->pixel_hash = pixel_hash;
     st->index = index;
     st->rindex = reverse_bits(index);
     st->dim = 0;
+}
+
+void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
+{
+    lf_sample_start_pixel(st, s, lf_sample_pixel_hash(s, px, py), index);
 }
 
 static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)

@@ -15,7 +15,8 @@
  * --save-ref, or another renderer's).  Errors are over all pixels and R, G,
  * B, divided by the reference's mean; the reference's own noise adds
  * e^2 N / N_ref to e^2 and is divided out as in bench/peers/eq_report.py
- * (when the reference was rendered here; --ref images are taken as exact). */
+ * (when the reference was rendered here, or --ref comes with --ref-spp;
+ * otherwise the --ref image is taken as exact). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -102,12 +103,12 @@ int main(int argc, char **argv)
     if (argc >= 4 && !strcmp(argv[1], "--rmse"))
         return rmse_mode(argc, argv);
     const char *scene = NULL, *ref_path = NULL, *save_ref = NULL, *spps = "1 4 16";
-    int ref_spp = 4096, seeds = 8, threads = 2;
+    int ref_spp = 4096, seeds = 8, threads = 2, ref_spp_given = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--ref") && i + 1 < argc)
             ref_path = argv[++i];
         else if (!strcmp(argv[i], "--ref-spp") && i + 1 < argc)
-            ref_spp = atoi(argv[++i]);
+            ref_spp = atoi(argv[++i]), ref_spp_given = 1;
         else if (!strcmp(argv[i], "--spp") && i + 1 < argc)
             spps = argv[++i];
         else if (!strcmp(argv[i], "--seeds") && i + 1 < argc)
@@ -136,6 +137,8 @@ int main(int argc, char **argv)
             fprintf(stderr, "bench_variance: %s\n", err.msg);
             return 1;
         }
+        if (ref_spp_given) /* a reference of that many samples, independent of these */
+            ref_n = ref_spp;
     } else {
         if (render(scene, ref_spp, 1000, threads, &ref, NULL))
             return 1;

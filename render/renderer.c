@@ -849,13 +849,22 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
     int nb = 0;
     int spp = r->spp_end - r->spp_begin;
     long long total = (long long)tw * th * spp;
+    /* pixel and sample index of path k = pixel * spp + (i - spp_begin),
+     * stepped rather than divided; the pixel's sample hash once per pixel */
+    int pixel = 0, i = r->spp_begin, x = x0, y = y0;
+    uint32_t pixel_hash = lf_sample_pixel_hash(&r->sampler, x, y);
     for (long long k = 0; k < total; k++) {
-        int pixel = (int)(k / spp), i = r->spp_begin + (int)(k % spp);
-        int x = x0 + pixel % tw, y = y0 + pixel / tw;
+        if (i == r->spp_end) {
+            i = r->spp_begin;
+            pixel++;
+            if (++x == x1)
+                x = x0, y++;
+            pixel_hash = lf_sample_pixel_hash(&r->sampler, x, y);
+        }
         pending *p = &pend[nb];
         lf_camera_sample *c = &cs[nb];
         p->pixel = pixel;
-        lf_sample_start(&p->st, &r->sampler, x, y, (uint32_t)i);
+        lf_sample_start_pixel(&p->st, &r->sampler, pixel_hash, (uint32_t)i++);
         double fu, fv, dx, dy;
         lf_sample_2d_d(&p->st, &fu, &fv);
         p->fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);

@@ -8,7 +8,7 @@
 # right-handed frames the image comes out the same way round.
 #   blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- \
 #       [SPP] [THREADS] [CASE] [--res W H] [--seed N] [--out FILE.exr]
-#       [--fisheye-model equisolid|polynomial]
+#       [--fisheye-model equisolid|polynomial] [--bounces N (8: pbrt's maxdepth)]
 # CASE: pinhole (default), thinlens (lens radius 0.08, focus 6), motion (one
 # sphere moves 0.5 units during the shutter), rolling (panning camera, rolling
 # shutter over half the frame), fisheye (equisolid 10.6 mm, 156 deg: the same
@@ -30,7 +30,7 @@ import bpy
 from mathutils import Matrix, Vector
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-opts = {"--res": None, "--seed": "1", "--out": None, "--fisheye-model": "equisolid"}
+opts = {"--res": None, "--seed": "1", "--out": None, "--fisheye-model": "equisolid", "--bounces": "8"}
 pos = []
 i = 0
 while i < len(argv):
@@ -61,11 +61,12 @@ cy.use_adaptive_sampling = False
 cy.use_denoising = False
 cy.seed = int(opts["--seed"])
 cy.use_animated_seed = False
-cy.max_bounces = 8
-cy.diffuse_bounces = 8
-cy.glossy_bounces = 8
-cy.transmission_bounces = 8
-cy.transparent_max_bounces = 8
+bounces = int(opts["--bounces"])  # pbrt's maxdepth (8 in every bench scene)
+cy.max_bounces = bounces
+cy.diffuse_bounces = bounces
+cy.glossy_bounces = bounces
+cy.transmission_bounces = bounces
+cy.transparent_max_bounces = bounces
 cy.sample_clamp_direct = 0
 cy.sample_clamp_indirect = 0
 cy.pixel_filter_type = "BOX"

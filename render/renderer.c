@@ -31,6 +31,7 @@ struct lf_renderer {
     void *camera;
     uint32_t camera_needs;
     lf_transform camera_to_world;
+    lf_dvec3 camera_origin_world; /* camera_to_world applied to (0,0,0) */
     double shutter_open, shutter_close;
     double imaging_ratio; /* exposure time * ISO / 100 (pbrt-v4 PixelSensor) */
     int xres, yres;
@@ -474,6 +475,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     r->camera_name = dupstr(type);
     r->world_to_camera = cd->world_to_camera.xf[0];
     r->camera_to_world = lf_transform_inverse(&cd->world_to_camera.xf[0]);
+    r->camera_origin_world = lf_xform_point_d(&r->camera_to_world, (lf_dvec3){0, 0, 0});
     r->time0 = d->transform_start_time;
     r->time1 = d->transform_end_time;
     if (cd->world_to_camera.animated) {
@@ -804,7 +806,11 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
         lf_motion_pair_matrix(&r->camera_motion, p->tau, moving.m);
         c2w = &moving;
     }
-    lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
+    /* Rays from the camera's centre (pinhole, fisheye) start at its world
+     * position, computed once (the same numbers as transforming 0). */
+    lf_dvec3 o = !r->camera_moving && cr->origin[0] == 0 && cr->origin[1] == 0 && cr->origin[2] == 0
+                     ? r->camera_origin_world
+                     : lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
     lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr->dir[0], cr->dir[1], cr->dir[2]});
     double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);

@@ -252,10 +252,10 @@ static int fisheye_describe(const void *state, char *buf, size_t size)
 static void fisheye_metadata(const void *state, const lf_camera_attr_sink *sink)
 {
     const fisheye *c = state;
-    sink->set_string(sink->ctx, "lensfield:fisheyeMapping", mapping_names[c->mapping]);
-    sink->set_double(sink->ctx, "lensfield:fisheyeFocalLengthMM", c->f_mm);
-    sink->set_double(sink->ctx, "lensfield:fisheyeFovDeg", c->fov_deg);
-    sink->set_double(sink->ctx, "lensfield:fisheyeCircleRadiusMM", c->r_max_mm);
+    sink->set_string(sink->ctx, "lensfield:fisheye_mapping", mapping_names[c->mapping]);
+    sink->set_double(sink->ctx, "lensfield:fisheye_focal_length_mm", c->f_mm);
+    sink->set_double(sink->ctx, "lensfield:fisheye_fov_deg", c->fov_deg);
+    sink->set_double(sink->ctx, "lensfield:fisheye_circle_radius_mm", c->r_max_mm);
 }
 
 const lf_camera_type lf_camera_fisheye = {

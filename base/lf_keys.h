@@ -82,5 +82,9 @@
 #define LF_KEY_VERSION                           "lensfield:version"
 #define LF_KEY_WHITE                             "lensfield:white"
 #define LF_KEY_WORLD_TO_CAMERA                   "lensfield:world_to_camera"
+#define LF_KEY_FISHEYE_CIRCLE_RADIUS_MM          "lensfield:fisheye_circle_radius_mm"
+#define LF_KEY_FISHEYE_FOCAL_LENGTH_MM           "lensfield:fisheye_focal_length_mm"
+#define LF_KEY_FISHEYE_FOV_DEG                   "lensfield:fisheye_fov_deg"
+#define LF_KEY_FISHEYE_MAPPING                   "lensfield:fisheye_mapping"
 
 #endif

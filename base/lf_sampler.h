@@ -94,6 +94,14 @@ typedef struct lf_sample_stream {
 } lf_sample_stream;
 
 void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index);
+/* The same in two steps, for a renderer that draws many samples per pixel:
+ * the pixel's hash once, then each sample from it.
+ * lf_sample_start(st, s, px, py, i) ==
+ * lf_sample_start_pixel(st, s, lf_sample_pixel_hash(s, px, py), px, py, i)
+ * (the pixel itself is still needed by halton, whose index depends on it). */
+uint32_t lf_sample_pixel_hash(const lf_sampler *s, int px, int py);
+void lf_sample_start_pixel(lf_sample_stream *st, const lf_sampler *s, uint32_t pixel_hash, int px, int py,
+                           uint32_t index);
 /* Next 1D value in [0,1). */
 float lf_sample_1d(lf_sample_stream *st);
 /* Next 2D value in [0,1)^2 (consumes a dimension pair). */
@@ -108,9 +116,22 @@ static inline void lf_sample_skip(lf_sample_stream *st)
 /* The same as doubles, for camera coordinates. */
 void lf_sample_2d_d(lf_sample_stream *st, double *u0, double *u1);
 
-/* Hash helpers shared by anything that needs decorrelated seeds. */
-uint32_t lf_hash_u32(uint32_t x);
-uint32_t lf_hash_combine(uint32_t a, uint32_t b);
+/* Hash helpers shared by anything that needs decorrelated seeds (inline:
+ * several run for every sample dimension pair). */
+/* 32-bit integer hash (Chris Wellons' "lowbias32" finaliser). */
+static inline uint32_t lf_hash_u32(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+static inline uint32_t lf_hash_combine(uint32_t a, uint32_t b)
+{
+    return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));
+}
 
 #ifdef __cplusplus
 }

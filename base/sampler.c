@@ -5,22 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* 32-bit integer hash (Chris Wellons' "lowbias32" finaliser). */
-uint32_t lf_hash_u32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
-uint32_t lf_hash_combine(uint32_t a, uint32_t b)
-{
-    return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));
-}
-
 static inline uint32_t reverse_bits(uint32_t x)
 {
     x = __builtin_bswap32(x);
@@ -96,12 +80,18 @@ static uint64_t halton_pixel_index(const lf_sampler *s, int px, int py, uint32_t
 static void halton_pair(lf_sample_stream *st, uint32_t dim, uint32_t *a, uint32_t *b);
 static void pmj_pair(lf_sample_stream *st, uint32_t dim, uint32_t h, uint32_t *a, uint32_t *b);
 
-void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
+uint32_t lf_sample_pixel_hash(const lf_sampler *s, int px, int py)
 {
     if (s->kind == LF_SAMPLER_SOBOL)
         pthread_once(&sobol_once, sobol_tables_init);
+    return lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
+}
+
+void lf_sample_start_pixel(lf_sample_stream *st, const lf_sampler *s, uint32_t pixel_hash, int px, int py,
+                           uint32_t index)
+{
     st->s = s;
-    st->pixel_hash = lf_hash_combine(lf_hash_combine(s->seed, (uint32_t)px), (uint32_t)py);
+    st->pixel_hash = pixel_hash;
     st->index = index;
     st->rindex = reverse_bits(index);
     st->dim = 0;
@@ -124,6 +114,11 @@ static uint32_t permute_index(uint32_t i, uint32_t n, uint32_t h)
         k = (lk_permute(k, h) ^ (h >> 7)) & mask;
     } while (k >= n);
     return k;
+}
+
+void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, uint32_t index)
+{
+    lf_sample_start_pixel(st, s, lf_sample_pixel_hash(s, px, py), px, py, index);
 }
 
 static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)

@@ -66,6 +66,7 @@ extern const lf_camera_type lf_camera_perspective;
 extern const lf_camera_type lf_camera_orthographic;
 extern const lf_camera_type lf_camera_thinlens;
 extern const lf_camera_type lf_camera_realistic;
+extern const lf_camera_type lf_camera_fisheye;
 extern const lf_camera_type lf_camera_lightfield;
 extern const lf_camera_type lf_camera_plenoptic;
 extern const lf_camera_type lf_camera_spherical;

@@ -12,6 +12,7 @@ static const lf_camera_type *const builtin[] = {
     &lf_camera_orthographic,
     &lf_camera_thinlens,
     &lf_camera_realistic,
+    &lf_camera_fisheye,
     &lf_camera_lightfield,
     &lf_camera_plenoptic,
     &lf_camera_spherical,

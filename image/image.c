@@ -412,6 +412,8 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
         rc = lf_pfm_write(tmp, path, img, err);
     else if (as_float)
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_FLOAT, img->data, err);
+    else if (strcasecmp(ext, "png") == 0 && img->channels <= 4)
+        rc = lf_png_write(tmp, path, img->width, img->height, img->channels, bytes, err);
     else
         rc = lf_oiio_write(tmp, path, img->width, img->height, img->channels, LF_OIIO_UINT8, bytes, err);
     free(bytes);

@@ -23,6 +23,11 @@ extern "C" {
 int lf_image_check_size(long long width, long long height, long long channels, const char *what, int code,
                         lf_error *err);
 
+/* 8-bit PNG (1-4 channels, sRGB-encoded pixels, row 0 at the top) through
+ * libpng, into `file`; `name` is the path shown in messages (image/png.c). */
+int lf_png_write(const char *file, const char *name, int width, int height, int channels,
+                 const unsigned char *pixels, lf_error *err);
+
 /* EXR via OpenEXRCore.  `file` is the file actually opened or created (for
  * writes, the temporary file); `name` is the path shown in messages. */
 int lf_exr_write(const char *file, const char *name, const lf_image *img, const lf_attrs *attrs, int half,

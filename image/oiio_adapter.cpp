@@ -1,6 +1,7 @@
 // oiio_adapter.cpp - PNG, JPEG, TIFF, HDR, ... through OpenImageIO, behind
-// the C interface of oiio_adapter.h.  Every entry point catches all
-// exceptions: C callers cannot unwind through C++ frames.
+// the C interface of oiio_adapter.h.  Built as the module liblf_oiio.so,
+// loaded only when an image needs it (image/oiio_loader.c).  Every entry
+// point catches all exceptions: C callers cannot unwind through C++ frames.
 #include "oiio_adapter.h"
 
 #include <OpenImageIO/imageio.h>
@@ -11,9 +12,10 @@
 #include <memory>
 #include <string>
 
-#include "image_internal.h"
 
 namespace {
+
+const lf_oiio_host *host; // set once by lf_oiio_module_init
 
 // OpenImageIO keeps errors per object and per thread, and complains on
 // stderr about any left unretrieved when an object is destroyed, so every
@@ -93,12 +95,12 @@ int read_impl(const char *file, const char *name, lf_image *img, lf_oiio_read_in
         return lf_error_set(err, LF_ERR_UNSUPPORTED, "cannot read '%s': volume images are not supported", name);
     }
     // Checked before any pixel is allocated: the header may be lying.
-    int rc = lf_image_check_size(spec.width, spec.height, spec.nchannels, name, LF_ERR_PARSE, err);
+    int rc = host->check_size(spec.width, spec.height, spec.nchannels, name, LF_ERR_PARSE, err);
     if (rc) {
         take_error(in.get(), nullptr);
         return rc;
     }
-    rc = lf_image_alloc(img, spec.width, spec.height, spec.nchannels, err);
+    rc = host->alloc(img, spec.width, spec.height, spec.nchannels, err);
     if (rc) {
         take_error(in.get(), nullptr);
         return rc;
@@ -107,7 +109,7 @@ int read_impl(const char *file, const char *name, lf_image *img, lf_oiio_read_in
     // message, so a pending error also counts as failure.
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img->data) || in->has_error()) {
         std::string msg = take_error(in.get(), nullptr);
-        lf_image_free(img);
+        host->free_image(img);
         return lf_error_set(err, LF_ERR_PARSE, "cannot read '%s': %s", name, msg.c_str());
     }
     info->alpha_channel = spec.alpha_channel >= 0 && spec.alpha_channel < spec.nchannels ? spec.alpha_channel : -1;
@@ -118,9 +120,7 @@ int read_impl(const char *file, const char *name, lf_image *img, lf_oiio_read_in
     return LF_OK;
 }
 
-} // namespace
-
-extern "C" int lf_oiio_write(const char *file, const char *name, int width, int height, int channels,
+int module_write(const char *file, const char *name, int width, int height, int channels,
                              lf_oiio_pixel_type type, const void *pixels, lf_error *err)
 {
     try {
@@ -134,19 +134,30 @@ extern "C" int lf_oiio_write(const char *file, const char *name, int width, int 
     }
 }
 
-extern "C" int lf_oiio_read(const char *file, const char *name, lf_image *img, lf_oiio_read_info *info,
+int module_read(const char *file, const char *name, lf_image *img, lf_oiio_read_info *info,
                             lf_error *err)
 {
     try {
         return read_impl(file, name, img, info, err);
     } catch (const std::bad_alloc &) {
-        lf_image_free(img);
+        host->free_image(img);
         return lf_error_set(err, LF_ERR_NOMEM, "cannot read '%s': out of memory", name);
     } catch (const std::exception &e) {
-        lf_image_free(img);
+        host->free_image(img);
         return lf_error_set(err, LF_ERR_INTERNAL, "cannot read '%s': OpenImageIO: %s", name, e.what());
     } catch (...) {
-        lf_image_free(img);
+        host->free_image(img);
         return lf_error_set(err, LF_ERR_INTERNAL, "cannot read '%s': unknown OpenImageIO exception", name);
     }
+}
+
+} // namespace
+
+extern "C" __attribute__((visibility("default"))) const lf_oiio_module *lf_oiio_module_init(const lf_oiio_host *h)
+{
+    static const lf_oiio_module module = {LF_OIIO_MODULE_ABI, module_write, module_read};
+    if (!h || h->abi != LF_OIIO_MODULE_ABI)
+        return nullptr;
+    host = h;
+    return &module;
 }

@@ -10,6 +10,7 @@
  * skipped without computing it: samples are the most expensive part of a
  * path after ray casting. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "render_internal.h"
 
@@ -180,14 +181,20 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         prev_p = h.sc.p;
         o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
         d = bs.wi;
-        /* Russian roulette (pbrt-v4: after depth 1, on beta * eta_scale). */
+        /* Russian roulette on the throughput beta * eta_scale, survival
+         * probability p, surviving paths weighted 1/p (unbiased for any
+         * p > 0).  pbrt-v4's rule: p = max component, after depth 1.  The
+         * default, "sqrt": p = sqrt(max component) (Cycles' rule), and not
+         * before depth 2: ending paths early kills the bright direct light
+         * their next vertices would have gathered, which costs far more
+         * variance than the rays it saves (docs/performance.md, issue 21). */
         lf_vec3 rr_beta = lf_scale(beta, eta_scale);
         float m = lf_maxc(rr_beta);
-        if (m < 1.f && depth > 1) {
-            float q = fmaxf(0.f, 1.f - m);
-            if (lf_sample_1d(st) < q)
+        if (m < 1.f && depth > in->rr_depth) {
+            float p = in->rr_rule == LF_RR_SQRT ? sqrtf(m) : m;
+            if (lf_sample_1d(st) >= p)
                 break;
-            beta = lf_scale(beta, 1.f / (1.f - q));
+            beta = lf_scale(beta, 1.f / p);
         } else {
             lf_sample_skip(st);
         }

@@ -299,11 +299,16 @@ typedef enum lf_light_sampler {
 } lf_light_sampler;
 enum { LF_LIGHTS_ALL_MAX = 8 };
 
+/* Russian roulette rule (Integrator "string russianroulette"). */
+typedef enum lf_rr_rule { LF_RR_SQRT, LF_RR_PBRT } lf_rr_rule;
+
 typedef struct lf_integrator {
     int volumetric;    /* "volpath" (the default): media are rendered; "path" ignores them (pbrt-v4) */
     int max_depth;
     int regularize;
     lf_light_sampler light_sampler;
+    lf_rr_rule rr_rule; /* survival probability sqrt(max beta) or max beta */
+    int rr_depth;       /* roulette only at depth > rr_depth (2; pbrt-v4: 1) */
 } lf_integrator;
 
 /* The strategy in effect for a scene (AUTO resolved by its light count). */

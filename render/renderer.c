@@ -32,6 +32,7 @@ struct lf_renderer {
     void *camera;
     uint32_t camera_needs;
     lf_transform camera_to_world;
+    lf_dvec3 camera_origin_world; /* camera_to_world applied to (0,0,0) */
     double shutter_open, shutter_close;
     double imaging_ratio; /* exposure time * ISO / 100 (pbrt-v4 PixelSensor) */
     int xres, yres;
@@ -371,6 +372,15 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM,
                             "%s: \"lightsampler\" must be \"bvh\", \"power\", \"uniform\" or \"all\", got \"%s\"", where,
                             ls);
+    /* Extension: the Russian roulette rule (docs/scene-format.md). */
+    const char *rr = lf_params_string(ps, "russianroulette", "sqrt");
+    if (!strcmp(rr, "sqrt"))
+        r->integrator.rr_rule = LF_RR_SQRT, r->integrator.rr_depth = 2;
+    else if (!strcmp(rr, "pbrt"))
+        r->integrator.rr_rule = LF_RR_PBRT, r->integrator.rr_depth = 1;
+    else
+        return lf_error_set(err, LF_ERR_PARAM, "%s: \"russianroulette\" must be \"sqrt\" or \"pbrt\", got \"%s\"",
+                            where, rr);
     lf_params_find(ps, "strategy");
     lf_params_find(ps, "bidirectional");
     lf_params_find(ps, "visualizestrategies");
@@ -495,6 +505,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     r->camera_name = dupstr(type);
     r->world_to_camera = cd->world_to_camera.xf[0];
     r->camera_to_world = lf_transform_inverse(&cd->world_to_camera.xf[0]);
+    r->camera_origin_world = lf_xform_point_d(&r->camera_to_world, (lf_dvec3){0, 0, 0});
     r->time0 = d->transform_start_time;
     r->time1 = d->transform_end_time;
     if (cd->world_to_camera.animated) {
@@ -747,16 +758,20 @@ char *lf_renderer_explain(const lf_renderer *r)
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
     appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
+    char rr[96];
+    snprintf(rr, sizeof rr, "Russian roulette %s after depth %d",
+             r->integrator.rr_rule == LF_RR_SQRT ? "p = sqrt(max throughput)" : "p = max throughput (pbrt-v4)",
+             r->integrator.rr_depth);
     if (s->has_media && r->integrator.volumetric)
         appendf(&b, &len, &cap,
-                "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, Russian roulette; %d "
+                "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, %s; %d "
                 "homogeneous media (closed-form transmittance, spectral-MIS distance sampling, Henyey-Greenstein), "
                 "camera in %s\n",
-                r->integrator_name, r->integrator.max_depth, s->n_media,
+                r->integrator_name, r->integrator.max_depth, rr, s->n_media,
                 s->camera_medium >= 0 ? "a medium" : "vacuum");
     else
-        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, Russian roulette%s\n",
-                r->integrator_name, r->integrator.max_depth,
+        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, %s%s\n",
+                r->integrator_name, r->integrator.max_depth, rr,
                 s->n_media ? " (media defined but no ray can enter one, or ignored by \"path\")" : "");
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
@@ -845,7 +860,11 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
         lf_motion_pair_matrix(&r->camera_motion, p->tau, moving.m);
         c2w = &moving;
     }
-    lf_dvec3 o = lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
+    /* Rays from the camera's centre (pinhole, fisheye) start at its world
+     * position, computed once (the same numbers as transforming 0). */
+    lf_dvec3 o = !r->camera_moving && cr->origin[0] == 0 && cr->origin[1] == 0 && cr->origin[2] == 0
+                     ? r->camera_origin_world
+                     : lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
     lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr->dir[0], cr->dir[1], cr->dir[2]});
     double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);
@@ -893,13 +912,22 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
     int nb = 0;
     int spp = r->spp_end - r->spp_begin;
     long long total = (long long)tw * th * spp;
+    /* pixel and sample index of path k = pixel * spp + (i - spp_begin),
+     * stepped rather than divided; the pixel's sample hash once per pixel */
+    int pixel = 0, i = r->spp_begin, x = x0, y = y0;
+    uint32_t pixel_hash = lf_sample_pixel_hash(&r->sampler, x, y);
     for (long long k = 0; k < total; k++) {
-        int pixel = (int)(k / spp), i = r->spp_begin + (int)(k % spp);
-        int x = x0 + pixel % tw, y = y0 + pixel / tw;
+        if (i == r->spp_end) {
+            i = r->spp_begin;
+            pixel++;
+            if (++x == x1)
+                x = x0, y++;
+            pixel_hash = lf_sample_pixel_hash(&r->sampler, x, y);
+        }
         pending *p = &pend[nb];
         lf_camera_sample *c = &cs[nb];
         p->pixel = pixel;
-        lf_sample_start(&p->st, &r->sampler, x, y, (uint32_t)i);
+        lf_sample_start_pixel(&p->st, &r->sampler, pixel_hash, x, y, (uint32_t)i++);
         double fu, fv, dx, dy;
         lf_sample_2d_d(&p->st, &fu, &fv);
         p->fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);

@@ -23,6 +23,8 @@ check "lflens --version from the install" sh -c "'$prefix/bin/lflens' --version 
 check "man page lflens.1" sh -c "grep -q '^.TH lflens 1' '$prefix/share/man/man1/lflens.1'"
 check "man page lists a flag" sh -c "grep -q 'aperture' '$prefix/share/man/man1/lflens.1'"
 check "installed header" test -f "$prefix/include/lensfield/lf_camera.h"
+check "installed OpenImageIO module" test -f "$prefix/lib/lensfield/liblf_oiio.so"
+check "installed web page files" test -f "$prefix/share/lensfield/web/index.html"
 printf '#include <lf_camera.h>\nint main(void) { lf_camera_sample s = {0}; return (int)s.film_x + (LF_CAMERA_ABI_VERSION > 0 ? 0 : 1); }\n' >"$tmp/alone.c"
 check "lf_camera.h alone as strict C11" cc -std=c11 -pedantic-errors -Wall -Werror -I"$prefix/include/lensfield" -c "$tmp/alone.c" -o "$tmp/alone.o"
 

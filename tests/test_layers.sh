@@ -28,6 +28,9 @@ done
 # Libraries never print to stdout/stderr or exit (only tools/ do).
 hits=$(grep -nE "\b(exit|abort)\(|\bprintf\(|fprintf\(std(out|err)|\bputs\(|perror\(" base/*.c image/*.c image/*.cpp camera/*.c render/*.c lightfield/*.c grade/*.c web/*.c 2>/dev/null | grep -v "^\s*//" )
 if [ -n "$hits" ]; then bad "a library prints or exits: $hits"; else ok; fi
+# lensfield:* attribute names are spelled once, in base/lf_keys.h.
+hits=$(grep -nE '"lensfield:[a-z_0-9]+"' base/*.c image/*.c image/*.cpp camera/*.c render/*.c lightfield/*.c grade/*.c web/*.c tools/*.c 2>/dev/null)
+if [ -n "$hits" ]; then bad "attribute names spelled outside base/lf_keys.h: $hits"; else ok; fi
 # The tools link only the layers they use.
 for t in lflens lftool; do
   if ldd "$bin/$t" | grep -qi embree; then bad "$t links Embree"; else ok; fi

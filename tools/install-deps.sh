@@ -5,11 +5,14 @@
 set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config zlib1g-dev
-  libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools
+  libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools libpng-dev
   clang libclang-rt-14-dev
   chromium nodejs
   slurm-wlm munge
 )
+# The benchmarks against Blender Cycles (bench/peers/) also need Blender;
+# not a build or test dependency, so only with LF_BENCH_DEPS=1.
+if [ "${LF_BENCH_DEPS:-0}" = 1 ]; then PACKAGES+=(blender); fi
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 missing=()

@@ -4,12 +4,14 @@
 # .pbrt file: equivalent scenes at 64 spp, 640x426, 2 threads, the renderers
 # interleaved (lensfield, Cycles, pbrt-v4, lensfield, ...) so machine drift
 # cancels; medians of RUNS runs.  Cases: pinhole, thinlens, motion, rolling,
-# fisheye (scenes/bench/plane-spheres[-CASE].pbrt and the same case of
-# bench/peers/cycles_plane_spheres.py) and realistic (double Gauss 50 mm,
-# pbrt-v4 only: Cycles has no traced lens; pbrt-v4 has no rolling shutter);
-# also fisheye-poly (the fisheye against Cycles' polynomial fisheye, fitted
-# to the traced mapping).  Default: the five Cycles cases, plus realistic
-# when PBRT is set.
+# fisheye (the ideal equisolid fisheye in both) (scenes/bench/plane-spheres
+# [-CASE].pbrt and the same case of bench/peers/cycles_plane_spheres.py),
+# sky and room (scenes/bench/sky.pbrt, room.pbrt) and realistic (double
+# Gauss 50 mm, pbrt-v4 only: Cycles has no traced lens; pbrt-v4 has no
+# rolling shutter and no ideal fisheye); also fisheye-lens (the traced 10 mm
+# fisheye against Cycles' equisolid fisheye fitted to it) and fisheye-poly
+# (against Cycles' polynomial fisheye fitted to the traced mapping).
+# Default: the seven Cycles cases, plus realistic when PBRT is set.
 # Times are each renderer's own render time (see bench/peers/lib.sh); a
 # camera path is one pixel sample, paths/s = width x height x spp / time.
 #   bash bench/peers/cycles_vs_lensfield.sh [RUNS] [CASE...]
@@ -21,7 +23,7 @@ runs=${1:-3}
 shift || true
 cases=("$@")
 if [ ${#cases[@]} -eq 0 ]; then
-    cases=(pinhole thinlens motion rolling fisheye)
+    cases=(pinhole thinlens motion rolling fisheye sky room)
     [ -z "${PBRT:-}" ] || cases+=(realistic)
 fi
 spp=${SPP:-64}

@@ -8,16 +8,18 @@
 # units and exposures compare).  bench/peers/eq_report.py fits e^2 = a/spp
 # and t = t0 + b spp and reports the time each renderer needs to reach a
 # common relative RMSE (TARGET), its efficiency 1/(RMSE^2 t) and the ratios.
-# The scenes are scenes/bench/plane-spheres[-CASE].pbrt at RES (default
-# 160x106, a quarter of the paths/s benchmark's 640x426 each way, same film;
-# the framing follows the pixel aspect, 1.509 instead of 1.502, the same for
-# every renderer) so that 4096-spp references, 16x the top rung of the
-# ladder, fit in about 15 minutes for all cases on 2 cores.
+# The scenes are scenes/bench/plane-spheres[-CASE].pbrt, sky.pbrt and
+# room.pbrt at RES (default 160x106, a quarter of the paths/s benchmark's
+# 640x426 each way, same film; the framing follows the pixel aspect, 1.509
+# instead of 1.502, the same for every renderer) so that 2048-spp
+# references, 16x the top rung of the ladder, fit with all seven cases in
+# about 15 minutes on 2 quiet cores.
 #   bash bench/peers/equal_quality.sh [CASE...]
 # CASE as in cycles_vs_lensfield.sh (default: pinhole thinlens motion rolling
-# fisheye, plus realistic when PBRT is set).
+# fisheye sky room, plus realistic when PBRT is set; fisheye-lens and
+# fisheye-poly on request).
 # Environment: BUILD (build), PBRT, THREADS (2), RES (160x106), REF_SPP
-# (4096), LADDER ("1 4 16 64 256"), RUNS (2), TARGET (0.02), OUT (out/peers-eq:
+# (2048), LADDER ("1 4 16 64 128"), RUNS (2), TARGET (0.02), OUT (out/peers-eq:
 # images and measurements.tsv; re-report with
 # python3 bench/peers/eq_report.py < OUT/measurements.tsv), REUSE_REFS (1:
 # keep references already in OUT, e.g. after changing only the ladder).
@@ -26,14 +28,14 @@ cd "$(dirname "$0")/../.."
 . bench/peers/lib.sh
 res=${RES:-160x106}
 w=${res%x*}; h=${res#*x}
-ref_spp=${REF_SPP:-4096}
-read -r -a ladder <<< "${LADDER:-1 4 16 64 256}"
+ref_spp=${REF_SPP:-2048}
+read -r -a ladder <<< "${LADDER:-1 4 16 64 128}"
 runs=${RUNS:-2}
 target=${TARGET:-0.02}
 out=${OUT:-out/peers-eq}
 cases=("$@")
 if [ ${#cases[@]} -eq 0 ]; then
-    cases=(pinhole thinlens motion rolling fisheye)
+    cases=(pinhole thinlens motion rolling fisheye sky room)
     [ -z "${PBRT:-}" ] || cases+=(realistic)
 fi
 top=${ladder[-1]}

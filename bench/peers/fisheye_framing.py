@@ -6,7 +6,7 @@ image centre) and the centroid and area of each of the four coloured spheres
 pixels come from `oiiotool --dumpdata`.
   python3 bench/peers/fisheye_framing.py LABEL=A.exr LABEL=B.exr ...
 With --fit [LFLENS]: the traced field angle theta(r) of scenes/bench/
-plane-spheres-fisheye.pbrt's lens (lflens info, default build/bin/lflens),
+plane-spheres-fisheye-lens.pbrt's lens (lflens info, default build/bin/lflens),
 the equisolid lens and polynomial that bench/peers/cycles_plane_spheres.py
 uses for Cycles, and how far each is from the traced mapping.
 """

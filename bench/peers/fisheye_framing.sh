@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Does Cycles' fisheye frame what lensfield's traced 10 mm fisheye frames?
-# Renders scenes/bench/plane-spheres-fisheye.pbrt with lensfield (and its flat
+# Renders scenes/bench/plane-spheres-fisheye-lens.pbrt with lensfield (and its flat
 # field, --white, to divide out the lens's vignetting) and the Cycles fisheye
 # case twice (equisolid, the issue's model, and the polynomial fitted to the
 # whole traced mapping), plus the pinhole case of both as a control; prints
@@ -19,11 +19,11 @@ peers_build
 cmake --build "$BUILD" --target lflens > /dev/null
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-make_scene scenes/bench/plane-spheres-fisheye.pbrt "$w" "$h" "$tmp/fisheye.pbrt"
+make_scene scenes/bench/plane-spheres-fisheye-lens.pbrt "$w" "$h" "$tmp/fisheye.pbrt"
 make_scene scenes/bench/plane-spheres.pbrt "$w" "$h" "$tmp/pinhole.pbrt"
 run_lf "$tmp/fisheye.pbrt" "$spp" 1 "$tmp/lf.exr" > /dev/null
 "$LFRENDER" "$tmp/fisheye.pbrt" --white --spp "$spp" --threads "$THREADS" -o "$tmp/white.exr" --quiet
-run_cy fisheye "$spp" 1 "$w" "$h" "$tmp/cy-equisolid.exr" > /dev/null
+run_cy fisheye-lens "$spp" 1 "$w" "$h" "$tmp/cy-equisolid.exr" > /dev/null
 run_cy fisheye-poly "$spp" 1 "$w" "$h" "$tmp/cy-poly.exr" > /dev/null
 run_lf "$tmp/pinhole.pbrt" "$spp" 1 "$tmp/lf-pinhole.exr" > /dev/null
 run_cy pinhole "$spp" 1 "$w" "$h" "$tmp/cy-pinhole.exr" > /dev/null

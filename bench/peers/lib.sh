@@ -14,7 +14,7 @@
 BUILD=${BUILD:-build}
 THREADS=${THREADS:-2}
 LFRENDER=$BUILD/bin/lfrender
-CASES_ALL=(pinhole thinlens motion rolling fisheye realistic)
+CASES_ALL=(pinhole thinlens motion rolling fisheye fisheye-lens sky room realistic)
 
 peers_build() {
     command -v blender > /dev/null || { echo "blender is not installed (apt-get install blender)" >&2; exit 1; }
@@ -34,11 +34,21 @@ peers_pbrt_note() {
     fi
 }
 
-# Case fisheye-poly: the fisheye scene against Cycles' polynomial fisheye
-# fitted to the lens's whole mapping (fisheye: Cycles' equisolid fisheye).
-scene_of() { [ "$1" = pinhole ] && echo scenes/bench/plane-spheres.pbrt || echo "scenes/bench/plane-spheres-${1%-poly}.pbrt"; }
+# Case fisheye: lensfield's ideal equisolid "fisheye" camera against Cycles'
+# (like for like); fisheye-lens: the traced 10 mm fisheye prescription
+# against Cycles' equisolid fisheye fitted to it; fisheye-poly: the same
+# traced lens against Cycles' polynomial fisheye fitted to its whole mapping.
+# sky and room: scenes/bench/sky.pbrt, scenes/bench/room.pbrt.
+scene_of() {
+    case $1 in
+        pinhole) echo scenes/bench/plane-spheres.pbrt ;;
+        fisheye-poly) echo scenes/bench/plane-spheres-fisheye-lens.pbrt ;;
+        sky | room) echo "scenes/bench/$1.pbrt" ;;
+        *) echo "scenes/bench/plane-spheres-$1.pbrt" ;;
+    esac
+}
 cycles_has() { [ "$1" != realistic ]; }                      # Cycles has no traced lens
-pbrt_has() { [ -n "${PBRT:-}" ] && [ "$1" != rolling ] && [ "$1" != fisheye-poly ]; }   # pbrt-v4 has no rolling shutter
+pbrt_has() { [ -n "${PBRT:-}" ] && [ "$1" != rolling ] && [ "$1" != fisheye ] && [ "$1" != fisheye-poly ]; }   # pbrt-v4 has no rolling shutter and no ideal fisheye
 
 # Resolution of a scene file: "W H".
 scene_res() {
@@ -68,8 +78,9 @@ run_lf() {
 # run_cy CASE SPP SEED W H OUT.exr
 run_cy() {
     local log extra=()
-    [ "$1" != fisheye-poly ] || extra=(--fisheye-model polynomial)
-    log=$(blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- "$2" "$THREADS" "${1%-poly}" \
+    local c=$1
+    [ "$c" != fisheye-poly ] || { extra=(--fisheye-model polynomial); c=fisheye-lens; }
+    log=$(blender -b --factory-startup -P bench/peers/cycles_plane_spheres.py -- "$2" "$THREADS" "$c" \
         --seed "$3" --res "$4" "$5" --out "$6" "${extra[@]}" 2>&1) || { echo "$log" >&2; return 1; }
     sed -nE 's/^cycles: [0-9]+ camera paths in ([0-9.]+) s.*/\1/p' <<< "$log" | grep . || { echo "$log" >&2; return 1; }
 }

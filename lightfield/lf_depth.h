@@ -58,8 +58,9 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
 /* A view at centred view coordinates (u, v) inside the captured aperture
  * with per-pixel geometry: a disparity map of the reference view (given, or
  * estimated with lf_lf_depth) is forward-warped to (u, v) with a z-buffer
- * (nearer disparities win), then the nearest views are backward-warped
- * through it and blended with weights by angular distance, visibility (the
+ * (nearer disparities win), then the views within 2 view steps are
+ * backward-warped through it and blended with weights by angular distance,
+ * resampling phase, visibility (the
  * view's own warped depth agrees) and confidence; where confidence is low
  * or no view sees the point the plane at plane_disparity is used.  At a
  * view position it returns that view exactly. */
@@ -69,6 +70,8 @@ typedef struct lf_lf_view_opts {
     lf_lf_depth_opts depth;
     double plane_disparity;     /* fallback plane */
     double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
+    double radius;              /* source views: tent of this radius in view steps; <= 0: 2 (1: the 4 nearest) */
+    double phase_floor;         /* resampling-phase weight 1/(fx(1-fx)+fy(1-fy)+floor); < 0: 0.05; 0: off */
     int threads;
 } lf_lf_view_opts;
 lf_lf_view_opts lf_lf_view_defaults(void);

@@ -514,11 +514,13 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
             v->data = lf_lf_view(lf, iu, iv);
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
             v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
+            /* the angular group from the grid: calibrated positions a little
+             * off a row or diagonal still belong to it */
+            v->group = view_group(v->du, v->dv);
             if (lf->view_shift) {
                 const double *p = lf->view_shift + 4 * ((size_t)iv * lf->nu + iu);
                 v->du = p[0], v->dv = p[1], v->ox = p[2], v->oy = p[3];
             }
-            v->group = view_group(v->du, v->dv);
         }
     /* colour scale: costs in units of the reference's mean channel sum */
     double msum = 0;

@@ -2,7 +2,7 @@
  * benchmark scene (default ../shared/lfdata/hci/backgammon beside the repo).
  *
  *   bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only | --views-only]
- *                       [--save-disp FILE.pfm] [--baseline]
+ *                       [--save-disp FILE.pfm] [--baseline] [--calibrate]
  *
  * Depth: lf_lf_depth on the 9x9 views with no range given (estimated from
  * the data), median wall time of --runs (3) runs; scored as the benchmark
@@ -11,7 +11,10 @@
  * MSE x 100.  Views: from the 5x5 views with even indices, the 16 views
  * with both indices odd, synthesised with per-pixel geometry; mean PSNR in
  * 8-bit sRGB, 15-px border excluded.  --baseline also scores the previous
- * methods (82-slice focal-stack depth, plane blending at disparity 0). */
+ * methods (82-slice focal-stack depth, plane blending at disparity 0).
+ * --calibrate: also self-calibrate the view positions (lf_lf_calibrate_views)
+ * from the depth and score the depth again; the views from the 5x5 views
+ * calibrated the same way. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

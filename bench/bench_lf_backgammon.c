@@ -2,7 +2,7 @@
  * benchmark scene (default ../shared/lfdata/hci/backgammon beside the repo).
  *
  *   bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only | --views-only]
- *                       [--save-disp FILE.pfm] [--baseline]
+ *                       [--save-disp FILE.pfm] [--baseline] [--calibrate]
  *
  * Depth: lf_lf_depth on the 9x9 views with no range given (estimated from
  * the data), median wall time of --runs (3) runs; scored as the benchmark
@@ -11,7 +11,10 @@
  * MSE x 100.  Views: from the 5x5 views with even indices, the 16 views
  * with both indices odd, synthesised with per-pixel geometry; mean PSNR in
  * 8-bit sRGB, 15-px border excluded.  --baseline also scores the previous
- * methods (82-slice focal-stack depth, plane blending at disparity 0). */
+ * methods (82-slice focal-stack depth, plane blending at disparity 0).
+ * --calibrate: also self-calibrate the view positions (lf_lf_calibrate_views)
+ * from the depth and score the depth again; the views from the 5x5 views
+ * calibrated the same way. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -189,7 +192,7 @@ static int cmpd(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     const char *dir = LF_SOURCE_DIR "/../shared/lfdata/hci/backgammon", *save = NULL;
-    int threads = 2, runs = 3, do_depth = 1, do_views = 1, baseline = 0;
+    int threads = 2, runs = 3, do_depth = 1, do_views = 1, baseline = 0, calibrate = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--threads") && i + 1 < argc)
             threads = atoi(argv[++i]);
@@ -201,13 +204,15 @@ int main(int argc, char **argv)
             do_depth = 0;
         else if (!strcmp(argv[i], "--baseline"))
             baseline = 1;
+        else if (!strcmp(argv[i], "--calibrate"))
+            calibrate = 1;
         else if (!strcmp(argv[i], "--save-disp") && i + 1 < argc)
             save = argv[++i];
         else if (argv[i][0] != '-')
             dir = argv[i];
         else {
             fprintf(stderr, "usage: bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only|--views-only] "
-                            "[--save-disp FILE.pfm] [--baseline]\n");
+                            "[--save-disp FILE.pfm] [--baseline] [--calibrate]\n");
             return 2;
         }
     }
@@ -276,6 +281,36 @@ int main(int argc, char **argv)
         score("lf_lf_depth (range auto)", &disp, &gt, times[runs / 2]);
         printf("  depth: median of %d runs: wall %.2f s, CPU %.2f s (all threads)\n", runs, times[runs / 2],
                cpus[runs / 2]);
+        if (calibrate) { /* self-calibrated view positions, depth again */
+            double *rep = malloc(sizeof(double) * 6 * lf.nu * lf.nv);
+            double s = now();
+            if (!rep || lf_lf_calibrate_views(&lf, &disp, &conf, threads, rep, &err)) {
+                fprintf(stderr, "bench_lf_backgammon: %s\n", rep ? err.msg : "out of memory");
+                return 1;
+            }
+            double tc = now() - s, worst = 0;
+            for (int k = 0; k < lf.nu * lf.nv; k++) {
+                int iu = k % lf.nu, iv = k / lf.nu;
+                double e = fmax(fabs(rep[6 * k] - (iu - lf.nu / 2)), fabs(rep[6 * k + 1] - (iv - lf.nv / 2)));
+                worst = e > worst ? e : worst;
+                if (getenv("LFD_VERBOSE"))
+                    printf("  view (%d,%d): su %+.4f sv %+.4f ox %+.4f oy %+.4f tiles %.0f rms %.4f px\n", iu, iv,
+                           rep[6 * k], rep[6 * k + 1], rep[6 * k + 2], rep[6 * k + 3], rep[6 * k + 4], rep[6 * k + 5]);
+            }
+            printf("  calibrated view positions in %.2f s: largest departure from the grid %.4f view steps\n", tc, worst);
+            free(rep);
+            lf_image_free(&disp), lf_image_free(&conf);
+            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            o.threads = threads;
+            s = now();
+            if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
+                fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                return 1;
+            }
+            score("lf_lf_depth (calibrated)", &disp, &gt, now() - s);
+            free(lf.view_shift);
+            lf.view_shift = NULL;
+        }
         if (save) {
             write_pfm(save, &disp);
             /* previews: disparity, |error| (x5, clipped), confidence */
@@ -320,6 +355,19 @@ int main(int argc, char **argv)
                 return 1;
             }
             printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            if (calibrate) {
+                s = now();
+                if (lf_lf_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
+                    fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                    return 1;
+                }
+                lf_image_free(&sd), lf_image_free(&sc);
+                if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
+                    fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+                    return 1;
+                }
+                printf("5x5 views calibrated, depth again: %.2f s\n", now() - s);
+            }
             if (getenv("LFD_GTVIEW")) { /* diagnostic: ground-truth geometry */
                 char gtp[4096];
                 snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);

@@ -32,6 +32,7 @@ void lf_lf_free(lf_lightfield *lf)
     free(lf->data);
     free(lf->valid);
     free(lf->half);
+    free(lf->view_shift);
     memset(lf, 0, sizeof *lf);
 }
 

@@ -42,6 +42,7 @@ typedef struct dview {
     const float *data;
     const float *valid; /* NULL: every sample valid */
     double du, dv; /* view steps from the reference (dv already scaled by disp_v_per_u) */
+    double ox, oy; /* constant pixel offset (calibrated views) */
     int group;     /* 2k: on the ray at k*45 degrees; 2k+1: strictly inside octant k */
 } dview;
 
@@ -206,7 +207,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
             for (int k = 0; k < c->nviews; k++) {
                 const dview *v = &c->views[k];
                 /* I_ref(x, y) = I_v(x - d du, y - d dv) */
-                double sx = -d * v->du, sy = -d * v->dv;
+                double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
                 int ix = (int)floor(sx), iy = (int)floor(sy);
                 float fx = (float)(sx - ix), fy = (float)(sy - iy);
                 int r0 = y + iy, r1 = fy > 0.f ? r0 + 1 : r0;
@@ -512,8 +513,14 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
             dview *v = &views[nv++];
             v->data = lf_lf_view(lf, iu, iv);
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
-            v->du = iu - iu0, v->dv = (iv - iv0) * rv;
+            v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
+            /* the angular group from the grid: calibrated positions a little
+             * off a row or diagonal still belong to it */
             v->group = view_group(v->du, v->dv);
+            if (lf->view_shift) {
+                const double *p = lf->view_shift + 4 * ((size_t)iv * lf->nu + iu);
+                v->du = p[0], v->dv = p[1], v->ox = p[2], v->oy = p[3];
+            }
         }
     /* colour scale: costs in units of the reference's mean channel sum */
     double msum = 0;
@@ -663,6 +670,16 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     if ((rc = lf_lf_alloc(&small, lf->nu, lf->nv, lf->ns / f, lf->nt / f, err)))
         return rc;
     small.disp_v_per_u = lf->disp_v_per_u;
+    if (lf->view_shift) { /* calibrated views: offsets in the smaller pixels */
+        small.view_shift = malloc(sizeof(double) * 4 * (size_t)lf->nu * lf->nv);
+        if (!small.view_shift) {
+            lf_lf_free(&small);
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        }
+        for (int k = 0; k < lf->nu * lf->nv; k++)
+            for (int i = 0; i < 4; i++)
+                small.view_shift[4 * k + i] = lf->view_shift[4 * k + i] / (i >= 2 ? f : 1);
+    }
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
             const float *src = lf_lf_view(lf, iu, iv);

@@ -58,8 +58,9 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
 /* A view at centred view coordinates (u, v) inside the captured aperture
  * with per-pixel geometry: a disparity map of the reference view (given, or
  * estimated with lf_lf_depth) is forward-warped to (u, v) with a z-buffer
- * (nearer disparities win), then the nearest views are backward-warped
- * through it and blended with weights by angular distance, visibility (the
+ * (nearer disparities win), then the views within 2 view steps are
+ * backward-warped through it and blended with weights by angular distance,
+ * resampling phase, visibility (the
  * view's own warped depth agrees) and confidence; where confidence is low
  * or no view sees the point the plane at plane_disparity is used.  At a
  * view position it returns that view exactly. */
@@ -69,11 +70,30 @@ typedef struct lf_lf_view_opts {
     lf_lf_depth_opts depth;
     double plane_disparity;     /* fallback plane */
     double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
+    double radius;              /* source views: tent of this radius in view steps; <= 0: 2 (1: the 4 nearest) */
+    double phase_floor;         /* resampling-phase weight 1/(fx(1-fx)+fy(1-fy)+floor); < 0: 0.05; 0: off */
     int threads;
 } lf_lf_view_opts;
 lf_lf_view_opts lf_lf_view_defaults(void);
 int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_view_opts *o, lf_image *out,
                      lf_error *err);
+
+/* Self-calibration of the views' effective positions (real captures: a
+ * decoded Lytro image, a hand-held or gantry array) from a disparity map of
+ * the reference view (and its confidence, may be NULL):
+ *   I_ref(x, y) = I_k(x - d su_k + ox_k, y - d sv_k + oy_k)
+ * per view k: (su, sv) its baseline in view steps (nominally iu - iu_ref,
+ * (iv - iv_ref) r), (ox, oy) a constant pixel offset.  Fitted robustly to
+ * the measured shifts of textured tiles of near-constant disparity
+ * (docs/depth.md); a view with fewer than 8 usable tiles keeps its nominal
+ * position.  Stores the result in lf->view_shift, which lf_lf_depth and
+ * lf_lf_view_depth then use.  report (may be NULL): 6 doubles per view
+ * (su, sv, ox, oy, tiles used, rms residual px; NaN offsets when not fitted). */
+int lf_lf_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf_image *confidence, int threads,
+                          double *report, lf_error *err);
+/* (su, sv, ox, oy) of the viewpoint at fractional view indices (fu, fv):
+ * nominal without calibration, else interpolated between the views. */
+void lf_lf_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4]);
 
 #ifdef __cplusplus
 }

@@ -112,6 +112,7 @@ typedef struct lf_lightfield {
     double disp_per_alpha;  /* d = disp_per_alpha * (1 - 1/alpha); 0: alpha unavailable */
     lf_lf_layout layout;
     uint16_t *half; /* optional IEEE half copy of data (lf_lf_make_half), same layout */
+    double *view_shift; /* NULL: the nominal grid; else per view (su, sv, ox, oy), lf_lf_calibrate_views */
 } lf_lightfield;
 
 static inline float *lf_lf_view(const lf_lightfield *lf, int iu, int iv)

@@ -6,9 +6,11 @@
  *    the nearest surface (largest disparity) wins; holes (disocclusions)
  *    take the farthest disparity around them, as the background is what
  *    appears there.
- * 2. Every target pixel is looked up (bicubic) in the 4 nearest views,
- *    weighted bilinearly in (u, v); a view whose own warped disparity there
- *    is clearly nearer sees an occluder instead and drops out.
+ * 2. Every target pixel is looked up (bicubic) in the views within a tent
+ *    of radius 2 view steps (up to 16), weighted by the tent in (u, v) and
+ *    by the resampling phase (sources whose pixel grid lands near the
+ *    target pixel centre need less interpolation); a view whose own warped
+ *    disparity there is clearly nearer sees an occluder and drops out.
  * 3. Near depth edges the nearest disparity within a pixel is primary and
  *    the others compete by photo-consistency (soft weights).
  * 4. Where the splatted confidence is low the result fades to the plane
@@ -27,6 +29,7 @@ lf_lf_view_opts lf_lf_view_defaults(void)
     memset(&o, 0, sizeof o);
     o.depth = lf_lf_depth_defaults();
     o.min_confidence = -1;
+    o.phase_floor = -1;
     return o;
 }
 
@@ -34,8 +37,8 @@ static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ?
 
 /* Splat the reference disparity (and confidence, may be NULL) to a
  * viewpoint offset (du, dv) view steps from the reference (dv scaled). */
-static void splat(const float *disp, const float *conf, int w, int h, double du, double dv, float *out,
-                  float *out_conf)
+static void splat(const float *disp, const float *conf, int w, int h, double du, double dv, double ox, double oy,
+                  float *out, float *out_conf)
 {
     size_t np = (size_t)w * h;
     for (size_t i = 0; i < np; i++)
@@ -48,7 +51,7 @@ static void splat(const float *disp, const float *conf, int w, int h, double du,
              * The footprint: every pixel centre within 0.5 (+ a little) of
              * the landing point, so a surface shifted by exactly half a
              * pixel leaves no holes (nearest-pixel rounding would). */
-            double xf = x - d * du, yf = y - d * dv;
+            double xf = x - d * du + ox, yf = y - d * dv + oy;
             int xa = (int)ceil(xf - 0.51), xb = (int)floor(xf + 0.51);
             int ya = (int)ceil(yf - 0.51), yb = (int)floor(yf + 0.51);
             for (int yt = ya; yt <= yb; yt++)
@@ -129,14 +132,18 @@ static void sample(const float *img, int w, int h, double x, double y, float rgb
     rgb[0] = a[0], rgb[1] = a[1], rgb[2] = a[2];
 }
 
+#define VS_MAXSRC 16
+
 typedef struct vs_ctx {
     const lf_lightfield *lf;
     int nsrc;
-    int iu[4], iv[4];
-    double wv[4];         /* angular (bilinear) weights */
-    double du[4], dv[4];  /* source view minus target, view steps (dv scaled) */
+    int iu[VS_MAXSRC], iv[VS_MAXSRC];
+    double wv[VS_MAXSRC];         /* angular (tent) weights */
+    double du[VS_MAXSRC], dv[VS_MAXSRC]; /* source view minus target, view steps (dv scaled) */
+    double ox[VS_MAXSRC], oy[VS_MAXSRC]; /* source minus target pixel offset (calibrated views) */
     const float *dt, *ct; /* target disparity, confidence */
-    const float *ds[4];   /* source views' warped disparity */
+    const float *ds[VS_MAXSRC];   /* source views' warped disparity */
+    double phase0;        /* resampling-phase weight floor (<= 0: phase ignored) */
     const float *plane;   /* plane blend, RGB */
     float cmin;
     float *out;
@@ -152,13 +159,21 @@ static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], flo
     double acc[3] = {0, 0, 0}, sq = 0, wsum = 0, acc_all[3] = {0, 0, 0}, wall = 0;
     for (int k = 0; k < c->nsrc; k++) {
         /* I_target(x, y) = I_k(x - d (u_k - u), y - d (v_k - v)) */
-        double sx = x - d * c->du[k], sy = y - d * c->dv[k];
+        double sx = x - d * c->du[k] + c->ox[k], sy = y - d * c->dv[k] + c->oy[k];
         float col[3];
         sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
         float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
         double vis = dk > d + 0.25f + 0.05f * fabsf(d) ? 0.0 : 1.0;
         double inside = (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1) ? 0.1 : 1.0;
         double wk = c->wv[k] * inside;
+        if (c->phase0 > 0) {
+            /* resampling phase: a source whose pixel grid lands on the
+             * target's pixel centres is read without interpolation; half a
+             * pixel off, interpolation loses texture at the pixel scale.
+             * Weight by 1 / (fx (1 - fx) + fy (1 - fy) + floor). */
+            double fx = sx - floor(sx), fy = sy - floor(sy);
+            wk /= fx * (1 - fx) + fy * (1 - fy) + c->phase0;
+        }
         for (int ch = 0; ch < 3; ch++)
             acc_all[ch] += wk * col[ch];
         wall += wk;
@@ -271,22 +286,30 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     }
     const float *D = o->disparity ? o->disparity->data : disp.data;
     const float *C = o->disparity ? (o->confidence ? o->confidence->data : NULL) : conf.data;
-    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
-    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
     vs_ctx c;
     memset(&c, 0, sizeof c);
     c.lf = lf;
-    int u0 = clampi((int)floor(fu), 0, lf->nu > 1 ? lf->nu - 2 : 0), v0 = clampi((int)floor(fv), 0, lf->nv > 1 ? lf->nv - 2 : 0);
-    double au = fu - u0, av = fv - v0;
-    for (int k = 0; k < 4; k++) {
-        int iu = u0 + (k & 1), iv = v0 + (k >> 1);
-        double wk = (k & 1 ? au : 1 - au) * (k & 2 ? av : 1 - av);
-        if (wk <= 0 || iu >= lf->nu || iv >= lf->nv)
-            continue;
-        c.iu[c.nsrc] = iu, c.iv[c.nsrc] = iv, c.wv[c.nsrc] = wk;
-        c.du[c.nsrc] = iu - fu, c.dv[c.nsrc] = (iv - fv) * rv;
-        c.nsrc++;
-    }
+    /* sources: the views within a tent of radius R view steps around the
+     * target (R = 1: the 4 nearest, bilinear weights; R = 2: up to 16) */
+    double R = o->radius > 0 ? o->radius : 2.0;
+    c.phase0 = o->phase_floor < 0 ? 0.05 : o->phase_floor;
+    int rr = (int)ceil(R - 1e-9);
+    double st[4]; /* the target's (su, sv, ox, oy) */
+    lf_lf_view_shift(lf, fu, fv, st);
+    for (int iv = (int)floor(fv) - rr + 1; iv <= (int)floor(fv) + rr; iv++)
+        for (int iu = (int)floor(fu) - rr + 1; iu <= (int)floor(fu) + rr; iu++) {
+            if (iu < 0 || iv < 0 || iu >= lf->nu || iv >= lf->nv || c.nsrc >= VS_MAXSRC)
+                continue;
+            double wu = 1 - fabs(iu - fu) / R, wvv = 1 - fabs(iv - fv) / R;
+            if (wu <= 1e-9 || wvv <= 1e-9)
+                continue;
+            c.iu[c.nsrc] = iu, c.iv[c.nsrc] = iv, c.wv[c.nsrc] = wu * wvv;
+            double sk[4];
+            lf_lf_view_shift(lf, iu, iv, sk);
+            c.du[c.nsrc] = sk[0] - st[0], c.dv[c.nsrc] = sk[1] - st[1];
+            c.ox[c.nsrc] = sk[2] - st[2], c.oy[c.nsrc] = sk[3] - st[3];
+            c.nsrc++;
+        }
     float *buf = malloc(sizeof(float) * np * (2 + (size_t)c.nsrc));
     lf_image plane = {0};
     if (!buf) {
@@ -294,10 +317,12 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     float *dt = buf, *ct = buf + np;
-    splat(D, C, w, h, fu - iu0, (fv - iv0) * rv, dt, ct);
+    splat(D, C, w, h, st[0], st[1], st[2], st[3], dt, ct);
     for (int k = 0; k < c.nsrc; k++) {
         float *dk = buf + (2 + (size_t)k) * np;
-        splat(D, NULL, w, h, c.iu[k] - iu0, (c.iv[k] - iv0) * rv, dk, NULL);
+        double sk[4];
+        lf_lf_view_shift(lf, c.iu[k], c.iv[k], sk);
+        splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
         c.ds[k] = dk;
     }
     c.dt = dt, c.ct = ct;

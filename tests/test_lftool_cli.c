@@ -168,6 +168,14 @@ int main(void)
     CHECK(strstr(out_text, "views are") != NULL);
     CHECK(run("%s view %s --u 0.5 --v 0 --geometry plane --disparity-map %s/dm2.exr -o %s/v.exr", LFTOOL, raw_path, dir,
               dir) == 2);
+    /* self-calibrated view positions: depth, and a view from a given map */
+    CHECK(run("%s depth %s --calibrate-views -o %s/dmc.exr", LFTOOL, raw_path, dir) == 0);
+    snprintf(path, sizeof path, "%s/dmc.exr", dir);
+    CHECK(exists(path));
+    CHECK(run("%s view %s --u 0.5 --v -0.5 --calibrate-views --disparity-map %s/dm2.exr -o %s/viewc.exr", LFTOOL,
+              raw_path, dir, dir) == 0);
+    CHECK(run("%s view %s --u 0.5 --v -0.5 --geometry plane --calibrate-views -o %s/viewc.exr", LFTOOL, raw_path, dir) ==
+          0);
     CHECK(run("%s view %s --u 3 --v 0 -o %s/view.exr", LFTOOL, raw_path, dir) == 1);
     CHECK(strstr(out_text, "outside") != NULL);
 

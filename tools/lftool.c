@@ -48,7 +48,7 @@ typedef struct opts {
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
     int have_u, have_v;
-    int views[4], steps, threads, allow_nonfinite;
+    int views[4], steps, threads, allow_nonfinite, calibrate_views;
     /* synth */
     lf_lf_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal;
@@ -168,6 +168,8 @@ static const lf_arg depth_args[] = {
     OUTPUT_FLAG("disparity map: .exr/.pfm values, .png a colour map with a legend"), RANGE_FLAGS(3), APERTURE_FLAGS,
     LAYOUT_FLAGS,
     {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "also write the confidence map"},
+    {"--calibrate-views", NULL, LF_ARG_FLAG, &opt.calibrate_views, NULL,
+     "fit each view's position and pixel offset to the data first (docs/depth.md)"},
     {"--method", NULL, LF_ARG_CHOICE, &opt.method, "METHOD",
      "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
      .choices = "volume|stack"},
@@ -182,6 +184,8 @@ static const lf_arg view_args[] = {
      "depth: per-pixel disparity (default); plane: blend on one plane", .choices = "depth|plane"},
     {"--disparity-map", NULL, LF_ARG_STRING, &opt.dispmap, "D.exr", "use this disparity map instead of estimating"},
     {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "its confidence (with --disparity-map)"},
+    {"--calibrate-views", NULL, LF_ARG_FLAG, &opt.calibrate_views, NULL,
+     "fit each view's position and pixel offset to the data first (docs/depth.md)"},
 };
 static const lf_arg synth_args[] = {
     LAYOUT_FLAGS, PICTURE_FLAGS,
@@ -777,6 +781,15 @@ static int cmd_depth(const opts *o)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
     }
     lf_image disp, conf;
+    if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */
+        if (lf_lf_depth(&l.lf, &d, &disp, &conf, &err) ||
+            lf_lf_calibrate_views(&l.lf, &disp, &conf, o->threads, NULL, &err)) {
+            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+            unload(&l);
+            return EXIT_INPUT;
+        }
+        lf_image_free(&disp), lf_image_free(&conf);
+    }
     if (lf_lf_depth(&l.lf, &d, &disp, o->confidence ? &conf : NULL, &err)) {
         fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
         unload(&l);
@@ -873,6 +886,21 @@ static int cmd_view(const opts *o)
         lf_image_free(&dm);
         unload(&l);
         return rc;
+    }
+    if (!plane && o->calibrate_views) { /* from the given map, or one estimated on the nominal grid */
+        lf_image ed = {0}, ec = {0};
+        lf_lf_depth_opts dopt = lf_lf_depth_defaults();
+        dopt.threads = o->threads;
+        rc = o->dispmap ? lf_lf_calibrate_views(&l.lf, &dm, o->confidence ? &cm : NULL, o->threads, NULL, &err)
+                        : (lf_lf_depth(&l.lf, &dopt, &ed, &ec, &err) ||
+                           lf_lf_calibrate_views(&l.lf, &ed, &ec, o->threads, NULL, &err));
+        lf_image_free(&ed), lf_image_free(&ec);
+        if (rc) {
+            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
+            lf_image_free(&dm), lf_image_free(&cm);
+            unload(&l);
+            return EXIT_INPUT;
+        }
     }
     if (plane)
         rc = lf_lf_view_at(&l.lf, o->u, o->v, d, &out, &err);

@@ -1,7 +1,7 @@
 /* bench_lf_backgammon - depth and view synthesis on an HCI 4D light-field
- * benchmark scene (default ../shared/lfdata/hci/backgammon beside the repo).
+ * benchmark scene (bench/lf_backgammon.sh passes the HCI backgammon folder).
  *
- *   bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only | --views-only]
+ *   bench_lf_backgammon DIR [--threads N] [--runs N] [--depth-only | --views-only]
  *                       [--save-disp FILE.pfm] [--baseline] [--calibrate]
  *
  * Depth: lf_lf_depth on the 9x9 views with no range given (estimated from
@@ -39,91 +39,39 @@ static double now(void)
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-/* TEMPORARY (until the light-field folder reader lands in lightfield/):
- * reads DIR/input_CamNNN.png, n = 0 .. N*N-1, row-major from the top-left
- * view, into an N x N light field. */
+/* The views through the library's folder reader (lightfield/folder.c):
+ * HCI layout, parameters.cfg, every view. */
 static int load_hci_views(const char *dir, lf_lightfield *lf)
 {
-    int n = 0;
-    char path[4096];
-    for (;;) {
-        snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, n);
-        FILE *f = fopen(path, "rb");
-        if (!f)
-            break;
-        fclose(f);
-        n++;
-    }
-    int side = (int)floor(sqrt((double)n) + 0.5);
-    if (n == 0 || side * side != n) {
-        fprintf(stderr, "bench_lf_backgammon: %s: expected N*N input_CamNNN.png views, found %d\n", dir, n);
-        return 1;
-    }
+    lf_lf_folder f;
+    lf_lf_layout flags;
     lf_error err = {0};
-    for (int k = 0; k < n; k++) {
-        snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, k);
-        lf_image img;
-        if (lf_image_read(path, &img, NULL, &err)) {
-            fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
-            return 1;
-        }
-        if (k == 0 && lf_lf_alloc(lf, side, side, img.width, img.height, &err)) {
-            fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
-            return 1;
-        }
-        if (img.width != lf->ns || img.height != lf->nt || img.channels < 3) {
-            fprintf(stderr, "bench_lf_backgammon: %s: size or channels differ from view 0\n", path);
-            return 1;
-        }
-        float *dst = lf_lf_view(lf, k % side, k / side);
-        for (size_t i = 0; i < (size_t)img.width * img.height; i++)
-            for (int c = 0; c < 3; c++)
-                dst[i * 3 + c] = img.data[i * img.channels + c];
-        lf_image_free(&img);
-    }
-    lf->disp_v_per_u = 1.0;
-    return 0;
+    lf_lf_layout_init(&flags);
+    int rc = lf_lf_folder_scan(dir, &f, &err) || lf_lf_folder_load(&f, &flags, lf, &err);
+    if (rc)
+        fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+    lf_lf_folder_free(&f);
+    return rc;
 }
 
-/* TEMPORARY (until image/ reads PFM): little-endian 1-channel PFM, rows bottom-up. */
+/* A 1-channel PFM (image/pfm.c: rows bottom-up, either byte order). */
 static int read_pfm(const char *path, lf_image *img)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return 1;
-    char magic[3] = {0};
-    int w, h;
-    double scale;
-    if (fscanf(f, "%2s %d %d %lf", magic, &w, &h, &scale) != 4 || strcmp(magic, "Pf") || scale >= 0 || w <= 0 ||
-        h <= 0) {
-        fclose(f);
-        return 1;
-    }
-    fgetc(f);
     lf_error err = {0};
-    if (lf_image_alloc(img, w, h, 1, &err)) {
-        fclose(f);
+    if (lf_image_read(path, img, NULL, &err))
+        return 1;
+    if (img->channels != 1) {
+        lf_image_free(img);
         return 1;
     }
-    for (int y = h - 1; y >= 0; y--)
-        if (fread(img->data + (size_t)y * w, sizeof(float), (size_t)w, f) != (size_t)w) {
-            fclose(f);
-            lf_image_free(img);
-            return 1;
-        }
-    fclose(f);
     return 0;
 }
 
 static void write_pfm(const char *path, const lf_image *img)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return;
-    fprintf(f, "Pf\n%d %d\n-1.0\n", img->width, img->height);
-    for (int y = img->height - 1; y >= 0; y--)
-        fwrite(img->data + (size_t)y * img->width, sizeof(float), (size_t)img->width, f);
-    fclose(f);
+    lf_error err = {0};
+    if (lf_image_write(path, img, NULL, NULL, &err))
+        fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
 }
 
 static void score(const char *name, const lf_image *d, const lf_image *gt, double secs)
@@ -191,7 +139,7 @@ static int cmpd(const void *a, const void *b)
 
 int main(int argc, char **argv)
 {
-    const char *dir = LF_SOURCE_DIR "/../shared/lfdata/hci/backgammon", *save = NULL;
+    const char *dir = NULL, *save = NULL;
     int threads = 2, runs = 3, do_depth = 1, do_views = 1, baseline = 0, calibrate = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--threads") && i + 1 < argc)
@@ -211,10 +159,14 @@ int main(int argc, char **argv)
         else if (argv[i][0] != '-')
             dir = argv[i];
         else {
-            fprintf(stderr, "usage: bench_lf_backgammon [DIR] [--threads N] [--runs N] [--depth-only|--views-only] "
-                            "[--save-disp FILE.pfm] [--baseline] [--calibrate]\n");
-            return 2;
+            dir = NULL;
+            break;
         }
+    }
+    if (!dir) {
+        fprintf(stderr, "usage: bench_lf_backgammon DIR [--threads N] [--runs N] [--depth-only|--views-only] "
+                        "[--save-disp FILE.pfm] [--baseline] [--calibrate]\n");
+        return 2;
     }
     lf_lightfield lf = {0};
     double t0 = now();

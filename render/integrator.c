@@ -14,13 +14,6 @@
 
 #include "render_internal.h"
 
-static float power_heuristic(float a, float b)
-{
-    float a2 = a * a, b2 = b * b;
-    if (isinf(a2))
-        return 1.f;
-    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
-}
 
 lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s)
 {
@@ -66,7 +59,7 @@ static lf_vec3 light_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *b
     float p_l = (float)pmf * ls.pdf;
     float w = 1.f;
     if (!ls.delta)
-        w = power_heuristic(p_l, lf_bsdf_pdf(bsdf, wo, ls.wi));
+        w = lf_power_heuristic(p_l, lf_bsdf_pdf(bsdf, wo, ls.wi));
     return lf_scale(lf_mul(f, ls.Li), cosi * w / p_l);
 }
 
@@ -114,33 +107,11 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         lf_hit h;
         (*rays)++;
         if (!lf_scene_intersect(s, o, d, INFINITY, tau, &h)) {
-            for (int k = 0; k < s->n_infinite; k++) {
-                const lf_light *l = &s->lights[s->infinite_lights[k]];
-                lf_vec3 Le = lf_light_infinite_le(l, d);
-                if (lf_is_black(Le))
-                    continue;
-                if (depth == 0 || specular_bounce) {
-                    L = lf_add(L, lf_mul(beta, Le));
-                } else {
-                    float p_l = (float)lf_light_pmf(s, lsm, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
-                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
-                }
-            }
+            lf_add_escaped_light(&L, s, lsm, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
             break;
         }
         lf_vec3 wo = lf_neg(d);
-        if (h.light >= 0) {
-            const lf_light *l = &s->lights[h.light];
-            lf_vec3 Le = lf_light_area_le(l, &h, d);
-            if (!lf_is_black(Le)) {
-                if (depth == 0 || specular_bounce) {
-                    L = lf_add(L, lf_mul(beta, Le));
-                } else {
-                    float p_l = (float)lf_light_pmf(s, lsm, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
-                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
-                }
-            }
-        }
+        lf_add_hit_emission(&L, s, lsm, &h, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
         const lf_material *mat = lf_materials_get(s->materials, h.material);
         if (lf_material_is_interface(mat)) {
             /* No surface here (pbrt "interface"): continue the ray unchanged. */

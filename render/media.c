@@ -116,13 +116,6 @@ int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
 
 /* ------------------------------------------------------------- integrator */
 
-static float power_heuristic(float a, float b)
-{
-    float a2 = a * a, b2 = b * b;
-    if (isinf(a2))
-        return 1.f;
-    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
-}
 
 /* exp(-sigma t) per channel; a zero coefficient transmits everything, even
  * over an infinite distance. */
@@ -243,7 +236,7 @@ static lf_vec3 vol_light_direct(const lf_scene *s, const vertex *v, int li, doub
     if (lf_is_black(T))
         return lf_v3(0, 0, 0);
     float p_l = (float)pmf * ls.pdf;
-    float w = ls.delta ? 1.f : power_heuristic(p_l, scatter_pdf);
+    float w = ls.delta ? 1.f : lf_power_heuristic(p_l, scatter_pdf);
     return lf_scale(lf_mul(lf_mul(f, ls.Li), T), w / p_l);
 }
 
@@ -367,34 +360,11 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
             lf_sample_skip(st);
         }
         if (!hit) {
-            for (int k = 0; k < s->n_infinite; k++) {
-                const lf_light *l = &s->lights[s->infinite_lights[k]];
-                lf_vec3 Le = lf_light_infinite_le(l, d);
-                if (lf_is_black(Le))
-                    continue;
-                if (depth == 0 || specular_bounce) {
-                    L = lf_add(L, lf_mul(beta, Le));
-                } else {
-                    float p_l =
-                        (float)lf_light_pmf(s, lsm, s->infinite_lights[k]) * lf_light_pdf_li(s, l, prev_p, d, NULL);
-                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
-                }
-            }
+            lf_add_escaped_light(&L, s, lsm, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
             break;
         }
         lf_vec3 wo = lf_neg(d);
-        if (h.light >= 0) {
-            const lf_light *l = &s->lights[h.light];
-            lf_vec3 Le = lf_light_area_le(l, &h, d);
-            if (!lf_is_black(Le)) {
-                if (depth == 0 || specular_bounce) {
-                    L = lf_add(L, lf_mul(beta, Le));
-                } else {
-                    float p_l = (float)lf_light_pmf(s, lsm, h.light) * lf_light_pdf_li(s, l, prev_p, d, &h);
-                    L = lf_add(L, lf_scale(lf_mul(beta, Le), power_heuristic(p_b, p_l)));
-                }
-            }
-        }
+        lf_add_hit_emission(&L, s, lsm, &h, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
         const lf_material *mat = lf_materials_get(s->materials, h.material);
         if (lf_material_is_interface(mat)) {
             /* A medium boundary without a surface: continue, maybe in another medium. */

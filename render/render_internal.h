@@ -3,6 +3,7 @@
 #define LF_RENDER_INTERNAL_H
 
 #include <embree3/rtcore.h>
+#include <math.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -319,6 +320,55 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                    long long *rays);
 /* Probability that NEE samples light `light` at a vertex (1 when all are). */
 double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light);
+
+/* ---- shared by the path and volumetric path integrators ---- */
+
+/* Veach's power heuristic (beta = 2) for a sample of pdf a against b. */
+static inline float lf_power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    if (isinf(a2))
+        return 1.f;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
+}
+
+/* Light a path meets by BSDF (or phase) sampling, added to *L: at the camera
+ * or after a specular bounce in full, otherwise MIS-weighted against next-
+ * event estimation, which would have found the same light from prev_p with
+ * pdf pmf * pdf_li (pbrt-v4's PathIntegrator). */
+static inline void lf_add_bsdf_sampled_light(lf_vec3 *L, const lf_scene *s, lf_light_sampler lsm, int light,
+                                             lf_vec3 Le, lf_vec3 beta, int unweighted, float p_b, lf_vec3 prev_p,
+                                             lf_vec3 d, const lf_hit *h)
+{
+    if (unweighted) {
+        *L = lf_add(*L, lf_mul(beta, Le));
+    } else {
+        float p_l = (float)lf_light_pmf(s, lsm, light) * lf_light_pdf_li(s, &s->lights[light], prev_p, d, h);
+        *L = lf_add(*L, lf_scale(lf_mul(beta, Le), lf_power_heuristic(p_b, p_l)));
+    }
+}
+
+/* The infinite lights seen by a ray that escaped the scene. */
+static inline void lf_add_escaped_light(lf_vec3 *L, const lf_scene *s, lf_light_sampler lsm, lf_vec3 beta,
+                                        int unweighted, float p_b, lf_vec3 prev_p, lf_vec3 d)
+{
+    for (int k = 0; k < s->n_infinite; k++) {
+        lf_vec3 Le = lf_light_infinite_le(&s->lights[s->infinite_lights[k]], d);
+        if (!lf_is_black(Le))
+            lf_add_bsdf_sampled_light(L, s, lsm, s->infinite_lights[k], Le, beta, unweighted, p_b, prev_p, d, NULL);
+    }
+}
+
+/* The emission of an area light the ray hit. */
+static inline void lf_add_hit_emission(lf_vec3 *L, const lf_scene *s, lf_light_sampler lsm, const lf_hit *h,
+                                       lf_vec3 beta, int unweighted, float p_b, lf_vec3 prev_p, lf_vec3 d)
+{
+    if (h->light < 0)
+        return;
+    lf_vec3 Le = lf_light_area_le(&s->lights[h->light], h, d);
+    if (!lf_is_black(Le))
+        lf_add_bsdf_sampled_light(L, s, lsm, h->light, Le, beta, unweighted, p_b, prev_p, d, h);
+}
 
 /* ---- participating media (render/media.c) ---- */
 /* Reads the MakeNamedMedium directives into s->media (grid media are

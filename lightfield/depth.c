@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "lf_depth.h"
-#include "parallel_internal.h"
+#include "../base/lf_parallel.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))
@@ -533,7 +533,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
                    o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
     if (lf->valid)
         cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
-    lf_lf_parallel_for(nt, threads, 4, cost_rows, &cc);
+    lf_parallel_for(nt, threads, 4, cost_rows, &cc);
 
     /* guide: the reference colour, square-root encoded (closer to perceptual
      * steps than linear) and normalised to [0, 1] */
@@ -575,11 +575,11 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         }
     }
     gf_ctx gc = {ns, nt, r, I, mI, Sinv, cost, scratch, per_thread};
-    lf_lf_parallel_for(nl, threads, 1, gf_slices, &gc);
+    lf_parallel_for(nl, threads, 1, gf_slices, &gc);
 
     float *conf = disp + np;
     wta_ctx wc = {ns, nt, nl, d0, step, cost, disp, conf};
-    lf_lf_parallel_for(nt, threads, 8, wta_rows, &wc);
+    lf_parallel_for(nt, threads, 8, wta_rows, &wc);
 
     if (lf_image_alloc(disparity, ns, nt, 1, err)) {
         rc = err ? err->code : LF_ERR_NOMEM;
@@ -601,7 +601,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
             goto done;
         }
         wm_ctx wm = {ns, nt, mr, disp, conf, refs, disparity->data, 0.02f, wscr, wpt};
-        lf_lf_parallel_for(nt, threads, 4, wm_rows, &wm);
+        lf_parallel_for(nt, threads, 4, wm_rows, &wm);
     } else {
         memcpy(disparity->data, disp, sizeof(float) * np);
     }

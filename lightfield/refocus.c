@@ -2,12 +2,12 @@
  * focal stacks, all-in-focus and disparity maps. */
 #include <stdatomic.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "half_internal.h"
 #include "lf_lightfield.h"
+#include "../base/lf_parallel.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -51,8 +51,7 @@ typedef struct refocus_job {
     int nviews;
     float inv_wsum;
     lf_image *out;
-    int y0, y1;
-    float *wacc; /* masked path: accumulated weights, ns per row in band */
+    float *wacc[LF_PARALLEL_MAX_THREADS]; /* masked path: per thread, ns weights per row of a block */
 } refocus_job;
 
 enum { BLOCK_ROWS = 16 };
@@ -139,14 +138,19 @@ static inline float rowval(const view_shift *v, size_t i)
     return v->half ? lf_lf_half_to_float(v->half[i]) : v->data[i];
 }
 
-static void *refocus_worker(void *arg)
+/* Blocks [b0, b1) of BLOCK_ROWS rows (lf_parallel_for): every row sums the
+ * views in the same order whichever thread takes it. */
+static void refocus_blocks(void *ctx, int b0, int b1, int tid)
 {
-    refocus_job *j = arg;
+    refocus_job *j = ctx;
     const lf_lightfield *lf = j->lf;
     const int ns = lf->ns, nt = lf->nt;
     const size_t row = (size_t)ns * 3;
-    for (int yb = j->y0; yb < j->y1; yb += BLOCK_ROWS) {
-        int ye = yb + BLOCK_ROWS < j->y1 ? yb + BLOCK_ROWS : j->y1;
+    float *wacc = j->wacc[tid];
+    for (int yb = b0 * BLOCK_ROWS; yb < b1 * BLOCK_ROWS && yb < nt; yb += BLOCK_ROWS) {
+        int ye = yb + BLOCK_ROWS < nt ? yb + BLOCK_ROWS : nt;
+        if (wacc)
+            memset(wacc, 0, sizeof(float) * (size_t)BLOCK_ROWS * ns);
         for (int vi = 0; vi < j->nviews; vi++) {
             const view_shift *v = &j->views[vi];
             float w00 = v->w * (1 - v->fx) * (1 - v->fy), w10 = v->w * v->fx * (1 - v->fy);
@@ -178,7 +182,7 @@ static void *refocus_worker(void *arg)
                 } else {
                     /* masked: every tap weighted by its validity, weights accumulated */
                     const float *m0 = v->valid + (size_t)sy0 * ns, *m1 = v->valid + (size_t)sy1 * ns;
-                    float *wa = j->wacc + (size_t)(y - j->y0) * ns;
+                    float *wa = wacc + (size_t)(y - yb) * ns;
                     for (int x = 0; x < ns; x++) {
                         int sx0 = clampi(x + v->ix, 0, ns - 1), sx1 = clampi(x + v->ix + 1, 0, ns - 1);
                         float a = w00 * m0[sx0], b = w10 * m0[sx1], c = w01 * m1[sx0], e = w11 * m1[sx1];
@@ -192,8 +196,8 @@ static void *refocus_worker(void *arg)
         }
         for (int y = yb; y < ye; y++) {
             float *acc = j->out->data + (size_t)y * row;
-            if (j->wacc) {
-                const float *wa = j->wacc + (size_t)(y - j->y0) * ns;
+            if (wacc) {
+                const float *wa = wacc + (size_t)(y - yb) * ns;
                 for (int x = 0; x < ns; x++) {
                     float s = wa[x] > 1e-6f ? 1.f / wa[x] : 0.f;
                     acc[3 * x] *= s, acc[3 * x + 1] *= s, acc[3 * x + 2] *= s;
@@ -204,7 +208,6 @@ static void *refocus_worker(void *arg)
             }
         }
     }
-    return NULL;
 }
 
 int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image *out, lf_error *err)
@@ -246,34 +249,15 @@ int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image
         free(vs);
         return err ? err->code : LF_ERR_NOMEM;
     }
-    int nth = o->threads > 0 ? o->threads : 2;
-    if (nth > 64)
-        nth = 64;
-    refocus_job jobs[64];
-    pthread_t tid[64];
-    int rc = LF_OK;
-    for (int t = 0; t < nth; t++) {
-        jobs[t] = (refocus_job){lf, vs, n, (float)(1.0 / wsum), out, lf->nt * t / nth, lf->nt * (t + 1) / nth, NULL};
-        if (lf->valid) {
-            jobs[t].wacc = calloc((size_t)(jobs[t].y1 - jobs[t].y0 + 1) * lf->ns, sizeof(float));
-            if (!jobs[t].wacc)
-                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-        }
-    }
-    int created[64] = {0};
-    for (int t = 1; t < nth && !rc; t++)
-        created[t] = pthread_create(&tid[t], NULL, refocus_worker, &jobs[t]) == 0;
-    if (!rc) {
-        refocus_worker(&jobs[0]);
-        for (int t = 1; t < nth; t++) {
-            if (created[t])
-                pthread_join(tid[t], NULL);
-            else
-                refocus_worker(&jobs[t]); /* no thread: do its rows here */
-        }
-    }
-    for (int t = 0; t < nth; t++)
-        free(jobs[t].wacc);
+    refocus_job job = {lf, vs, n, (float)(1.0 / wsum), out, {NULL}};
+    int rc = LF_OK, nblocks = (lf->nt + BLOCK_ROWS - 1) / BLOCK_ROWS;
+    for (int t = 0; lf->valid && t < LF_PARALLEL_MAX_THREADS && !rc; t++)
+        if (!(job.wacc[t] = malloc(sizeof(float) * (size_t)BLOCK_ROWS * lf->ns)))
+            rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    if (!rc)
+        lf_parallel_for(nblocks, o->threads, 1, refocus_blocks, &job);
+    for (int t = 0; t < LF_PARALLEL_MAX_THREADS; t++)
+        free(job.wacc[t]);
     free(vs);
     if (rc)
         lf_image_free(out);

@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "lf_depth.h"
-#include "parallel_internal.h"
+#include "../base/lf_parallel.h"
 
 void lf_lf_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4])
 {
@@ -257,7 +257,7 @@ int lf_lf_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf
             grey[(size_t)k * np + i] = (v[3 * i] + v[3 * i + 1] + v[3 * i + 2]) * (1.f / 3.f);
     }
     c.grey = grey, c.out = out, c.ok = ok;
-    lf_lf_parallel_for(nviews, threads > 0 ? threads : 2, 1, cal_views, &c);
+    lf_parallel_for(nviews, threads > 0 ? threads : 2, 1, cal_views, &c);
     int nok = 0;
     for (int k = 0; k < nviews; k++) {
         for (int i = 0; i < 4; i++)

@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "lf_depth.h"
-#include "parallel_internal.h"
+#include "../base/lf_parallel.h"
 
 lf_lf_view_opts lf_lf_view_defaults(void)
 {
@@ -333,7 +333,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     }
     c.plane = plane.data;
     c.out = out->data;
-    lf_lf_parallel_for(h, o->threads, 8, vs_rows, &c);
+    lf_parallel_for(h, o->threads, 8, vs_rows, &c);
     free(buf), lf_image_free(&plane), lf_image_free(&disp), lf_image_free(&conf);
     return LF_OK;
 }

@@ -1,15 +1,16 @@
-/* A parallel for on pthreads (parallel_internal.h). */
+/* A parallel for on pthreads (lf_parallel.h). */
 #include <pthread.h>
 #include <stdatomic.h>
+#include <unistd.h>
 
-#include "parallel_internal.h"
+#include "lf_parallel.h"
 
-enum { MAX_THREADS = 64 };
+enum { MAX_THREADS = LF_PARALLEL_MAX_THREADS };
 
 typedef struct par_shared {
     atomic_int next;
     int n, chunk;
-    lf_lf_par_fn fn;
+    lf_parallel_fn fn;
     void *ctx;
 } par_shared;
 
@@ -32,9 +33,10 @@ static void *par_worker(void *arg)
     return NULL;
 }
 
-int lf_lf_parallel_for(int n, int threads, int chunk, lf_lf_par_fn fn, void *ctx)
+int lf_parallel_for(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx)
 {
-    int nth = threads > 0 ? threads : 2;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int nth = threads > 0 ? threads : (cores > 0 ? (int)cores : 1);
     if (nth > MAX_THREADS)
         nth = MAX_THREADS;
     if (chunk <= 0)

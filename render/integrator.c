@@ -122,18 +122,9 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         }
         if (depth++ == in->max_depth)
             break;
-        if (h.sphere >= 0 && lf_material_uses_textures(mat))
-            lf_scene_sphere_uv(s, &h);
         lf_bsdf bsdf;
-        lf_material_bsdf(mat, &h.sc, &bsdf);
-        int specular = lf_bsdf_is_specular(&bsdf);
-        int need_light_choice = !specular && s->n_nee_lights > 1 && lsm != LF_LIGHTS_ALL;
-        int need_lobe_choice = bsdf.kind != LF_LOBE_DIFFUSE;
-        float ul = 0.5f, uc = 0.5f;
-        if (need_light_choice || need_lobe_choice)
-            lf_sample_2d(st, &ul, &uc);
-        else
-            lf_sample_skip(st);
+        float ul, uc;
+        int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc);
         if (!specular && s->n_nee_lights > 0)
             L = lf_add(L, lf_mul(beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
         else

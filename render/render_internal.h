@@ -359,6 +359,27 @@ static inline void lf_add_escaped_light(lf_vec3 *L, const lf_scene *s, lf_light_
     }
 }
 
+/* The BSDF at a surface vertex and the two sample values it may spend on
+ * choosing a light and a lobe: one 2D sample drawn only when a choice exists,
+ * else one skipped, so later dimensions line up whatever the surface.
+ * Returns whether the BSDF is specular. */
+static inline int lf_surface_vertex(const lf_scene *s, lf_light_sampler lsm, lf_hit *h, const lf_material *mat,
+                                    lf_sample_stream *st, lf_bsdf *bsdf, float *ul, float *uc)
+{
+    if (h->sphere >= 0 && lf_material_uses_textures(mat))
+        lf_scene_sphere_uv(s, h);
+    lf_material_bsdf(mat, &h->sc, bsdf);
+    int specular = lf_bsdf_is_specular(bsdf);
+    int need_light_choice = !specular && s->n_nee_lights > 1 && lsm != LF_LIGHTS_ALL;
+    int need_lobe_choice = bsdf->kind != LF_LOBE_DIFFUSE;
+    *ul = *uc = 0.5f;
+    if (need_light_choice || need_lobe_choice)
+        lf_sample_2d(st, ul, uc);
+    else
+        lf_sample_skip(st);
+    return specular;
+}
+
 /* The emission of an area light the ray hit. */
 static inline void lf_add_hit_emission(lf_vec3 *L, const lf_scene *s, lf_light_sampler lsm, const lf_hit *h,
                                        lf_vec3 beta, int unweighted, float p_b, lf_vec3 prev_p, lf_vec3 d)

@@ -143,24 +143,13 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         prev_p = h.sc.p;
         o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
         d = bs.wi;
-        /* Russian roulette on the throughput beta * eta_scale, survival
-         * probability p, surviving paths weighted 1/p (unbiased for any
-         * p > 0).  pbrt-v4's rule: p = max component, after depth 1.  The
-         * default, "sqrt": p = sqrt(max component) (Cycles' rule), and not
-         * before depth 2: ending paths early kills the bright direct light
-         * their next vertices would have gathered, which costs far more
-         * variance than the rays it saves (docs/performance.md, issue 21). */
-        lf_vec3 rr_beta = lf_scale(beta, eta_scale);
-        float m = lf_maxc(rr_beta);
-        if (m < 1.f && depth > in->rr_depth) {
-            float p = in->rr_rule == LF_RR_SQRT ? sqrtf(m) : m;
-            if (lf_sample_1d(st) >= p)
-                break;
-            beta = lf_scale(beta, 1.f / p);
-        } else {
-            lf_sample_skip(st);
-        }
-        if (!(lf_maxc(beta) > 0))
+        /* Russian roulette (render_internal.h).  pbrt-v4's rule: p = max
+         * component, after depth 1.  The default, "sqrt": p = sqrt(max
+         * component) (Cycles' rule), and not before depth 2: ending paths
+         * early kills the bright direct light their next vertices would have
+         * gathered, which costs far more variance than the rays it saves
+         * (docs/performance.md, issue 21). */
+        if (!lf_roulette(in, &beta, eta_scale, depth, st))
             break;
     }
     return L;

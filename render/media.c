@@ -268,21 +268,6 @@ static lf_vec3 vol_sample_direct(const lf_scene *s, lf_light_sampler lsm, const 
     return vol_light_direct(s, v, li, pmf, u0, u1, tau, rays);
 }
 
-/* Russian roulette as the surface integrator (after depth 1). Returns 0 to stop. */
-static int roulette(lf_vec3 *beta, float eta_scale, int depth, lf_sample_stream *st)
-{
-    float m = lf_maxc(lf_scale(*beta, eta_scale));
-    if (m < 1.f && depth > 1) {
-        float q = fmaxf(0.f, 1.f - m);
-        if (lf_sample_1d(st) < q)
-            return 0;
-        *beta = lf_scale(*beta, 1.f / (1.f - q));
-    } else {
-        lf_sample_skip(st);
-    }
-    return lf_maxc(*beta) > 0;
-}
-
 lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, int medium,
                       lf_sample_stream *st, long long *rays)
 {
@@ -344,7 +329,7 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                     specular_bounce = 0;
                     prev_p = p;
                     o = p;
-                    if (!roulette(&beta, eta_scale, depth, st))
+                    if (!lf_roulette(in, &beta, eta_scale, depth, st))
                         break;
                     continue;
                 }
@@ -400,7 +385,7 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
         medium = medium_after(&h, bs.wi, medium);
         o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
         d = bs.wi;
-        if (!roulette(&beta, eta_scale, depth, st))
+        if (!lf_roulette(in, &beta, eta_scale, depth, st))
             break;
     }
     return L;

@@ -380,6 +380,25 @@ static inline int lf_surface_vertex(const lf_scene *s, lf_light_sampler lsm, lf_
     return specular;
 }
 
+/* Russian roulette on the throughput beta * eta_scale (the integrator's
+ * "russianroulette" rule, docs/scene-format.md): survival probability p,
+ * survivors weighted 1/p, so the estimate stays unbiased for any p > 0.
+ * One 1D sample is drawn or skipped either way.  Returns 0 to end the path. */
+static inline int lf_roulette(const lf_integrator *in, lf_vec3 *beta, float eta_scale, int depth,
+                              lf_sample_stream *st)
+{
+    float m = lf_maxc(lf_scale(*beta, eta_scale));
+    if (m < 1.f && depth > in->rr_depth) {
+        float p = in->rr_rule == LF_RR_SQRT ? sqrtf(m) : m;
+        if (lf_sample_1d(st) >= p)
+            return 0;
+        *beta = lf_scale(*beta, 1.f / p);
+    } else {
+        lf_sample_skip(st);
+    }
+    return lf_maxc(*beta) > 0;
+}
+
 /* The emission of an area light the ray hit. */
 static inline void lf_add_hit_emission(lf_vec3 *L, const lf_scene *s, lf_light_sampler lsm, const lf_hit *h,
                                        lf_vec3 beta, int unweighted, float p_b, lf_vec3 prev_p, lf_vec3 d)

@@ -1,6 +1,6 @@
 /* Light sources with pbrt-v4 parameters and semantics: point, spot,
  * distant, infinite (uniform or equal-area octahedral image) and diffuse
- * area lights on triangles and spheres.  Spectra become linear sRGB; an RGB
+ * area lights on triangles, parallelograms (quads of two triangles) and spheres.  Spectra become linear sRGB; an RGB
  * light of "scale" 1 renders its RGB values (pbrt-v4 divides lights by the
  * photometric value of their illuminant, which is 1 for RGB illuminants).
  */
@@ -195,31 +195,44 @@ int lf_light_sample_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float ta
         ls->Li = lf_mul(l->L, env_lookup(l->env, (float)u, (float)v));
         return 1;
     }
-    case LF_LIGHT_TRIANGLE: {
+    case LF_LIGHT_TRIANGLE:
+    case LF_LIGHT_PARALLELOGRAM: {
         const lf_mesh *m = &s->meshes[l->mesh];
         int t = l->prim;
         lf_vec3 pa = lf_mesh_vertex_at(m, m->idx[3 * t], tau), pb = lf_mesh_vertex_at(m, m->idx[3 * t + 1], tau),
                 pc = lf_mesh_vertex_at(m, m->idx[3 * t + 2], tau);
-        /* uniform barycentrics (Heitz's low-distortion square-to-triangle) */
-        float b0, b1;
-        if (u0 < u1) {
-            b0 = u0 / 2;
-            b1 = u1 - b0;
-        } else {
-            b1 = u1 / 2;
-            b0 = u0 - b1;
-        }
-        float b2 = 1 - b0 - b1;
-        lf_vec3 q = lf_add(lf_add(lf_scale(pa, b0), lf_scale(pb, b1)), lf_scale(pc, b2));
         lf_vec3 n = lf_normalize(lf_cross(lf_sub(pa, pc), lf_sub(pb, pc)));
-        if (m->N) {
-            lf_vec3 na = lf_mesh_normal_at(m, m->idx[3 * t], tau), nb = lf_mesh_normal_at(m, m->idx[3 * t + 1], tau),
-                    nc = lf_mesh_normal_at(m, m->idx[3 * t + 2], tau);
-            lf_vec3 ns = lf_add(lf_add(lf_scale(na, b0), lf_scale(nb, b1)), lf_scale(nc, b2));
-            if (lf_dot(n, ns) < 0)
+        lf_vec3 q;
+        if (l->kind == LF_LIGHT_PARALLELOGRAM) {
+            /* uniform over the parallelogram (a static mesh without vertex
+             * normals: lf_mesh.light_quads) */
+            lf_vec3 c = lf_mesh_vertex_at(m, l->quad[0], tau);
+            lf_vec3 e1 = lf_sub(lf_mesh_vertex_at(m, l->quad[1], tau), c);
+            lf_vec3 e2 = lf_sub(lf_mesh_vertex_at(m, l->quad[2], tau), c);
+            q = lf_add(c, lf_add(lf_scale(e1, u0), lf_scale(e2, u1)));
+            if (m->flip_normal)
                 n = lf_neg(n);
-        } else if (m->flip_normal) {
-            n = lf_neg(n);
+        } else {
+            /* uniform barycentrics (Heitz's low-distortion square-to-triangle) */
+            float b0, b1;
+            if (u0 < u1) {
+                b0 = u0 / 2;
+                b1 = u1 - b0;
+            } else {
+                b1 = u1 / 2;
+                b0 = u0 - b1;
+            }
+            float b2 = 1 - b0 - b1;
+            q = lf_add(lf_add(lf_scale(pa, b0), lf_scale(pb, b1)), lf_scale(pc, b2));
+            if (m->N) {
+                lf_vec3 na = lf_mesh_normal_at(m, m->idx[3 * t], tau), nb = lf_mesh_normal_at(m, m->idx[3 * t + 1], tau),
+                        nc = lf_mesh_normal_at(m, m->idx[3 * t + 2], tau);
+                lf_vec3 ns = lf_add(lf_add(lf_scale(na, b0), lf_scale(nb, b1)), lf_scale(nc, b2));
+                if (lf_dot(n, ns) < 0)
+                    n = lf_neg(n);
+            } else if (m->flip_normal) {
+                n = lf_neg(n);
+            }
         }
         lf_vec3 d = lf_sub(q, p);
         float d2 = lf_dot(d, d);
@@ -280,7 +293,8 @@ float lf_light_pdf_li(const lf_scene *s, const lf_light *l, lf_vec3 p, lf_vec3 w
         lf_equal_area_sphere_to_square(wl, &u, &v);
         return (float)(lf_distrib2d_pdf(&l->env->distrib, u, v) * LF_INV_4PI);
     }
-    case LF_LIGHT_TRIANGLE: {
+    case LF_LIGHT_TRIANGLE:
+    case LF_LIGHT_PARALLELOGRAM: { /* uniform by area: the same density on either kind */
         float cosl = fabsf(lf_dot(hit->sc.ng, wi));
         lf_vec3 d = lf_sub(hit->sc.p, p);
         float d2 = lf_dot(d, d);
@@ -323,6 +337,7 @@ double lf_light_power(const lf_scene *s, const lf_light *l)
         return 4 * LF_PI * LF_PI * r * r * lum * sum / (double)n;
     }
     case LF_LIGHT_TRIANGLE:
+    case LF_LIGHT_PARALLELOGRAM:
     case LF_LIGHT_SPHERE:
         return LF_PI * (l->twosided ? 2 : 1) * l->area * lum;
     }

@@ -30,6 +30,7 @@ typedef struct lf_mesh {
     float *uv;     /* 2 per vertex, or NULL (pbrt defaults per triangle) */
     int material;
     int light_first;   /* index of the first triangle's light, -1 if not emissive */
+    int light_quads;   /* emissive, and triangles 2k, 2k+1 form parallelogram k: one light each */
     int flip_normal;   /* reverse orientation XOR handedness swap */
     int medium_in, medium_out; /* MediumInterface (lf_scene.media indices, -1 vacuum); LF_MEDIUM_SAME: none */
     int bump;          /* its material has a displacement: hits carry (u,v) derivatives */
@@ -143,6 +144,7 @@ typedef enum lf_light_kind {
     LF_LIGHT_INFINITE_UNIFORM,
     LF_LIGHT_INFINITE_IMAGE,
     LF_LIGHT_TRIANGLE,
+    LF_LIGHT_PARALLELOGRAM, /* two triangles of a static mesh, sampled as one (uniform area) */
     LF_LIGHT_SPHERE
 } lf_light_kind;
 
@@ -159,7 +161,8 @@ typedef struct lf_light {
     lf_vec3 pos;        /* point, spot */
     lf_vec3 dir;        /* spot axis; distant: direction light travels FROM (towards the light) */
     float cos_total, cos_start; /* spot */
-    int mesh, prim;     /* triangle */
+    int mesh, prim;     /* triangle; parallelogram: its first triangle */
+    int quad[3];        /* parallelogram: vertex indices of a corner and of the ends of its two edges */
     int sphere;         /* sphere */
     float area;
     int twosided;

@@ -776,14 +776,16 @@ char *lf_renderer_explain(const lf_renderer *r)
     appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
-    int counts[7] = {0};
+    int counts[LF_LIGHT_SPHERE + 1] = {0};
     for (int i = 0; i < s->n_lights; i++)
         counts[s->lights[i].kind]++;
     lf_light_sampler lsm = lf_light_sampler_for(&r->integrator, s);
     appendf(&b, &len, &cap,
             "lights: %d (point %d, spot %d, distant %d, infinite %d, image infinite %d, area triangles %d, area "
-            "spheres %d), %s\n",
-            s->n_lights, counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6],
+            "quads %d, area spheres %d), %s\n",
+            s->n_lights, counts[LF_LIGHT_POINT], counts[LF_LIGHT_SPOT], counts[LF_LIGHT_DISTANT],
+            counts[LF_LIGHT_INFINITE_UNIFORM], counts[LF_LIGHT_INFINITE_IMAGE], counts[LF_LIGHT_TRIANGLE],
+            counts[LF_LIGHT_PARALLELOGRAM], counts[LF_LIGHT_SPHERE],
             lsm == LF_LIGHTS_ALL       ? "every light sampled at every vertex (one shadow ray each)"
             : lsm == LF_LIGHTS_UNIFORM ? "one light per vertex, chosen uniformly"
                                        : "one light per vertex, chosen by power");

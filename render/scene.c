@@ -149,37 +149,93 @@ static void apply_area_power(lf_vec3 *L, const area_emission *ae, double area)
         *L = lf_scale(*L, (float)(ae->power / k_e));
 }
 
+static lf_vec3 mesh_p(const lf_mesh *m, int i) { return lf_v3(m->P[3 * i], m->P[3 * i + 1], m->P[3 * i + 2]); }
+
+/* Twice the area of the triangle a, b, c (vertex indices) or the area of
+ * the parallelogram with corner a and edges to b and c. */
+static float mesh_span(const lf_mesh *m, int a, int b, int c)
+{
+    return lf_length(lf_cross(lf_sub(mesh_p(m, b), mesh_p(m, a)), lf_sub(mesh_p(m, c), mesh_p(m, a))));
+}
+
+/* Whether triangles t and t + 1 of a static mesh form a planar
+ * parallelogram, wound the same way (a quad as pbrt's bilinear patches and
+ * most trianglemesh quads are written): they share one edge, the diagonal
+ * (s0, s1), and the other two vertices x, y satisfy x + y = s0 + s1.  Then
+ * q[0] = x is a corner and q[1] = s0, q[2] = s1 the ends of its edges. */
+static int triangle_pair_parallelogram(const lf_mesh *m, int t, int q[3])
+{
+    const int *A = m->idx + 3 * t, *B = A + 3;
+    int shared[2], ns = 0, x = -1, y = -1;
+    for (int i = 0; i < 3; i++) {
+        int in_b = A[i] == B[0] || A[i] == B[1] || A[i] == B[2];
+        if (in_b && ns < 2)
+            shared[ns++] = A[i];
+        else if (!in_b)
+            x = A[i];
+    }
+    for (int i = 0; i < 3; i++)
+        if (B[i] != A[0] && B[i] != A[1] && B[i] != A[2])
+            y = B[i];
+    if (ns != 2 || x < 0 || y < 0)
+        return 0;
+    lf_vec3 px = mesh_p(m, x), py = mesh_p(m, y), s0 = mesh_p(m, shared[0]), s1 = mesh_p(m, shared[1]);
+    lf_vec3 e1 = lf_sub(s0, px), e2 = lf_sub(s1, px), gap = lf_sub(lf_add(px, py), lf_add(s0, s1));
+    float tol = 1e-5f * (lf_length(e1) + lf_length(e2));
+    if (!(fabsf(gap.x) <= tol && fabsf(gap.y) <= tol && fabsf(gap.z) <= tol))
+        return 0;
+    /* the same winding: both triangles' normals point the same way */
+    lf_vec3 na = lf_cross(lf_sub(mesh_p(m, A[1]), mesh_p(m, A[0])), lf_sub(mesh_p(m, A[2]), mesh_p(m, A[0])));
+    lf_vec3 nb = lf_cross(lf_sub(mesh_p(m, B[1]), mesh_p(m, B[0])), lf_sub(mesh_p(m, B[2]), mesh_p(m, B[0])));
+    if (!(lf_dot(na, nb) > 0) || !(lf_length(lf_cross(e1, e2)) > 0))
+        return 0;
+    q[0] = x, q[1] = shared[0], q[2] = shared[1];
+    return 1;
+}
+
+/* One light per emissive triangle, or per parallelogram when the whole mesh
+ * is static, has no vertex normals and pairs its triangles into
+ * parallelograms: a quad light is then one light, sampled uniformly over
+ * its area, as pbrt-v4 makes one light of a bilinear patch.  Either way the
+ * sum is the same emitter; one light instead of two halves one shadow ray
+ * per vertex where every light is sampled (docs/performance.md). */
 static int add_mesh_lights(builder *b, lf_mesh *m, int area_light)
 {
     m->light_first = -1;
+    m->light_quads = 0;
     if (area_light < 0)
         return 0;
     area_emission ae;
     if (read_area_light(b, area_light, &ae))
         return b->err->code;
     double total_area = 0;
-    for (int t = 0; t < m->n_tris; t++) {
-        const float *p0 = m->P + 3 * m->idx[3 * t], *p1 = m->P + 3 * m->idx[3 * t + 1], *p2 = m->P + 3 * m->idx[3 * t + 2];
-        lf_vec3 e1 = lf_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]);
-        lf_vec3 e2 = lf_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]);
-        total_area += 0.5 * lf_length(lf_cross(e1, e2));
-    }
+    for (int t = 0; t < m->n_tris; t++)
+        total_area += 0.5 * mesh_span(m, m->idx[3 * t], m->idx[3 * t + 1], m->idx[3 * t + 2]);
     lf_vec3 L = ae.L;
     apply_area_power(&L, &ae, total_area);
+    int quads = m->n_keys == 1 && !m->N && m->n_tris % 2 == 0 && m->n_tris > 0;
+    for (int t = 0; quads && t < m->n_tris; t += 2) {
+        int q[3];
+        quads = triangle_pair_parallelogram(m, t, q);
+    }
     m->light_first = b->s->n_lights;
+    m->light_quads = quads;
     int mesh_index = b->s->n_meshes; /* the mesh is pushed right after this */
-    for (int t = 0; t < m->n_tris; t++) {
-        const float *p0 = m->P + 3 * m->idx[3 * t], *p1 = m->P + 3 * m->idx[3 * t + 1], *p2 = m->P + 3 * m->idx[3 * t + 2];
-        lf_vec3 e1 = lf_v3(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]);
-        lf_vec3 e2 = lf_v3(p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]);
+    for (int t = 0; t < m->n_tris; t += quads ? 2 : 1) {
         lf_light l = {0};
-        l.kind = LF_LIGHT_TRIANGLE;
         l.L = L;
         l.mesh = mesh_index;
         l.prim = t;
-        l.area = 0.5f * lf_length(lf_cross(e1, e2));
         l.twosided = ae.twosided;
         l.sphere = -1;
+        if (quads) {
+            triangle_pair_parallelogram(m, t, l.quad);
+            l.kind = LF_LIGHT_PARALLELOGRAM;
+            l.area = mesh_span(m, l.quad[0], l.quad[1], l.quad[2]);
+        } else {
+            l.kind = LF_LIGHT_TRIANGLE;
+            l.area = 0.5f * mesh_span(m, m->idx[3 * t], m->idx[3 * t + 1], m->idx[3 * t + 2]);
+        }
         if (push_light(b, &l))
             return b->err->code;
     }
@@ -1654,7 +1710,7 @@ static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 
     }
     sc->ng = n;
     hit->material = m->material;
-    hit->light = m->light_first >= 0 ? m->light_first + t : -1;
+    hit->light = m->light_first >= 0 ? m->light_first + (m->light_quads ? t >> 1 : t) : -1;
     hit->medium_in = m->medium_in;
     hit->medium_out = m->medium_out;
 }

@@ -135,6 +135,7 @@ typedef struct lf_motion_pair {
     double theta, cos_theta, sin_theta;
     int lerp;              /* nearly parallel: normalised lerp, as lf_decomposed_matrix */
     double sa[3][3], sb[3][3], ta[3], tb[3];
+    int same_scale;        /* sa == sb: no scale lerp */
 } lf_motion_pair;
 void lf_motion_pair_prepare(const lf_decomposed *a, const lf_decomposed *b, lf_motion_pair *p);
 /* Equals lf_decomposed_matrix(a, b, f, m) up to rounding (1e-15). */

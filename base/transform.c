@@ -393,35 +393,58 @@ void lf_motion_pair_prepare(const lf_decomposed *a, const lf_decomposed *b, lf_m
     p->sin_theta = sin(p->theta);
     memcpy(p->sa, a->s, sizeof p->sa);
     memcpy(p->sb, b->s, sizeof p->sb);
+    p->same_scale = !memcmp(p->sa, p->sb, sizeof p->sa);
     memcpy(p->ta, a->t, sizeof p->ta);
     memcpy(p->tb, b->t, sizeof p->tb);
 }
 
 void lf_motion_pair_matrix(const lf_motion_pair *p, double f, double m[4][4])
 {
+    /* Called per camera ray of a moving camera: written out on locals (the
+     * output cannot alias the keys then, so nothing is reloaded), the
+     * scale lerp skipped when both keys share it, and the slerp's sine and
+     * cosine by series where the angle allows (lf_sincos_quarter). */
     double wa = 1 - f, wb = f;
     if (!p->lerp) {
         /* sin((1-f) th) = sin th cos(f th) - cos th sin(f th) */
-        double sf = sin(f * p->theta), cf = cos(f * p->theta);
+        double x = f * p->theta, sf, cf;
+        if (fabs(x) <= M_PI / 4)
+            lf_sincos_quarter(x, &sf, &cf);
+        else
+            sf = sin(x), cf = cos(x);
         wa = (p->sin_theta * cf - p->cos_theta * sf) / p->sin_theta;
         wb = sf / p->sin_theta;
     }
-    double q[4];
-    for (int i = 0; i < 4; i++)
-        q[i] = wa * p->qa[i] + wb * p->qb[i];
-    double il = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (int i = 0; i < 4; i++)
-        q[i] *= il;
-    double R[3][3], S[3][3];
-    matrix_from_quat(q, R);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            S[i][j] = (1 - f) * p->sa[i][j] + f * p->sb[i][j];
-    for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++)
-            m[i][j] = R[i][0] * S[0][j] + R[i][1] * S[1][j] + R[i][2] * S[2][j];
-        m[i][3] = (1 - f) * p->ta[i] + f * p->tb[i];
+    double x = wa * p->qa[0] + wb * p->qb[0], y = wa * p->qa[1] + wb * p->qb[1];
+    double z = wa * p->qa[2] + wb * p->qb[2], w = wa * p->qa[3] + wb * p->qb[3];
+    double il = 1.0 / sqrt(x * x + y * y + z * z + w * w);
+    x *= il, y *= il, z *= il, w *= il;
+    /* the rotation, as matrix_from_quat */
+    double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                      {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                      {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    double Sl[3][3];
+    const double(*S)[3] = p->sa;
+    if (!p->same_scale) {
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                Sl[i][j] = (1 - f) * p->sa[i][j] + f * p->sb[i][j];
+        S = (const double(*)[3])Sl;
     }
+    double s00 = S[0][0], s01 = S[0][1], s02 = S[0][2], s10 = S[1][0], s11 = S[1][1], s12 = S[1][2];
+    double s20 = S[2][0], s21 = S[2][1], s22 = S[2][2];
+    double t0 = (1 - f) * p->ta[0] + f * p->tb[0], t1 = (1 - f) * p->ta[1] + f * p->tb[1];
+    double t2 = (1 - f) * p->ta[2] + f * p->tb[2];
+    m[0][0] = R[0][0] * s00 + R[0][1] * s10 + R[0][2] * s20;
+    m[0][1] = R[0][0] * s01 + R[0][1] * s11 + R[0][2] * s21;
+    m[0][2] = R[0][0] * s02 + R[0][1] * s12 + R[0][2] * s22;
+    m[1][0] = R[1][0] * s00 + R[1][1] * s10 + R[1][2] * s20;
+    m[1][1] = R[1][0] * s01 + R[1][1] * s11 + R[1][2] * s21;
+    m[1][2] = R[1][0] * s02 + R[1][1] * s12 + R[1][2] * s22;
+    m[2][0] = R[2][0] * s00 + R[2][1] * s10 + R[2][2] * s20;
+    m[2][1] = R[2][0] * s01 + R[2][1] * s11 + R[2][2] * s21;
+    m[2][2] = R[2][0] * s02 + R[2][1] * s12 + R[2][2] * s22;
+    m[0][3] = t0, m[1][3] = t1, m[2][3] = t2;
     m[3][0] = m[3][1] = m[3][2] = 0, m[3][3] = 1;
 }
 

@@ -863,10 +863,12 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
         c2w = &moving;
     }
     /* Rays from the camera's centre (pinhole, fisheye) start at its world
-     * position, computed once (the same numbers as transforming 0). */
-    lf_dvec3 o = !r->camera_moving && cr->origin[0] == 0 && cr->origin[1] == 0 && cr->origin[2] == 0
-                     ? r->camera_origin_world
-                     : lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
+     * position: computed once for a still camera, the translation column of
+     * a moving one's matrix (the same numbers as transforming 0). */
+    int centre = cr->origin[0] == 0 && cr->origin[1] == 0 && cr->origin[2] == 0;
+    lf_dvec3 o = centre && !r->camera_moving ? r->camera_origin_world
+                 : centre ? (lf_dvec3){moving.m[0][3], moving.m[1][3], moving.m[2][3]} /* M (0,0,0,1): exact */
+                          : lf_xform_point_d(c2w, (lf_dvec3){cr->origin[0], cr->origin[1], cr->origin[2]});
     lf_dvec3 d = lf_xform_vector_d(c2w, (lf_dvec3){cr->dir[0], cr->dir[1], cr->dir[2]});
     double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
     lf_vec3 of = lf_v3((float)o.x, (float)o.y, (float)o.z);

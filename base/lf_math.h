@@ -141,6 +141,31 @@ void lf_motion_pair_prepare(const lf_decomposed *a, const lf_decomposed *b, lf_m
 /* Equals lf_decomposed_matrix(a, b, f, m) up to rounding (1e-15). */
 void lf_motion_pair_matrix(const lf_motion_pair *p, double f, double m[4][4]);
 
+/* A motion pair tabulated for evaluation per camera ray: the 3x4 matrix at
+ * n + 1 evenly spaced times, lerped between them.  n is chosen so that the
+ * lerp departs from lf_motion_pair_matrix by at most max_err (the lerp's
+ * error is at most |M''| / (8 n^2), with |M''| bounded by the rotation's
+ * angle and the scale's change); 0 from lf_motion_table_init (no table)
+ * when that would take more than max_n steps. */
+typedef struct lf_motion_table {
+    int n;
+    double (*m)[12];       /* n + 1 rows of a 3x4 matrix */
+} lf_motion_table;
+int lf_motion_table_init(const lf_motion_pair *p, double max_err, int max_n, lf_motion_table *t);
+void lf_motion_table_free(lf_motion_table *t);
+static inline void lf_motion_table_matrix(const lf_motion_table *t, double f, double m[4][4])
+{
+    double x = f * t->n;
+    int k = (int)x;
+    k = k < 0 ? 0 : (k >= t->n ? t->n - 1 : k);
+    double w = x - k;
+    const double *a = t->m[k], *b = t->m[k + 1];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            m[i][j] = a[4 * i + j] + w * (b[4 * i + j] - a[4 * i + j]);
+    m[3][0] = m[3][1] = m[3][2] = 0, m[3][3] = 1;
+}
+
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif

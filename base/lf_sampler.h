@@ -115,6 +115,9 @@ static inline void lf_sample_skip(lf_sample_stream *st)
 }
 /* The same as doubles, for camera coordinates. */
 void lf_sample_2d_d(lf_sample_stream *st, double *u0, double *u1);
+/* The first value of lf_sample_2d_d's pair (the same dimensions consumed),
+ * without computing the second. */
+double lf_sample_1d_d(lf_sample_stream *st);
 
 /* Hash helpers shared by anything that needs decorrelated seeds (inline:
  * several run for every sample dimension pair). */

@@ -171,6 +171,22 @@ static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
     }
 }
 
+/* The first value of the next pair, the second not computed where that
+ * saves work: the Sobol sampler's 1D value needs only the first Sobol
+ * dimension of the pair (the same bits sample_pair's a would be). */
+static uint32_t sample_first(lf_sample_stream *st)
+{
+    if (st->s->kind == LF_SAMPLER_SOBOL) {
+        uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
+        st->dim += 2;
+        uint32_t i = reverse_bits(lk_permute(st->rindex, h));
+        return reverse_bits(lk_permute(i, seed_a(h)));
+    }
+    uint32_t a, b;
+    sample_pair(st, &a, &b);
+    return a;
+}
+
 float lf_sample_1d(lf_sample_stream *st)
 {
     if (st->s->kind == LF_SAMPLER_PMJ02BN && st->dim > 0) {
@@ -182,17 +198,10 @@ float lf_sample_1d(lf_sample_stream *st)
         float f = (float)((k + (lf_hash_u32(h ^ 0x51ed270bu) >> 8) * 0x1p-24) / n);
         return f < 0x1.fffffep-1f ? f : 0x1.fffffep-1f;
     }
-    if (st->s->kind == LF_SAMPLER_SOBOL) {
-        /* a 1D value needs only the first Sobol dimension of the pair */
-        uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
-        st->dim += 2;
-        uint32_t i = reverse_bits(lk_permute(st->rindex, h));
-        return to_unit(reverse_bits(lk_permute(i, seed_a(h))));
-    }
-    uint32_t a, b;
-    sample_pair(st, &a, &b);
-    return to_unit(a);
+    return to_unit(sample_first(st));
 }
+
+double lf_sample_1d_d(lf_sample_stream *st) { return (sample_first(st) + 0.5) * 0x1p-32; }
 
 void lf_sample_2d(lf_sample_stream *st, float *u0, float *u1)
 {

@@ -1,5 +1,6 @@
 #include "lf_math.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 lf_transform lf_transform_identity(void)
@@ -446,6 +447,50 @@ void lf_motion_pair_matrix(const lf_motion_pair *p, double f, double m[4][4])
     m[2][2] = R[2][0] * s02 + R[2][1] * s12 + R[2][2] * s22;
     m[0][3] = t0, m[1][3] = t1, m[2][3] = t2;
     m[3][0] = m[3][1] = m[3][2] = 0, m[3][3] = 1;
+}
+
+int lf_motion_table_init(const lf_motion_pair *p, double max_err, int max_n, lf_motion_table *t)
+{
+    t->n = 0;
+    t->m = NULL;
+    /* |M''| <= (2 theta)^2 |S| + 2 (2 theta) |dS| (rotation by 2 theta over
+     * f in [0, 1] at constant rate; nlerp'd pairs are within 1e-3 rad of
+     * that), taken with a factor 2 of margin; scales are bounded by their
+     * largest entry */
+    double smax = 0, ds = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            smax = fmax(smax, fmax(fabs(p->sa[i][j]), fabs(p->sb[i][j])));
+            ds = fmax(ds, fabs(p->sb[i][j] - p->sa[i][j]));
+        }
+    double rot = 2 * p->theta;
+    double d2 = 2 * 3 * (rot * rot * smax + 2 * rot * ds); /* 3: a row sums three entries */
+    double n = ceil(sqrt(d2 / (8 * max_err)));
+    if (n < 1)
+        n = 1;
+    if (!(n <= max_n))
+        return 0;
+    t->n = (int)n;
+    t->m = malloc(sizeof *t->m * (size_t)(t->n + 1));
+    if (!t->m) {
+        t->n = 0;
+        return 0;
+    }
+    for (int k = 0; k <= t->n; k++) {
+        double m[4][4];
+        lf_motion_pair_matrix(p, (double)k / t->n, m);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 4; j++)
+                t->m[k][4 * i + j] = m[i][j];
+    }
+    return 1;
+}
+
+void lf_motion_table_free(lf_motion_table *t)
+{
+    free(t->m);
+    t->m = NULL;
+    t->n = 0;
 }
 
 lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decomposed *b, double f)

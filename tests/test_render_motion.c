@@ -702,9 +702,9 @@ static void test_object_instance_streaks(void)
 static void test_motion_pair(void)
 {
     const double angles[] = {0.01, 3, 30, 120, 179.9, 250};
-    double worst = 0, worst_rot = 0;
+    double worst = 0, worst_rot = 0, worst_table = 0;
     for (int a = 0; a < 6; a++) {
-        for (int variant = 0; variant < 3; variant++) {
+        for (int variant = 0; variant < 4; variant++) {
             lf_transform x0 = lf_transform_translate(1, -2, 3), x1;
             lf_transform r = lf_transform_rotate(angles[a], 0.3, 1, -0.2);
             lf_transform t = lf_transform_translate(-4, 0.5, 2);
@@ -716,6 +716,9 @@ static void test_motion_pair(void)
             } else if (variant == 2) { /* mirrored */
                 lf_transform sc = lf_transform_scale(-1, 1, 1);
                 x0 = lf_transform_compose(&x0, &sc);
+                x1 = lf_transform_compose(&x1, &sc);
+            } else if (variant == 3) { /* a scale that changes */
+                lf_transform sc = lf_transform_scale(1.5, 0.8, 1);
                 x1 = lf_transform_compose(&x1, &sc);
             }
             lf_decomposed da, db;
@@ -739,9 +742,33 @@ static void test_motion_pair(void)
                             worst_rot = fmax(worst_rot, fabs(m2[i][j] - rf.m[i][j]));
                 }
             }
+            /* the table the renderer lerps in: within its bound of the
+             * exact matrices, between its rows too (997 times, prime) */
+            lf_motion_table tb;
+            CHECK(lf_motion_table_init(&mp, 1e-9, 1 << 22, &tb) == 1 && tb.n >= 1);
+            for (int k = 0; k <= 997 && tb.m; k++) {
+                double m1[4][4], m2[4][4];
+                lf_motion_pair_matrix(&mp, k / 997.0, m1);
+                lf_motion_table_matrix(&tb, k / 997.0, m2);
+                for (int i = 0; i < 4; i++)
+                    for (int j = 0; j < 4; j++)
+                        worst_table = fmax(worst_table, fabs(m1[i][j] - m2[i][j]));
+            }
+            lf_motion_table_free(&tb);
         }
     }
     CHECK_MSG(worst < 1e-13, "prepared interpolation differs from lf_decomposed_matrix by %g", worst);
+    CHECK_MSG(worst_table <= 1e-9, "the motion table departs from the exact matrices by %g (bound 1e-9)", worst_table);
+    /* the table is the exact matrices when it must: too many steps, none */
+    {
+        lf_decomposed da, db;
+        lf_transform x0 = lf_transform_identity(), x1 = lf_transform_rotate(170, 0, 1, 0);
+        CHECK(lf_transform_decompose(&x0, &da) == 0 && lf_transform_decompose(&x1, &db) == 0);
+        lf_motion_pair mp;
+        lf_motion_pair_prepare(&da, &db, &mp);
+        lf_motion_table tb;
+        CHECK(lf_motion_table_init(&mp, 1e-9, 100, &tb) == 0 && tb.n == 0 && !tb.m);
+    }
     CHECK_MSG(worst_rot < 1e-12, "slerp differs from the rotation by the same fraction by %g", worst_rot);
 }
 

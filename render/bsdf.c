@@ -32,7 +32,7 @@ void lf_bsdf_frame(lf_bsdf *b, const lf_shading_ctx *ctx)
     b->kind = LF_LOBE_NONE;
 }
 
-static lf_vec3 to_local(const lf_bsdf *b, lf_vec3 v) { return lf_v3(lf_dot(v, b->s), lf_dot(v, b->t), lf_dot(v, b->n)); }
+static inline lf_vec3 to_local(const lf_bsdf *b, lf_vec3 v) { return lf_v3(lf_dot(v, b->s), lf_dot(v, b->t), lf_dot(v, b->n)); }
 
 static lf_vec3 to_world(const lf_bsdf *b, lf_vec3 v)
 {

@@ -47,6 +47,7 @@ typedef struct lf_sphere {
     int flip_normal;
     int medium_in, medium_out; /* as lf_mesh */
     int bump;                  /* as lf_mesh */
+    int textured;              /* its material reads textures: hits need pbrt's (u,v) */
 } lf_sphere;
 
 /* A shape whose MediumInterface does not change the medium (none given,
@@ -272,7 +273,18 @@ int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float
 /* Fills hit->sc.uv for sphere hits (deferred: only textured materials read it). */
 void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit);
 /* Origin offset off a surface to avoid self-intersection, on the side of w. */
-lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w);
+static inline lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w)
+{
+    /* Float error of an intersection point grows with its magnitude; a few
+     * ulps of the largest coordinate (plus an absolute floor) clears it.
+     * (Selects, not fmaxf: the coordinates are finite, and fmaxf's NaN
+     * rule makes it a libm call.) */
+    float ax = fabsf(p.x), ay = fabsf(p.y), az = fabsf(p.z);
+    float m = ax > ay ? ax : ay;
+    m = m > az ? m : az;
+    float eps = 1e-6f + m * 4e-6f;
+    return lf_madd(p, ng, lf_dot(ng, w) >= 0 ? eps : -eps);
+}
 
 /* ---- ground-truth disparity of light-field cameras (render/disparity.c) ---- */
 typedef struct lf_disparity_geom {
@@ -369,7 +381,7 @@ static inline void lf_add_escaped_light(lf_vec3 *L, const lf_scene *s, lf_light_
 static inline int lf_surface_vertex(const lf_scene *s, lf_light_sampler lsm, lf_hit *h, const lf_material *mat,
                                     lf_sample_stream *st, lf_bsdf *bsdf, float *ul, float *uc)
 {
-    if (h->sphere >= 0 && lf_material_uses_textures(mat))
+    if (h->sphere >= 0 && s->spheres[h->sphere].textured)
         lf_scene_sphere_uv(s, h);
     lf_material_bsdf(mat, &h->sc, bsdf);
     int specular = lf_bsdf_is_specular(bsdf);

@@ -575,6 +575,7 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
         sp.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
         sp.light = -1;
         sp.bump = lf_material_bumps(lf_materials_get(b->s->materials, sh->material));
+        sp.textured = lf_material_uses_textures(lf_materials_get(b->s->materials, sh->material));
         if (shape_media(b, sh, &sp.medium_in, &sp.medium_out)) {
             free(sp.centers);
             return b->err->code;
@@ -1510,15 +1511,6 @@ void lf_scene_free(lf_scene *s)
 }
 
 /* ---- intersection ---- */
-
-lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w)
-{
-    /* Float error of an intersection point grows with its magnitude; a few
-     * ulps of the largest coordinate (plus an absolute floor) clears it. */
-    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
-    float eps = 1e-6f + m * 4e-6f;
-    return lf_madd(p, ng, lf_dot(ng, w) >= 0 ? eps : -eps);
-}
 
 static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax, float tau)
 {

@@ -118,6 +118,11 @@ void lf_sample_2d_d(lf_sample_stream *st, double *u0, double *u1);
 /* The first value of lf_sample_2d_d's pair (the same dimensions consumed),
  * without computing the second. */
 double lf_sample_1d_d(lf_sample_stream *st);
+/* Three values drawn jointly, in two pair slots: with the Sobol sampler
+ * the first three dimensions of one Owen-scrambled Sobol point (stratified
+ * together, e.g. film position and time for motion blur), else a pair and
+ * the first value of the next. */
+void lf_sample_3d_d(lf_sample_stream *st, double *u0, double *u1, double *u2);
 
 /* Hash helpers shared by anything that needs decorrelated seeds (inline:
  * several run for every sample dimension pair). */

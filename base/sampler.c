@@ -32,8 +32,20 @@ static inline uint32_t lk_permute(uint32_t x, uint32_t seed)
  * Dimension 1 is linear over GF(2) in the index bits, so it is evaluated a
  * byte at a time from four 256-entry tables; the tables hold the
  * bit-reversed values, which is the form the Owen scramble consumes. */
-static uint32_t sobol1_rev_table[4][256];
+static uint32_t sobol1_rev_table[4][256], sobol2_rev_table[4][256];
 static pthread_once_t sobol_once = PTHREAD_ONCE_INIT;
+
+static void sobol_table(const uint32_t v[32], uint32_t table[4][256])
+{
+    for (int byte = 0; byte < 4; byte++)
+        for (int b = 0; b < 256; b++) {
+            uint32_t x = 0;
+            for (int k = 0; k < 8; k++)
+                if (b & (1 << k))
+                    x ^= v[8 * byte + k];
+            table[byte][b] = reverse_bits(x);
+        }
+}
 
 static void sobol_tables_init(void)
 {
@@ -41,14 +53,21 @@ static void sobol_tables_init(void)
     v[0] = 0x80000000u;
     for (int k = 1; k < 32; k++)
         v[k] = v[k - 1] ^ (v[k - 1] >> 1);
-    for (int byte = 0; byte < 4; byte++)
-        for (int b = 0; b < 256; b++) {
-            uint32_t x = 0;
-            for (int k = 0; k < 8; k++)
-                if (b & (1 << k))
-                    x ^= v[8 * byte + k];
-            sobol1_rev_table[byte][b] = reverse_bits(x);
-        }
+    sobol_table(v, sobol1_rev_table);
+    /* Dimension 2 (Joe and Kuo's third): primitive polynomial x^2 + x + 1,
+     * m_1 = 1, m_2 = 3, m_k = 2 m_{k-1} ^ 4 m_{k-2} ^ m_{k-2}; as 32-bit
+     * direction numbers v_k = m_k 2^(32-k): v_k = v_{k-1} ^ v_{k-2} ^ v_{k-2} >> 2
+     * (0x80000000, 0xc0000000, 0x60000000, 0x90000000, 0xe8000000, ...). */
+    v[0] = 0x80000000u, v[1] = 0xc0000000u;
+    for (int k = 2; k < 32; k++)
+        v[k] = v[k - 1] ^ v[k - 2] ^ (v[k - 2] >> 2);
+    sobol_table(v, sobol2_rev_table);
+}
+
+static inline uint32_t sobol2_rev(uint32_t i)
+{
+    return sobol2_rev_table[0][i & 0xffu] ^ sobol2_rev_table[1][(i >> 8) & 0xffu] ^
+           sobol2_rev_table[2][(i >> 16) & 0xffu] ^ sobol2_rev_table[3][i >> 24];
 }
 
 /* reverse_bits(sobol dimension 1 of index i) */
@@ -74,6 +93,10 @@ static inline uint32_t seed_a(uint32_t h)
 static inline uint32_t seed_b(uint32_t h)
 {
     return h * 0x297a2d39u + 0xb5297a4du;
+}
+static inline uint32_t seed_c(uint32_t h)
+{
+    return h * 0x7feb352du + 0x846ca68bu;
 }
 
 static uint64_t halton_pixel_index(const lf_sampler *s, int px, int py, uint32_t index);
@@ -202,6 +225,28 @@ float lf_sample_1d(lf_sample_stream *st)
 }
 
 double lf_sample_1d_d(lf_sample_stream *st) { return (sample_first(st) + 0.5) * 0x1p-32; }
+
+void lf_sample_3d_d(lf_sample_stream *st, double *u0, double *u1, double *u2)
+{
+    uint32_t a, b, c;
+    if (st->s->kind == LF_SAMPLER_SOBOL) {
+        /* the first three Sobol dimensions of one shuffled index, each
+         * Owen-scrambled on its own: jointly a (1, m, 3)-net over any 2^m
+         * consecutive samples of the pixel; the second pair slot is unused */
+        uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
+        st->dim += 4;
+        uint32_t i = reverse_bits(lk_permute(st->rindex, h));
+        a = reverse_bits(lk_permute(i, seed_a(h)));
+        b = reverse_bits(lk_permute(sobol1_rev(i), seed_b(h)));
+        c = reverse_bits(lk_permute(sobol2_rev(i), seed_c(h)));
+    } else {
+        sample_pair(st, &a, &b);
+        c = sample_first(st);
+    }
+    *u0 = (a + 0.5) * 0x1p-32;
+    *u1 = (b + 0.5) * 0x1p-32;
+    *u2 = (c + 0.5) * 0x1p-32;
+}
 
 void lf_sample_2d(lf_sample_stream *st, float *u0, float *u1)
 {

@@ -942,8 +942,14 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
         lf_camera_sample *c = &cs[nb];
         p->pixel = pixel;
         lf_sample_start_pixel(&p->st, &r->sampler, pixel_hash, x, y, (uint32_t)i++);
-        double fu, fv, dx, dy;
-        lf_sample_2d_d(&p->st, &fu, &fv);
+        /* Film position and time are drawn together (lf_sample_3d_d): motion
+         * blur integrates over both at once, so their joint stratification
+         * pays where separate draws would only stratify each alone. */
+        double fu, fv, ut = 0, dx, dy;
+        if (r->time_needed)
+            lf_sample_3d_d(&p->st, &fu, &fv, &ut);
+        else
+            lf_sample_2d_d(&p->st, &fu, &fv);
         p->fw = lf_filter_sample(&r->filter, fu, fv, &dx, &dy);
         c->film_x = x + 0.5 + dx;
         c->film_y = y + 0.5 + dy;
@@ -953,7 +959,7 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
         p->tau = 0;
         c->time = r->shutter_open;
         if (r->time_needed) {
-            c->time = shutter_time(r, lf_sample_1d_d(&p->st), c->film_x, c->film_y);
+            c->time = shutter_time(r, ut, c->film_x, c->film_y);
             double tau = r->time1 > r->time0 ? (c->time - r->time0) / (r->time1 - r->time0) : 0;
             p->tau = tau < 0 ? 0 : (tau > 1 ? 1 : tau); /* Embree asserts 0 <= time <= 1 */
         }

@@ -56,6 +56,65 @@ static void test_sobol_stratification(void)
     CHECK(is_02_net(x, y, 4));
 }
 
+/* A (t,m,3)-net in base 2: every elementary box of volume 2^(t-m), of
+ * every shape 2^-a x 2^-b x 2^-c (a + b + c = m - t), holds exactly 2^t of
+ * the 2^m points. */
+static int is_t3_net(const double *x, const double *y, const double *z, int m, int t)
+{
+    int n = 1 << m, ok = 1;
+    int *count = malloc(sizeof(int) * n);
+    for (int a = 0; a <= m - t; a++)
+        for (int b = 0; a + b <= m - t; b++) {
+            int c = m - t - a - b, na = 1 << a, nb = 1 << b, nc = 1 << c, boxes = na * nb * nc;
+            memset(count, 0, sizeof(int) * boxes);
+            for (int i = 0; i < n; i++)
+                count[((int)(z[i] * nc) * nb + (int)(y[i] * nb)) * na + (int)(x[i] * na)]++;
+            for (int k = 0; k < boxes; k++)
+                ok &= count[k] == 1 << t;
+        }
+    free(count);
+    return ok;
+}
+
+/* lf_sample_3d_d (film position and time drawn together): the first three
+ * Sobol dimensions, which form a (1,m,3)-net (Joe and Kuo's t-value for
+ * three dimensions), each coordinate a (0,m,1)-net, over each pixel's 2^m
+ * samples and after it; two pair slots consumed. */
+static void test_sobol_3d(void)
+{
+    lf_sampler s = {LF_SAMPLER_SOBOL, 11, 64, 0, 0};
+    double x[64], y[64], z[64];
+    for (int px = 0; px < 4; px++) {
+        int ok = 1, layout = 1;
+        for (int i = 0; i < 64; i++) {
+            lf_sample_stream st, st2;
+            lf_sample_start(&st, &s, px, 2 * px + 5, (uint32_t)i);
+            st2 = st;
+            lf_sample_3d_d(&st, &x[i], &y[i], &z[i]);
+            ok &= x[i] > 0 && x[i] < 1 && y[i] > 0 && y[i] < 1 && z[i] > 0 && z[i] < 1;
+            /* the next pair is the third slot's */
+            float a, b, a2, b2;
+            lf_sample_skip(&st2);
+            lf_sample_skip(&st2);
+            lf_sample_2d(&st, &a, &b);
+            lf_sample_2d(&st2, &a2, &b2);
+            layout &= a == a2 && b == b2;
+        }
+        CHECK_MSG(ok, "pixel %d: a value outside (0, 1)", px);
+        CHECK_MSG(layout, "pixel %d: lf_sample_3d_d does not take exactly two pair slots", px);
+        CHECK_MSG(is_t3_net(x, y, z, 6, 1), "pixel %d: (u0, u1, u2) is not a (1,6,3)-net", px);
+        /* and the check can fail: Sobol's first three dimensions are no (0,m,3)-net */
+        CHECK_MSG(is_t3_net(x, y, z, 6, 0) == 0, "pixel %d: unexpectedly a (0,6,3)-net", px);
+        for (int d = 0; d < 3; d++) {
+            const double *u = d == 0 ? x : d == 1 ? y : z;
+            int seen[64] = {0}, strat = 1;
+            for (int i = 0; i < 64; i++)
+                strat &= !seen[(int)(u[i] * 64)]++;
+            CHECK_MSG(strat, "pixel %d: coordinate %d is not stratified over 64 samples", px, d);
+        }
+    }
+}
+
 static void test_stratified(void)
 {
     lf_sampler s = {LF_SAMPLER_STRATIFIED, 1, 12, 4, 3};
@@ -327,6 +386,7 @@ static void test_pmj02bn(void)
 int main(void)
 {
     test_sobol_stratification();
+    test_sobol_3d();
     test_stratified();
     test_independent_moments();
     test_determinism();

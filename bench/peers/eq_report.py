@@ -5,7 +5,8 @@ stdin; plain Python, no numpy).
 Input lines, tab-separated:
   rung  CASE RENDERER SPP TIME_S RMS REF_MEAN REF_SPP   (one per ladder rung)
   cross CASE RENDERER_A RENDERER_B REL_RMSE            (references compared)
-  meta  TARGET                                          (the common rel. RMSE)
+  meta  TARGET [W H]                                    (the common rel. RMSE;
+                                                        the image size)
 
 For each rung the relative error is e = RMS / REF_MEAN (RMS over all pixels
 and the R, G, B channels, from idiff; REF_MEAN the reference's mean over the
@@ -22,6 +23,9 @@ Fits, per case and renderer, over the ladder:
   log N between the two rungs that bracket X (or from the nearest two,
   marked *, when X lies outside the ladder);
   efficiency 1/(e^2 t) per rung (constant if e^2 ~ 1/t).
+The summary also shows what explains each ratio: the error per sample (e at
+the rung nearest 64 spp) and the camera paths per second of the fitted cost
+per sample, W H / b (with W H from the meta line).
 """
 import math
 import sys
@@ -44,6 +48,7 @@ def main():
     rungs = OrderedDict()
     cross = []
     target = 0.02
+    pixels = None
     for line in sys.stdin:
         f = line.rstrip("\n").split("\t")
         if f[0] == "rung":
@@ -55,6 +60,8 @@ def main():
             cross.append((f[1], f[2], f[3], float(f[4])))
         elif f[0] == "meta":
             target = float(f[1])
+            if len(f) >= 4:
+                pixels = int(f[2]) * int(f[3])
 
     print("| case | renderer | spp | time s | rel. RMSE | 1/(RMSE^2 t) |")
     print("|---|---|---|---|---|---|")
@@ -76,9 +83,11 @@ def main():
             y0, y1 = math.log(es2[seg]), math.log(es2[seg + 1])
             n_x = math.exp(x0 + (lx - y0) * (x1 - x0) / (y1 - y0)) if y1 < y0 else float("inf")
             top = pts[-1]
+            mid = min(pts, key=lambda p: abs(math.log(p[0] / 64)))
             fits.setdefault(case, OrderedDict())[r] = dict(
                 slope=k, n_x=n_x, t_x=t0 + b * n_x, extrapolated=not (ns[0] <= n_x <= ns[-1]),
-                eff_top=1 / (top[2] ** 2 * top[1]))
+                eff_top=1 / (top[2] ** 2 * top[1]), e_mid=mid[2], n_mid=mid[0],
+                mpaths=pixels / b / 1e6 if pixels else None)
     print()
     peers = [r for r in ("cy", "pbrt") if any(r in f for f in fits.values())]
     hdr = f"| case | lensfield: spp, s to rel. RMSE {target:g} | 1/(RMSE^2 t) at top rung |"
@@ -104,6 +113,37 @@ def main():
         row += " " + ", ".join(f"{NAMES.get(r, r)} {f['slope']:.2f}" for r, f in fr.items()) + " |"
         print(row)
     print("(* extrapolated: outside the ladder's range of spp)")
+    print()
+    print("What explains each ratio: error per sample and cost per sample")
+    print()
+    hdr, sep = "| case | spp | lensfield rel. RMSE |", "|---|---|---|"
+    for r in peers:
+        hdr += f" {NAMES[r]} rel. RMSE | lensfield error / {NAMES[r]} error |"
+        sep += "---|---|"
+    if pixels:
+        hdr += " lensfield M paths/s |"
+        sep += "---|"
+        for r in peers:
+            hdr += f" {NAMES[r]} M paths/s | lensfield / {NAMES[r]} paths/s |"
+            sep += "---|---|"
+    print(hdr)
+    print(sep)
+    for case, fr in fits.items():
+        lf = fr.get("lf")
+        if not lf:
+            continue
+        row = f"| {case} | {lf['n_mid']} | {lf['e_mid']:.4f} |"
+        for r in peers:
+            f = fr.get(r)
+            row += f" {f['e_mid']:.4f} | {lf['e_mid'] / f['e_mid']:.2f} |" if f else " — | — |"
+        if pixels:
+            row += f" {lf['mpaths']:.2f} |"
+            for r in peers:
+                f = fr.get(r)
+                row += f" {f['mpaths']:.2f} | {lf['mpaths'] / f['mpaths']:.2f} |" if f else " — | — |"
+        print(row)
+    if pixels:
+        print("(paths/s from the fitted cost per sample over the ladder, start-up and BVH build excluded)")
     if cross:
         print()
         print("References side by side (each divided by its own mean): relative RMSE between them")

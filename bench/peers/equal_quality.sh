@@ -63,7 +63,7 @@ render() { # RENDERER CASE SCENE SPP SEED OUT
     esac
 }
 
-echo "meta	$target" >> "$tsv"
+echo "meta	$target	$w	$h" >> "$tsv"
 for c in "${cases[@]}"; do
     src=$(scene_of "$c")
     [ -f "$src" ] || { echo "no scene $src for case $c" >&2; exit 1; }

@@ -232,7 +232,10 @@ void lf_sample_3d_d(lf_sample_stream *st, double *u0, double *u1, double *u2)
     if (st->s->kind == LF_SAMPLER_SOBOL) {
         /* the first three Sobol dimensions of one shuffled index, each
          * Owen-scrambled on its own: jointly a (1, m, 3)-net over any 2^m
-         * consecutive samples of the pixel; the second pair slot is unused */
+         * consecutive samples of the pixel, while (u0, u1) stays a
+         * (0, m, 2)-net and u2 a (0, m, 1)-net as separate draws would be
+         * (a fourth dimension would make the lens pair (2, 3) a (1, m, 2)-net,
+         * a loss for it: not done); the second pair slot is unused */
         uint32_t h = lf_hash_combine(st->pixel_hash, st->dim >> 1);
         st->dim += 4;
         uint32_t i = reverse_bits(lk_permute(st->rindex, h));

@@ -69,7 +69,8 @@ static lf_vec3 sample_cosine(float u0, float u1)
 {
     float r = sqrtf(u0), phi = 2.f * PI_F * u1;
     float x = r * cosf(phi), y = r * sinf(phi);
-    return lf_v3(x, y, sqrtf(fmaxf(0.f, 1.f - x * x - y * y)));
+    float z2 = 1.f - x * x - y * y; /* a select, not fmaxf (a libm call) */
+    return lf_v3(x, y, sqrtf(z2 > 0.f ? z2 : 0.f));
 }
 
 /* ---------------------------------------------------------- Fresnel */

@@ -123,13 +123,9 @@ static int find_interval(const double *cdf, int n, double target, double *frac)
     return lo;
 }
 
-double lf_filter_sample(const lf_filter *f, double u0, double u1, double *dx, double *dy)
+/* The tabulated filters: a cell by the tabulated |f|, uniform within it. */
+double lf_filter_sample_table(const lf_filter *f, double u0, double u1, double *dx, double *dy)
 {
-    if (f->kind == LF_FILTER_BOX) {
-        *dx = (2 * u0 - 1) * f->radius[0];
-        *dy = (2 * u1 - 1) * f->radius[1];
-        return 1.0;
-    }
     double fy, fx;
     int j = find_interval(f->cdf_row, f->ny, u1 * f->cdf_row[f->ny], &fy);
     const double *cc = f->cdf_col + (size_t)j * (f->nx + 1);

@@ -50,8 +50,18 @@ typedef struct lf_filter_params {
 int lf_filter_init(lf_filter *f, lf_filter_kind kind, const lf_filter_params *p, lf_error *err);
 void lf_filter_free(lf_filter *f);
 double lf_filter_eval(const lf_filter *f, double x, double y);
-/* Maps u in [0,1)^2 to an offset (dx, dy) from the pixel centre; returns the weight. */
-double lf_filter_sample(const lf_filter *f, double u0, double u1, double *dx, double *dy);
+/* Maps u in [0,1)^2 to an offset (dx, dy) from the pixel centre; returns the
+ * weight.  The box (uniform offsets, weight 1) inline: it runs per camera ray. */
+double lf_filter_sample_table(const lf_filter *f, double u0, double u1, double *dx, double *dy);
+static inline double lf_filter_sample(const lf_filter *f, double u0, double u1, double *dx, double *dy)
+{
+    if (f->kind == LF_FILTER_BOX) {
+        *dx = (2 * u0 - 1) * f->radius[0];
+        *dy = (2 * u1 - 1) * f->radius[1];
+        return 1.0;
+    }
+    return lf_filter_sample_table(f, u0, u1, dx, dy);
+}
 
 #ifdef __cplusplus
 }

@@ -15,13 +15,6 @@
 #include "render_internal.h"
 
 
-lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s)
-{
-    if (in->light_sampler == LF_LIGHTS_AUTO)
-        return s->n_nee_lights <= LF_LIGHTS_ALL_MAX ? LF_LIGHTS_ALL : LF_LIGHTS_POWER;
-    return in->light_sampler;
-}
-
 double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
 {
     if (s->lights[light].kind == LF_LIGHT_INFINITE_UNIFORM)

@@ -328,7 +328,12 @@ typedef struct lf_integrator {
 } lf_integrator;
 
 /* The strategy in effect for a scene (AUTO resolved by its light count). */
-lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s);
+static inline lf_light_sampler lf_light_sampler_for(const lf_integrator *in, const lf_scene *s)
+{
+    if (in->light_sampler == LF_LIGHTS_AUTO)
+        return s->n_nee_lights <= LF_LIGHTS_ALL_MAX ? LF_LIGHTS_ALL : LF_LIGHTS_POWER;
+    return in->light_sampler;
+}
 
 /* Radiance along a world-space camera ray. rays counts traced rays. */
 lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
@@ -384,7 +389,7 @@ static inline int lf_surface_vertex(const lf_scene *s, lf_light_sampler lsm, lf_
     if (h->sphere >= 0 && s->spheres[h->sphere].textured)
         lf_scene_sphere_uv(s, h);
     lf_material_bsdf(mat, &h->sc, bsdf);
-    int specular = lf_bsdf_is_specular(bsdf);
+    int specular = bsdf->kind != LF_LOBE_DIFFUSE && lf_bsdf_is_specular(bsdf); /* diffuse: never, without a call */
     int need_light_choice = !specular && s->n_nee_lights > 1 && lsm != LF_LIGHTS_ALL;
     int need_lobe_choice = bsdf->kind != LF_LOBE_DIFFUSE;
     *ul = *uc = 0.5f;

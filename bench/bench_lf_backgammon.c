@@ -356,8 +356,8 @@ int main(int argc, char **argv)
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
                     if (getenv("LFD_VERBOSE")) {
                         /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
-                        double se[2] = {0, 0};
-                        size_t nn[2] = {0, 0};
+                        double se[2] = {0, 0}, sb[2][12] = {{0}};
+                        size_t nn[2] = {0, 0}, nb[2][12] = {{0}};
                         const float *tv = lf_lf_view(&lf, c, r);
                         for (int y = 15; y < out.height - 15; y++)
                             for (int x = 15; x < out.width - 15; x++) {
@@ -371,11 +371,21 @@ int main(int argc, char **argv)
                                     size_t q = ((size_t)y * out.width + x) * 3 + ch;
                                     double e = (double)lf_srgb_encode(out.data[q]) - lf_srgb_encode(tv[q]);
                                     se[edge] += e * e, nn[edge]++;
+                                    int bi = (int)floor((g / 2 + 2) / 0.25);
+                                    bi = bi < 0 ? 0 : (bi > 11 ? 11 : bi);
+                                    sb[edge][bi] += e * e, nb[edge][bi]++;
                                 }
                             }
                         printf("  view r%d c%d: %.2f dB (away from edges %.2f dB, near edges %.2f dB, %.1f %% of pixels)\n",
                                r, c, p, 10 * log10(65025.0 * nn[0] / se[0]), 10 * log10(65025.0 * nn[1] / se[1]),
                                100.0 * nn[1] / (nn[0] + nn[1]));
+                        if (r == 3 && c == 3)
+                            for (int bi = 0; bi < 12; bi++)
+                                if (nb[0][bi] + nb[1][bi] > 300)
+                                    printf("    d/step %5.2f..%5.2f: away %6.2f dB (%5.1f %%) near %6.2f dB (%5.1f %%)\n",
+                                           -2 + 0.25 * bi, -1.75 + 0.25 * bi,
+                                           10 * log10(65025.0 * nb[0][bi] / (sb[0][bi] + 1e-9)), 100.0 * nb[0][bi] / (nn[0] + nn[1]),
+                                           10 * log10(65025.0 * nb[1][bi] / (sb[1][bi] + 1e-9)), 100.0 * nb[1][bi] / (nn[0] + nn[1]));
                     }
                     if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
                         lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);

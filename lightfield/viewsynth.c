@@ -132,7 +132,7 @@ static void sample(const float *img, int w, int h, double x, double y, float rgb
     rgb[0] = a[0], rgb[1] = a[1], rgb[2] = a[2];
 }
 
-#define VS_MAXSRC 16
+#define VS_MAXSRC 81
 
 typedef struct vs_ctx {
     const lf_lightfield *lf;
@@ -143,18 +143,161 @@ typedef struct vs_ctx {
     double ox[VS_MAXSRC], oy[VS_MAXSRC]; /* source minus target pixel offset (calibrated views) */
     const float *dt, *ct; /* target disparity, confidence */
     const float *ds[VS_MAXSRC];   /* source views' warped disparity */
+    const float *dx[VS_MAXSRC];   /* the same, largest over 3 x 3 (a pixel next to a nearer surface may mix it in) */
     double phase0;        /* resampling-phase weight floor (<= 0: phase ignored) */
     const float *plane;   /* plane blend, RGB */
     float cmin;
     float *out;
+    int mode;      /* experiment: 0 bicubic blend, 1 scattered fit */
+    double sigma;  /* kernel width (px) of the scattered fit */
+    int order;     /* polynomial order of the scattered fit */
+    double qmax;
 } vs_ctx;
 
-/* Colour of target pixel (x, y) at disparity d from the sources: visible
- * sources (their own warped disparity is not clearly nearer) weighted by
- * angular distance; returns the weighted colour variance across them (a
- * photo-consistency score), or -1 when no source sees the point. */
+/* Solve the n x n system A x = b in place (Gaussian elimination, partial
+ * pivoting), 4 right-hand sides.  Returns 0 when (nearly) singular. */
+static int solve4(double *A, double (*b)[4], int n)
+{
+    for (int i = 0; i < n; i++) {
+        int p = i;
+        for (int r = i + 1; r < n; r++)
+            if (fabs(A[r * n + i]) > fabs(A[p * n + i]))
+                p = r;
+        if (fabs(A[p * n + i]) < 1e-12)
+            return 0;
+        if (p != i) {
+            for (int k = 0; k < n; k++) {
+                double t = A[i * n + k];
+                A[i * n + k] = A[p * n + k], A[p * n + k] = t;
+            }
+            for (int ch = 0; ch < 4; ch++) {
+                double t = b[i][ch];
+                b[i][ch] = b[p][ch], b[p][ch] = t;
+            }
+        }
+        for (int r = i + 1; r < n; r++) {
+            double f = A[r * n + i] / A[i * n + i];
+            for (int k = i; k < n; k++)
+                A[r * n + k] -= f * A[i * n + k];
+            for (int ch = 0; ch < 4; ch++)
+                b[r][ch] -= f * b[i][ch];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--)
+        for (int ch = 0; ch < 4; ch++) {
+            double t = b[i][ch];
+            for (int k = i + 1; k < n; k++)
+                t -= A[i * n + k] * b[k][ch];
+            b[i][ch] = t / A[i * n + i];
+        }
+    return 1;
+}
+
+/* Scattered-data fit at kernel width sigma: every pixel of every visible
+ * source lands, via d, at an offset from the target pixel centre; a
+ * Gaussian-weighted least-squares quadratic in the offset gives the value
+ * at the centre.  Returns the variance gain of that value, wsum (A^-1)_00
+ * (1 for a plain mean; large when the samples do not pin the centre down),
+ * or -1 when nothing is seen; *res the weighted residual (photo-consistency). */
+static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, float rgb[3], double *seen,
+                        double *res)
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    const int nb = c->order == 0 ? 1 : (c->order == 1 ? 3 : 6);
+    double A[36] = {0}, b[6][4] = {{0}}, wsum = 0, sq = 0;
+    double is2 = 1.0 / (2 * sigma * sigma);
+    double r2max = 9 * sigma * sigma;
+    int rad = (int)ceil(3 * sigma);
+    float dtol = d + 0.25f + 0.05f * fabsf(d);
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = x - d * c->du[k] + c->ox[k], sy = y - d * c->dv[k] + c->oy[k];
+        if (sx < -0.5 || sy < -0.5 || sx > w - 0.5 || sy > h - 0.5)
+            continue;
+        float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
+        if (dk > d + 0.25f + 0.05f * fabsf(d))
+            continue;
+        const float *img = lf_lf_view(c->lf, c->iu[k], c->iv[k]);
+        int xc = (int)lrint(sx), yc = (int)lrint(sy);
+        for (int j = yc - rad; j <= yc + rad; j++) {
+            if (j < 0 || j >= h)
+                continue;
+            double ey = j - sy;
+            for (int i = xc - rad; i <= xc + rad; i++) {
+                if (i < 0 || i >= w)
+                    continue;
+                double ex = i - sx, r2 = ex * ex + ey * ey;
+                if (r2 > r2max)
+                    continue;
+                if (c->dx[k][(size_t)j * w + i] > dtol)
+                    continue;
+                double wk = c->wv[k] * exp(-r2 * is2);
+                double f[6] = {1, ex, ey, ex * ex, ex * ey, ey * ey};
+                const float *p = img + ((size_t)j * w + i) * 3;
+                for (int a = 0; a < nb; a++) {
+                    double wf = wk * f[a];
+                    for (int bb = a; bb < nb; bb++)
+                        A[a * nb + bb] += wf * f[bb];
+                    b[a][0] += wf * p[0], b[a][1] += wf * p[1], b[a][2] += wf * p[2];
+                }
+                wsum += wk;
+                sq += wk * ((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+            }
+        }
+    }
+    *seen = wsum;
+    if (wsum <= 1e-6)
+        return -1;
+    for (int a = 0; a < nb; a++)
+        for (int bb = 0; bb < a; bb++)
+            A[a * nb + bb] = A[bb * nb + a];
+    double rhs[6][3];
+    for (int a = 0; a < nb; a++)
+        rhs[a][0] = b[a][0], rhs[a][1] = b[a][1], rhs[a][2] = b[a][2];
+    /* a little ridge on the higher terms keeps degenerate layouts finite */
+    for (int a = 1; a < nb; a++)
+        A[a * nb + a] += 1e-4 * wsum;
+    for (int a = 0; a < nb; a++)
+        b[a][3] = a == 0;
+    if (!solve4(A, b, nb)) {
+        for (int ch = 0; ch < 3; ch++)
+            rgb[ch] = (float)(rhs[0][ch] / wsum);
+        *res = 0;
+        return 1e30;
+    }
+    double cb = 0;
+    for (int a = 0; a < nb; a++)
+        cb += b[a][0] * rhs[a][0] + b[a][1] * rhs[a][1] + b[a][2] * rhs[a][2];
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = (float)b[0][ch];
+    double r = (sq - cb) / wsum;
+    *res = r > 0 ? r : 0;
+    return wsum * b[0][3];
+}
+
+/* The fit at the smallest kernel whose centre value is well determined. */
+static double fit_at(const vs_ctx *c, int x, int y, float d, float rgb[3], double *seen)
+{
+    static const double sig[4] = {0.35, 0.5, 0.7, 1.0};
+    double res = 0, s2;
+    for (int q = 0; q < 4; q++) {
+        double sg = c->sigma * sig[q] / 0.35;
+        double g = fit_sigma(c, x, y, d, sg, rgb, seen, &res);
+        if (g < 0)
+            return -1;
+        if (g <= c->qmax || q == 3)
+            break;
+    }
+    (void)s2;
+    return res;
+}
+
 static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], float all[3], double *seen)
 {
+    if (c->mode == 1) {
+        double v = fit_at(c, x, y, d, rgb, seen);
+        if (v >= 0)
+            return v;
+    }
     int w = c->lf->ns, h = c->lf->nt;
     double acc[3] = {0, 0, 0}, sq = 0, wsum = 0, acc_all[3] = {0, 0, 0}, wall = 0;
     for (int k = 0; k < c->nsrc; k++) {
@@ -292,7 +435,11 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     /* sources: the views within a tent of radius R view steps around the
      * target (R = 1: the 4 nearest, bilinear weights; R = 2: up to 16) */
     double R = o->radius > 0 ? o->radius : 2.0;
+    if (getenv("LFV_R"))
+        R = atof(getenv("LFV_R"));
     c.phase0 = o->phase_floor < 0 ? 0.05 : o->phase_floor;
+    if (getenv("LFV_P0"))
+        c.phase0 = atof(getenv("LFV_P0"));
     int rr = (int)ceil(R - 1e-9);
     double st[4]; /* the target's (su, sv, ox, oy) */
     lf_lf_view_shift(lf, fu, fv, st);
@@ -310,7 +457,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
             c.ox[c.nsrc] = sk[2] - st[2], c.oy[c.nsrc] = sk[3] - st[3];
             c.nsrc++;
         }
-    float *buf = malloc(sizeof(float) * np * (2 + (size_t)c.nsrc));
+    float *buf = malloc(sizeof(float) * np * (2 + 2 * (size_t)c.nsrc));
     lf_image plane = {0};
     if (!buf) {
         lf_image_free(&disp), lf_image_free(&conf);
@@ -324,6 +471,18 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         lf_lf_view_shift(lf, c.iu[k], c.iv[k], sk);
         splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
         c.ds[k] = dk;
+        float *dxk = buf + (2 + (size_t)c.nsrc + k) * np;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                float m = -FLT_MAX;
+                for (int j = -1; j <= 1; j++)
+                    for (int i = -1; i <= 1; i++) {
+                        float v = dk[(size_t)clampi(y + j, 0, h - 1) * w + clampi(x + i, 0, w - 1)];
+                        m = v > m ? v : m;
+                    }
+                dxk[(size_t)y * w + x] = m;
+            }
+        c.dx[k] = dxk;
     }
     c.dt = dt, c.ct = ct;
     c.cmin = o->min_confidence < 0 ? 0.05f : (float)o->min_confidence;
@@ -332,6 +491,10 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         return rc ? rc : LF_ERR_NOMEM;
     }
     c.plane = plane.data;
+    c.mode = getenv("LFV_MODE") ? atoi(getenv("LFV_MODE")) : 0;
+    c.sigma = getenv("LFV_SIGMA") ? atof(getenv("LFV_SIGMA")) : 0.35;
+    c.qmax = getenv("LFV_Q") ? atof(getenv("LFV_Q")) : 4;
+    c.order = getenv("LFV_ORDER") ? atoi(getenv("LFV_ORDER")) : 2;
     c.out = out->data;
     lf_parallel_for(h, o->threads, 8, vs_rows, &c);
     free(buf), lf_image_free(&plane), lf_image_free(&disp), lf_image_free(&conf);

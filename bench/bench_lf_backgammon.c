@@ -356,17 +356,22 @@ int main(int argc, char **argv)
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
                     if (getenv("LFD_VERBOSE")) {
                         /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
-                        double se[2] = {0, 0}, sb[2][12] = {{0}};
+                        double se[2] = {0, 0}, sb[2][12] = {{0}}, sdist[2][6] = {{0}};
+                        size_t ndist[2][6] = {{0}};
                         size_t nn[2] = {0, 0}, nb[2][12] = {{0}};
                         const float *tv = lf_lf_view(&lf, c, r);
                         for (int y = 15; y < out.height - 15; y++)
                             for (int x = 15; x < out.width - 15; x++) {
                                 float g = sd.data[(size_t)y * out.width + x];
-                                int edge = 0;
-                                for (int j = -4; j <= 4 && !edge; j++)
+                                int edge = 0, dist = 5, nearer = 0;
+                                for (int j = -4; j <= 4; j++)
                                     for (int i = -4; i <= 4; i++)
-                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f)
+                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f) {
+                                            int dd = abs(i) > abs(j) ? abs(i) : abs(j);
                                             edge = 1;
+                                            dist = dd < dist ? dd : dist;
+                                            nearer |= sd.data[(size_t)(y + j) * out.width + x + i] < g;
+                                        }
                                 for (int ch = 0; ch < 3; ch++) {
                                     size_t q = ((size_t)y * out.width + x) * 3 + ch;
                                     double e = (double)lf_srgb_encode(out.data[q]) - lf_srgb_encode(tv[q]);
@@ -374,11 +379,19 @@ int main(int argc, char **argv)
                                     int bi = (int)floor((g / 2 + 2) / 0.25);
                                     bi = bi < 0 ? 0 : (bi > 11 ? 11 : bi);
                                     sb[edge][bi] += e * e, nb[edge][bi]++;
+                                    sdist[nearer][dist] += e * e, ndist[nearer][dist]++;
                                 }
                             }
                         printf("  view r%d c%d: %.2f dB (away from edges %.2f dB, near edges %.2f dB, %.1f %% of pixels)\n",
                                r, c, p, 10 * log10(65025.0 * nn[0] / se[0]), 10 * log10(65025.0 * nn[1] / se[1]),
                                100.0 * nn[1] / (nn[0] + nn[1]));
+                        if (r == 3 && c == 3)
+                            for (int q = 0; q < 2; q++)
+                                for (int dd = 1; dd <= (q ? 4 : 5); dd++)
+                                    printf("    %s side of an edge %d px away: %.2f dB (%.1f %% of pixels)\n",
+                                           q ? "nearer" : "farther", dd,
+                                           10 * log10(65025.0 * ndist[q][dd] / (sdist[q][dd] + 1e-9)),
+                                           100.0 * ndist[q][dd] / (nn[0] + nn[1]));
                         if (r == 3 && c == 3)
                             for (int bi = 0; bi < 12; bi++)
                                 if (nb[0][bi] + nb[1][bi] > 300)

@@ -132,7 +132,7 @@ static void sample(const float *img, int w, int h, double x, double y, float rgb
     rgb[0] = a[0], rgb[1] = a[1], rgb[2] = a[2];
 }
 
-#define VS_MAXSRC 81
+#define VS_MAXSRC 64
 
 typedef struct vs_ctx {
     const lf_lightfield *lf;
@@ -148,10 +148,8 @@ typedef struct vs_ctx {
     const float *plane;   /* plane blend, RGB */
     float cmin;
     float *out;
-    int mode;      /* experiment: 0 bicubic blend, 1 scattered fit */
-    double sigma;  /* kernel width (px) of the scattered fit */
-    int order;     /* polynomial order of the scattered fit */
-    double qmax;
+    int blend;     /* 1: bicubic blend (phase-weighted); 0: scattered-data fit */
+    double sigma;  /* Gaussian kernel of the fit, px */
 } vs_ctx;
 
 /* Solve the n x n system A x = b in place (Gaussian elimination, partial
@@ -203,8 +201,9 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
                         double *res)
 {
     int w = c->lf->ns, h = c->lf->nt;
-    const int nb = c->order == 0 ? 1 : (c->order == 1 ? 3 : 6);
+    enum { nb = 6 }; /* 1, x, y, x^2, xy, y^2 */
     double A[36] = {0}, b[6][4] = {{0}}, wsum = 0, sq = 0;
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     double is2 = 1.0 / (2 * sigma * sigma);
     double r2max = 9 * sigma * sigma;
     int rad = (int)ceil(3 * sigma);
@@ -241,6 +240,11 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
                 }
                 wsum += wk;
                 sq += wk * ((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+                if (r2 <= 1)
+                    for (int ch = 0; ch < 3; ch++) {
+                        lo[ch] = p[ch] < lo[ch] ? p[ch] : lo[ch];
+                        hi[ch] = p[ch] > hi[ch] ? p[ch] : hi[ch];
+                    }
             }
         }
     }
@@ -267,33 +271,46 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
     double cb = 0;
     for (int a = 0; a < nb; a++)
         cb += b[a][0] * rhs[a][0] + b[a][1] * rhs[a][1] + b[a][2] * rhs[a][2];
-    for (int ch = 0; ch < 3; ch++)
+    for (int ch = 0; ch < 3; ch++) {
         rgb[ch] = (float)b[0][ch];
+        /* never outside the samples within 1 px: bounds what noise or an
+         * ill-placed sample can do to an extrapolating fit */
+        if (lo[ch] <= hi[ch])
+            rgb[ch] = rgb[ch] < lo[ch] ? lo[ch] : (rgb[ch] > hi[ch] ? hi[ch] : rgb[ch]);
+    }
     double r = (sq - cb) / wsum;
     *res = r > 0 ? r : 0;
     return wsum * b[0][3];
 }
 
-/* The fit at the smallest kernel whose centre value is well determined. */
+/* The fit at the smallest kernel whose centre value the samples pin down:
+ * where every source lands at the same phase (e.g. all half a pixel off)
+ * a narrow quadratic is undetermined (variance gain of the centre value
+ * over a plain weighted mean above 1e4), and a wider kernel makes it an
+ * interpolation over the neighbours. */
 static double fit_at(const vs_ctx *c, int x, int y, float d, float rgb[3], double *seen)
 {
-    static const double sig[4] = {0.35, 0.5, 0.7, 1.0};
-    double res = 0, s2;
+    static const double scale[4] = {1.0, 1.43, 2.0, 2.86};
+    double res = 0;
     for (int q = 0; q < 4; q++) {
-        double sg = c->sigma * sig[q] / 0.35;
-        double g = fit_sigma(c, x, y, d, sg, rgb, seen, &res);
+        double g = fit_sigma(c, x, y, d, c->sigma * scale[q], rgb, seen, &res);
         if (g < 0)
             return -1;
-        if (g <= c->qmax || q == 3)
+        if (g <= 1e4)
             break;
     }
-    (void)s2;
     return res;
 }
 
+/* Colour of target pixel (x, y) at disparity d from the sources that see
+ * it: the scattered-data fit, or (blend) the bicubic lookups of the
+ * visible sources weighted by angular distance and resampling phase.
+ * Returns a photo-consistency score (the fit's weighted residual, or the
+ * weighted colour variance across the sources), -1 when no source sees
+ * the point (rgb then the blend of all sources). */
 static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], float all[3], double *seen)
 {
-    if (c->mode == 1) {
+    if (!c->blend) {
         double v = fit_at(c, x, y, d, rgb, seen);
         if (v >= 0)
             return v;
@@ -433,13 +450,13 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     memset(&c, 0, sizeof c);
     c.lf = lf;
     /* sources: the views within a tent of radius R view steps around the
-     * target (R = 1: the 4 nearest, bilinear weights; R = 2: up to 16) */
-    double R = o->radius > 0 ? o->radius : 2.0;
-    if (getenv("LFV_R"))
-        R = atof(getenv("LFV_R"));
+     * target (R = 1: the 4 nearest, bilinear weights; R = 3: up to 36;
+     * at most 4: 64) */
+    c.blend = o->blend;
+    c.sigma = o->kernel > 0 ? o->kernel : 0.35;
+    double R = o->radius > 0 ? o->radius : (o->blend ? 2.0 : 3.0);
+    R = R > 4 ? 4 : R;
     c.phase0 = o->phase_floor < 0 ? 0.05 : o->phase_floor;
-    if (getenv("LFV_P0"))
-        c.phase0 = atof(getenv("LFV_P0"));
     int rr = (int)ceil(R - 1e-9);
     double st[4]; /* the target's (su, sv, ox, oy) */
     lf_lf_view_shift(lf, fu, fv, st);
@@ -491,10 +508,6 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         return rc ? rc : LF_ERR_NOMEM;
     }
     c.plane = plane.data;
-    c.mode = getenv("LFV_MODE") ? atoi(getenv("LFV_MODE")) : 0;
-    c.sigma = getenv("LFV_SIGMA") ? atof(getenv("LFV_SIGMA")) : 0.35;
-    c.qmax = getenv("LFV_Q") ? atof(getenv("LFV_Q")) : 4;
-    c.order = getenv("LFV_ORDER") ? atoi(getenv("LFV_ORDER")) : 2;
     c.out = out->data;
     lf_parallel_for(h, o->threads, 8, vs_rows, &c);
     free(buf), lf_image_free(&plane), lf_image_free(&disp), lf_image_free(&conf);

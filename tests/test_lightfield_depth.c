@@ -350,13 +350,18 @@ int main(void)
      * to 0.42 cycles/px: view (iu, iv) is T(x + d du, y + d dv), du, dv the
      * offsets from the centre view.  At (0.5, 0.5) the 4 nearest views sit
      * 1/3 px off the target's pixel grid (interpolated), the next ring at
-     * 1.5 views lands exactly on it (shift 1 px).  Phase weighting leans on
-     * the exact samples: with the default tent (radius 2) and floor 0.05 the
-     * weights of the 16 views are, per view, 4 x 0.56/(4/9+0.05) (both axes
-     * off the grid), 8 x 0.19/(2/9+0.05) (one axis) and 4 x 0.06/0.05 (none),
-     * so at most half of the weight carries an interpolation error (6 dB):
-     * asserted with half that margin against the 4 nearest views without
-     * phase weights. */
+     * 1.5 views lands exactly on it (shift 1 px).
+     * Bicubic blend (blend = 1): phase weighting leans on the exact samples:
+     * with the tent of radius 2 and floor 0.05 the weights of the 16 views
+     * are, per view, 4 x 0.56/(4/9+0.05) (both axes off the grid),
+     * 8 x 0.19/(2/9+0.05) (one axis) and 4 x 0.06/0.05 (none), so at most
+     * half of the weight carries an interpolation error (6 dB): asserted with
+     * half that margin against the 4 nearest views without phase weights.
+     * Scattered-data fit (default): the views within 3 steps put samples at
+     * offsets 0, 1/3 and 2/3 px in both axes around every target pixel,
+     * three times the grid's sampling rate, so the texture (below the
+     * single grid's Nyquist limit but not below the fit's) is reconstructed
+     * from exact samples at the centre: asserted 3 dB above the blend. */
     {
         enum { N4 = 7 };
         const double d4 = 2.0 / 3.0;
@@ -383,15 +388,21 @@ int main(void)
         lf_lf_view_opts po = lf_lf_view_defaults();
         po.disparity = &dm;
         CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+        double p_fit = psnr(view.data, truth, 8);
+        lf_image_free(&view);
+        po.blend = 1;
+        CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
         double p_phase = psnr(view.data, truth, 8);
         lf_image_free(&view);
         po.radius = 1, po.phase_floor = 0;
         CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
         double p_near4 = psnr(view.data, truth, 8);
         lf_image_free(&view);
-        printf("resampling phase, plane d = 2/3, view (0.5, 0.5): 16 views phase-weighted %.2f dB, 4 nearest %.2f dB\n",
-               p_phase, p_near4);
+        printf("resampling phase, plane d = 2/3, view (0.5, 0.5): scattered-data fit %.2f dB; blend: 16 views "
+               "phase-weighted %.2f dB, 4 nearest %.2f dB\n",
+               p_fit, p_phase, p_near4);
         CHECK(p_phase > p_near4 + 3);
+        CHECK(p_fit > p_phase + 3);
         lf_image_free(&dm);
         lf_lf_free(&pl);
     }

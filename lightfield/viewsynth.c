@@ -6,13 +6,20 @@
  *    the nearest surface (largest disparity) wins; holes (disocclusions)
  *    take the farthest disparity around them, as the background is what
  *    appears there.
- * 2. Every target pixel is looked up (bicubic) in the views within a tent
- *    of radius 2 view steps (up to 16), weighted by the tent in (u, v) and
- *    by the resampling phase (sources whose pixel grid lands near the
- *    target pixel centre need less interpolation); a view whose own warped
- *    disparity there is clearly nearer sees an occluder and drops out.
- * 3. Near depth edges the nearest disparity within a pixel is primary and
- *    the others compete by photo-consistency (soft weights).
+ * 2. Scattered-data fit (default): every pixel of every view within a tent
+ *    of radius 3 view steps lands, via the target pixel's disparity, at a
+ *    sub-pixel offset from the target pixel centre; views at other
+ *    viewpoints land at other phases, so together they sample the
+ *    (pixel-integrated) image more densely than one grid.  A Gaussian-
+ *    weighted (sigma 0.35 px) quadratic fit to the samples gives the value
+ *    at the centre; a sample whose own warped disparity, or a neighbour's,
+ *    is clearly nearer sees (part of) an occluder and drops out.  Blend
+ *    (blend = 1): bicubic lookups in the views within 2 view steps weighted
+ *    by the tent and the resampling phase.
+ * 3. Near depth edges the nearest disparity within a pixel is primary; with
+ *    the fit, the outline's mixed pixels are unmixed against the parallax-
+ *    shifted backgrounds (two_layer); with the blend, the candidates compete
+ *    by photo-consistency (soft weights).
  * 4. Where the splatted confidence is low the result fades to the plane
  *    blend at plane_disparity (lf_lf_view_at). */
 #include <float.h>
@@ -360,6 +367,84 @@ static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], flo
     return var > 0 ? var : 0;
 }
 
+/* Background colour at target position (xf, yf) on the surface at
+ * disparity db: bicubic lookups in the sources that see it clear of
+ * nearer surfaces (within a pixel), weighted by angular distance.
+ * Returns 0 when no source sees it. */
+static int bg_at(const vs_ctx *c, double xf, double yf, float db, float rgb[3])
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    double acc[3] = {0, 0, 0}, wsum = 0;
+    float tol = db + 0.25f + 0.05f * fabsf(db);
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = xf - db * c->du[k] + c->ox[k], sy = yf - db * c->dv[k] + c->oy[k];
+        if (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1)
+            continue;
+        if (c->dx[k][(size_t)lrint(sy) * w + lrint(sx)] > tol)
+            continue;
+        float col[3];
+        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
+        for (int ch = 0; ch < 3; ch++)
+            acc[ch] += c->wv[k] * col[ch];
+        wsum += c->wv[k];
+    }
+    if (wsum <= 1e-9)
+        return 0;
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = (float)(acc[ch] / wsum);
+    return 1;
+}
+
+/* Two layers at a depth edge: the views' pixels on the nearer surface's
+ * outline (disparity df) mix its colour F with whatever lies behind by a
+ * coverage alpha that travels with the outline, I_k = alpha F + (1 - alpha)
+ * B_k, while the background behind (disparity db) differs from view to
+ * view by parallax.  With B_k looked up where the views see the background
+ * clear, least squares over the views gives 1 - alpha = Cov(B, I) / Var(B)
+ * (multi-background matting, as triangulation matting with backgrounds
+ * that parallax provides) and the target pixel is
+ * I_fit + (1 - alpha) (B_t - mean(B)): ifit the scattered-data fit at df
+ * (which averages the views' mixes), B_t the target's own background.
+ * Returns 0 when fewer than 3 views constrain it. */
+static int two_layer(const vs_ctx *c, int x, int y, float df, float db, const float bt[3], const float ifit[3],
+                     float rgb[3])
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    double W = 0, sI[3] = {0, 0, 0}, sB[3] = {0, 0, 0}, sBI = 0, sBB = 0;
+    float tol = df + 0.25f + 0.05f * fabsf(df);
+    int n = 0;
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = x - df * c->du[k] + c->ox[k], sy = y - df * c->dv[k] + c->oy[k];
+        if (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1)
+            continue;
+        if (c->ds[k][(size_t)lrint(sy) * w + lrint(sx)] > tol)
+            continue;
+        float I[3], B[3];
+        if (!bg_at(c, x - (df - db) * c->du[k], y - (df - db) * c->dv[k], db, B))
+            continue;
+        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, I);
+        double wk = c->wv[k];
+        for (int ch = 0; ch < 3; ch++) {
+            sI[ch] += wk * I[ch], sB[ch] += wk * B[ch];
+            sBI += wk * (double)B[ch] * I[ch], sBB += wk * (double)B[ch] * B[ch];
+        }
+        W += wk, n++;
+    }
+    if (n < 3)
+        return 0;
+    double cov = sBI / W, var = sBB / W;
+    for (int ch = 0; ch < 3; ch++)
+        cov -= sB[ch] * sI[ch] / (W * W), var -= sB[ch] * sB[ch] / (W * W);
+    /* a weak prior (alpha 1/2, worth a colour spread of 0.01) where the
+     * backgrounds hardly differ; then alpha hardly matters either */
+    const double lam = 1e-4;
+    double oma = (cov + lam * 0.5) / (var + lam);
+    oma = oma < 0 ? 0 : (oma > 1 ? 1 : oma);
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = (float)(ifit[ch] + oma * (bt[ch] - sB[ch] / W));
+    return 1;
+}
+
 static void vs_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
@@ -384,7 +469,12 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
             float px[3], all[3];
             double seen, seen2;
             double best = blend_at(c, x, y, d, px, all, &seen);
-            if (dmax - dmin > 0.25f && best >= 0) {
+            float bt[3], tl[3];
+            double sb;
+            if (!c->blend && dmax - dmin > 0.25f && best >= 0 && blend_at(c, x, y, dmin, bt, all, &sb) >= 0 &&
+                two_layer(c, x, y, dmax, dmin, bt, px, tl)) {
+                px[0] = tl[0], px[1] = tl[1], px[2] = tl[2];
+            } else if (dmax - dmin > 0.25f && best >= 0) {
                 /* soft choice: candidates weighted by 1 / (variance + floor);
                  * a mixed edge pixel then gets a mix too */
                 const double floor_v = 1e-4;

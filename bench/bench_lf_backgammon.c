@@ -297,6 +297,27 @@ int main(int argc, char **argv)
         for (int j = 0; j < n5; j++)
             for (int i = 0; i < n5; i++)
                 memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
+        if (getenv("LFD_NOISE")) {
+            /* robustness diagnostic: Gaussian noise of LFD_NOISE 8-bit sRGB levels on the source views
+             * (added in sRGB, fixed seed), scored against the clean held-out views */
+            double sig = atof(getenv("LFD_NOISE")) / 255.0;
+            unsigned long long st = 12345;
+            size_t nv = (size_t)n5 * n5 * lf.ns * lf.nt * 3;
+            for (size_t i = 0; i < nv; i += 2) {
+                double u1, u2;
+                st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                u1 = ((st >> 11) + 0.5) / 9007199254740992.0;
+                st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                u2 = ((st >> 11) + 0.5) / 9007199254740992.0;
+                double r = sqrt(-2 * log(u1)), g[2] = {r * cos(6.283185307179586 * u2), r * sin(6.283185307179586 * u2)};
+                for (int q = 0; q < 2 && i + q < nv; q++) {
+                    float *p = &sub.data[i + q];
+                    double e = lf_srgb_encode(*p) / 255.0 + sig * g[q];
+                    e = e < 0 ? 0 : (e > 1 ? 1 : e);
+                    *p = (float)(e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4));
+                }
+            }
+        }
         lf_image sd = {0}, sc = {0};
         {
             lf_lf_depth_opts o = lf_lf_depth_defaults();
@@ -307,6 +328,20 @@ int main(int argc, char **argv)
                 return 1;
             }
             printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            if (getenv("LFD_VERBOSE")) { /* the 5x5 map (per view step of the 9x9 grid) against the ground truth */
+                char gtp[4096];
+                snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
+                lf_image gt;
+                if (!read_pfm(gtp, &gt)) {
+                    lf_image half = sd;
+                    half.data = malloc(sizeof(float) * sd.width * sd.height);
+                    for (size_t i = 0; i < (size_t)sd.width * sd.height; i++)
+                        half.data[i] = 0.5f * sd.data[i];
+                    score("5x5 depth / 2", &half, &gt, 0);
+                    free(half.data);
+                    lf_image_free(&gt);
+                }
+            }
             if (calibrate) {
                 s = now();
                 if (lf_lf_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
@@ -346,6 +381,7 @@ int main(int argc, char **argv)
                         lf_lf_view_opts vo = lf_lf_view_defaults();
                         vo.threads = threads;
                         vo.disparity = &sd, vo.confidence = &sc;
+                        vo.blend = getenv("LFD_BLEND") && *getenv("LFD_BLEND") == '1'; /* diagnostic: the bicubic blend */
                         rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
                     }
                     secs += now() - s;

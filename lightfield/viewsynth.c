@@ -201,7 +201,7 @@ static int solve4(double *A, double (*b)[4], int n)
 /* Scattered-data fit at kernel width sigma: every pixel of every visible
  * source lands, via d, at an offset from the target pixel centre; a
  * Gaussian-weighted least-squares quadratic in the offset gives the value
- * at the centre.  Returns the variance gain of that value, wsum (A^-1)_00
+ * at the centre (samples marked invalid in lf->valid left out).  Returns the variance gain of that value, wsum (A^-1)_00
  * (1 for a plain mean; large when the samples do not pin the centre down),
  * or -1 when nothing is seen; *res the weighted residual (photo-consistency). */
 static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, float rgb[3], double *seen,
@@ -220,9 +220,10 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
         if (sx < -0.5 || sy < -0.5 || sx > w - 0.5 || sy > h - 0.5)
             continue;
         float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
-        if (dk > d + 0.25f + 0.05f * fabsf(d))
+        if (dk > dtol)
             continue;
         const float *img = lf_lf_view(c->lf, c->iu[k], c->iv[k]);
+        const float *valid = c->lf->valid ? c->lf->valid + ((size_t)c->iv[k] * c->lf->nu + c->iu[k]) * (size_t)w * h : NULL;
         int xc = (int)lrint(sx), yc = (int)lrint(sy);
         for (int j = yc - rad; j <= yc + rad; j++) {
             if (j < 0 || j >= h)
@@ -234,7 +235,7 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
                 double ex = i - sx, r2 = ex * ex + ey * ey;
                 if (r2 > r2max)
                     continue;
-                if (c->dx[k][(size_t)j * w + i] > dtol)
+                if (c->dx[k][(size_t)j * w + i] > dtol || (valid && valid[(size_t)j * w + i] == 0.f))
                     continue;
                 double wk = c->wv[k] * exp(-r2 * is2);
                 double f[6] = {1, ex, ey, ex * ex, ex * ey, ey * ey};

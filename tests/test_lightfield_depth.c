@@ -221,6 +221,20 @@ int main(void)
     printf("  depth with missing samples: BadPix0.07 %.2f %%, MSE x 100 %.4f\n", s.bad07, s.mse100);
     CHECK(s.bad07 < 2.0);
     CHECK(s.mse100 < 1.6);
+    {
+        /* and a view between the cameras from those views: the missing
+         * samples (0) left out, the view as good as from complete views
+         * below (> 45 dB) */
+        lf_lf_view_opts mvo = lf_lf_view_defaults();
+        mvo.disparity = &d;
+        lf_image mv;
+        CHECK_MSG(lf_lf_view_depth(&lf, 0.5, -1.5, &mvo, &mv, &err) == 0, "%s", err.msg);
+        render(3.5, 1.5, truth);
+        double pm = psnr(mv.data, truth, 8);
+        printf("  view (0.5, -1.5) with missing samples: %.2f dB\n", pm);
+        CHECK(pm > 45);
+        lf_image_free(&mv);
+    }
     lf_image_free(&d);
     free(lf.valid);
     lf.valid = NULL;

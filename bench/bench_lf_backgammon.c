@@ -297,6 +297,27 @@ int main(int argc, char **argv)
         for (int j = 0; j < n5; j++)
             for (int i = 0; i < n5; i++)
                 memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
+        if (getenv("LFD_NOISE")) {
+            /* robustness diagnostic: Gaussian noise of LFD_NOISE 8-bit sRGB levels on the source views
+             * (added in sRGB, fixed seed), scored against the clean held-out views */
+            double sig = atof(getenv("LFD_NOISE")) / 255.0;
+            unsigned long long st = 12345;
+            size_t nv = (size_t)n5 * n5 * lf.ns * lf.nt * 3;
+            for (size_t i = 0; i < nv; i += 2) {
+                double u1, u2;
+                st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                u1 = ((st >> 11) + 0.5) / 9007199254740992.0;
+                st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                u2 = ((st >> 11) + 0.5) / 9007199254740992.0;
+                double r = sqrt(-2 * log(u1)), g[2] = {r * cos(6.283185307179586 * u2), r * sin(6.283185307179586 * u2)};
+                for (int q = 0; q < 2 && i + q < nv; q++) {
+                    float *p = &sub.data[i + q];
+                    double e = lf_srgb_encode(*p) / 255.0 + sig * g[q];
+                    e = e < 0 ? 0 : (e > 1 ? 1 : e);
+                    *p = (float)(e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4));
+                }
+            }
+        }
         lf_image sd = {0}, sc = {0};
         {
             lf_lf_depth_opts o = lf_lf_depth_defaults();
@@ -307,6 +328,20 @@ int main(int argc, char **argv)
                 return 1;
             }
             printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            if (getenv("LFD_VERBOSE")) { /* the 5x5 map (per view step of the 9x9 grid) against the ground truth */
+                char gtp[4096];
+                snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
+                lf_image gt;
+                if (!read_pfm(gtp, &gt)) {
+                    lf_image half = sd;
+                    half.data = malloc(sizeof(float) * sd.width * sd.height);
+                    for (size_t i = 0; i < (size_t)sd.width * sd.height; i++)
+                        half.data[i] = 0.5f * sd.data[i];
+                    score("5x5 depth / 2", &half, &gt, 0);
+                    free(half.data);
+                    lf_image_free(&gt);
+                }
+            }
             if (calibrate) {
                 s = now();
                 if (lf_lf_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
@@ -346,6 +381,7 @@ int main(int argc, char **argv)
                         lf_lf_view_opts vo = lf_lf_view_defaults();
                         vo.threads = threads;
                         vo.disparity = &sd, vo.confidence = &sc;
+                        vo.blend = getenv("LFD_BLEND") && *getenv("LFD_BLEND") == '1'; /* diagnostic: the bicubic blend */
                         rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
                     }
                     secs += now() - s;
@@ -356,26 +392,49 @@ int main(int argc, char **argv)
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
                     if (getenv("LFD_VERBOSE")) {
                         /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
-                        double se[2] = {0, 0};
-                        size_t nn[2] = {0, 0};
+                        double se[2] = {0, 0}, sb[2][12] = {{0}}, sdist[2][6] = {{0}};
+                        size_t ndist[2][6] = {{0}};
+                        size_t nn[2] = {0, 0}, nb[2][12] = {{0}};
                         const float *tv = lf_lf_view(&lf, c, r);
                         for (int y = 15; y < out.height - 15; y++)
                             for (int x = 15; x < out.width - 15; x++) {
                                 float g = sd.data[(size_t)y * out.width + x];
-                                int edge = 0;
-                                for (int j = -4; j <= 4 && !edge; j++)
+                                int edge = 0, dist = 5, nearer = 0;
+                                for (int j = -4; j <= 4; j++)
                                     for (int i = -4; i <= 4; i++)
-                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f)
+                                        if (fabsf(sd.data[(size_t)(y + j) * out.width + x + i] - g) > 0.3f) {
+                                            int dd = abs(i) > abs(j) ? abs(i) : abs(j);
                                             edge = 1;
+                                            dist = dd < dist ? dd : dist;
+                                            nearer |= sd.data[(size_t)(y + j) * out.width + x + i] < g;
+                                        }
                                 for (int ch = 0; ch < 3; ch++) {
                                     size_t q = ((size_t)y * out.width + x) * 3 + ch;
                                     double e = (double)lf_srgb_encode(out.data[q]) - lf_srgb_encode(tv[q]);
                                     se[edge] += e * e, nn[edge]++;
+                                    int bi = (int)floor((g / 2 + 2) / 0.25);
+                                    bi = bi < 0 ? 0 : (bi > 11 ? 11 : bi);
+                                    sb[edge][bi] += e * e, nb[edge][bi]++;
+                                    sdist[nearer][dist] += e * e, ndist[nearer][dist]++;
                                 }
                             }
                         printf("  view r%d c%d: %.2f dB (away from edges %.2f dB, near edges %.2f dB, %.1f %% of pixels)\n",
                                r, c, p, 10 * log10(65025.0 * nn[0] / se[0]), 10 * log10(65025.0 * nn[1] / se[1]),
                                100.0 * nn[1] / (nn[0] + nn[1]));
+                        if (r == 3 && c == 3)
+                            for (int q = 0; q < 2; q++)
+                                for (int dd = 1; dd <= (q ? 4 : 5); dd++)
+                                    printf("    %s side of an edge %d px away: %.2f dB (%.1f %% of pixels)\n",
+                                           q ? "nearer" : "farther", dd,
+                                           10 * log10(65025.0 * ndist[q][dd] / (sdist[q][dd] + 1e-9)),
+                                           100.0 * ndist[q][dd] / (nn[0] + nn[1]));
+                        if (r == 3 && c == 3)
+                            for (int bi = 0; bi < 12; bi++)
+                                if (nb[0][bi] + nb[1][bi] > 300)
+                                    printf("    d/step %5.2f..%5.2f: away %6.2f dB (%5.1f %%) near %6.2f dB (%5.1f %%)\n",
+                                           -2 + 0.25 * bi, -1.75 + 0.25 * bi,
+                                           10 * log10(65025.0 * nb[0][bi] / (sb[0][bi] + 1e-9)), 100.0 * nb[0][bi] / (nn[0] + nn[1]),
+                                           10 * log10(65025.0 * nb[1][bi] / (sb[1][bi] + 1e-9)), 100.0 * nb[1][bi] / (nn[0] + nn[1]));
                     }
                     if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
                         lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);

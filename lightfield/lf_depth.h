@@ -58,20 +58,26 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
 /* A view at centred view coordinates (u, v) inside the captured aperture
  * with per-pixel geometry: a disparity map of the reference view (given, or
  * estimated with lf_lf_depth) is forward-warped to (u, v) with a z-buffer
- * (nearer disparities win), then the views within 2 view steps are
- * backward-warped through it and blended with weights by angular distance,
- * resampling phase, visibility (the
- * view's own warped depth agrees) and confidence; where confidence is low
- * or no view sees the point the plane at plane_disparity is used.  At a
- * view position it returns that view exactly. */
+ * (nearer disparities win).  Every pixel of the views within 3 view steps
+ * that sees the point (its own warped depth agrees, no nearer surface
+ * within a pixel) lands at a sub-pixel offset from the target pixel; a
+ * Gaussian-weighted quadratic fit to those samples (multi-view
+ * scattered-data reconstruction) gives the pixel.  blend = 1 instead
+ * blends bicubic lookups of the views within 2 steps weighted by angular
+ * distance and resampling phase.  Where confidence is low or no view sees
+ * the point the plane at plane_disparity is used.  At a view position it
+ * returns that view exactly. */
 typedef struct lf_lf_view_opts {
     const lf_image *disparity;  /* NULL: estimated (lf_lf_depth with depth) */
     const lf_image *confidence; /* NULL with a given disparity: all 1 */
     lf_lf_depth_opts depth;
     double plane_disparity;     /* fallback plane */
     double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
-    double radius;              /* source views: tent of this radius in view steps; <= 0: 2 (1: the 4 nearest) */
-    double phase_floor;         /* resampling-phase weight 1/(fx(1-fx)+fy(1-fy)+floor); < 0: 0.05; 0: off */
+    double radius;              /* source views: tent of this radius in view steps, at most 4;
+                                   <= 0: 3 (blend: 2; 1: the 4 nearest) */
+    int blend;                  /* 0: scattered-data fit; 1: bicubic blend of lookups */
+    double kernel;              /* fit: Gaussian sigma in px; <= 0: 0.35 */
+    double phase_floor;         /* blend: resampling-phase weight 1/(fx(1-fx)+fy(1-fy)+floor); < 0: 0.05; 0: off */
     int threads;
 } lf_lf_view_opts;
 lf_lf_view_opts lf_lf_view_defaults(void);

@@ -6,13 +6,20 @@
  *    the nearest surface (largest disparity) wins; holes (disocclusions)
  *    take the farthest disparity around them, as the background is what
  *    appears there.
- * 2. Every target pixel is looked up (bicubic) in the views within a tent
- *    of radius 2 view steps (up to 16), weighted by the tent in (u, v) and
- *    by the resampling phase (sources whose pixel grid lands near the
- *    target pixel centre need less interpolation); a view whose own warped
- *    disparity there is clearly nearer sees an occluder and drops out.
- * 3. Near depth edges the nearest disparity within a pixel is primary and
- *    the others compete by photo-consistency (soft weights).
+ * 2. Scattered-data fit (default): every pixel of every view within a tent
+ *    of radius 3 view steps lands, via the target pixel's disparity, at a
+ *    sub-pixel offset from the target pixel centre; views at other
+ *    viewpoints land at other phases, so together they sample the
+ *    (pixel-integrated) image more densely than one grid.  A Gaussian-
+ *    weighted (sigma 0.35 px) quadratic fit to the samples gives the value
+ *    at the centre; a sample whose own warped disparity, or a neighbour's,
+ *    is clearly nearer sees (part of) an occluder and drops out.  Blend
+ *    (blend = 1): bicubic lookups in the views within 2 view steps weighted
+ *    by the tent and the resampling phase.
+ * 3. Near depth edges the nearest disparity within a pixel is primary; with
+ *    the fit, the outline's mixed pixels are unmixed against the parallax-
+ *    shifted backgrounds (two_layer); with the blend, the candidates compete
+ *    by photo-consistency (soft weights).
  * 4. Where the splatted confidence is low the result fades to the plane
  *    blend at plane_disparity (lf_lf_view_at). */
 #include <float.h>
@@ -132,7 +139,7 @@ static void sample(const float *img, int w, int h, double x, double y, float rgb
     rgb[0] = a[0], rgb[1] = a[1], rgb[2] = a[2];
 }
 
-#define VS_MAXSRC 16
+#define VS_MAXSRC 64
 
 typedef struct vs_ctx {
     const lf_lightfield *lf;
@@ -143,18 +150,179 @@ typedef struct vs_ctx {
     double ox[VS_MAXSRC], oy[VS_MAXSRC]; /* source minus target pixel offset (calibrated views) */
     const float *dt, *ct; /* target disparity, confidence */
     const float *ds[VS_MAXSRC];   /* source views' warped disparity */
+    const float *dx[VS_MAXSRC];   /* the same, largest over 3 x 3 (a pixel next to a nearer surface may mix it in) */
     double phase0;        /* resampling-phase weight floor (<= 0: phase ignored) */
     const float *plane;   /* plane blend, RGB */
     float cmin;
     float *out;
+    int blend;     /* 1: bicubic blend (phase-weighted); 0: scattered-data fit */
+    double sigma;  /* Gaussian kernel of the fit, px */
 } vs_ctx;
 
-/* Colour of target pixel (x, y) at disparity d from the sources: visible
- * sources (their own warped disparity is not clearly nearer) weighted by
- * angular distance; returns the weighted colour variance across them (a
- * photo-consistency score), or -1 when no source sees the point. */
+/* Solve the n x n system A x = b in place (Gaussian elimination, partial
+ * pivoting), 4 right-hand sides.  Returns 0 when (nearly) singular. */
+static int solve4(double *A, double (*b)[4], int n)
+{
+    for (int i = 0; i < n; i++) {
+        int p = i;
+        for (int r = i + 1; r < n; r++)
+            if (fabs(A[r * n + i]) > fabs(A[p * n + i]))
+                p = r;
+        if (fabs(A[p * n + i]) < 1e-12)
+            return 0;
+        if (p != i) {
+            for (int k = 0; k < n; k++) {
+                double t = A[i * n + k];
+                A[i * n + k] = A[p * n + k], A[p * n + k] = t;
+            }
+            for (int ch = 0; ch < 4; ch++) {
+                double t = b[i][ch];
+                b[i][ch] = b[p][ch], b[p][ch] = t;
+            }
+        }
+        for (int r = i + 1; r < n; r++) {
+            double f = A[r * n + i] / A[i * n + i];
+            for (int k = i; k < n; k++)
+                A[r * n + k] -= f * A[i * n + k];
+            for (int ch = 0; ch < 4; ch++)
+                b[r][ch] -= f * b[i][ch];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--)
+        for (int ch = 0; ch < 4; ch++) {
+            double t = b[i][ch];
+            for (int k = i + 1; k < n; k++)
+                t -= A[i * n + k] * b[k][ch];
+            b[i][ch] = t / A[i * n + i];
+        }
+    return 1;
+}
+
+/* Scattered-data fit at kernel width sigma: every pixel of every visible
+ * source lands, via d, at an offset from the target pixel centre; a
+ * Gaussian-weighted least-squares quadratic in the offset gives the value
+ * at the centre (samples marked invalid in lf->valid left out).  Returns the variance gain of that value, wsum (A^-1)_00
+ * (1 for a plain mean; large when the samples do not pin the centre down),
+ * or -1 when nothing is seen; *res the weighted residual (photo-consistency). */
+static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, float rgb[3], double *seen,
+                        double *res)
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    enum { nb = 6 }; /* 1, x, y, x^2, xy, y^2 */
+    double A[36] = {0}, b[6][4] = {{0}}, wsum = 0, sq = 0;
+    float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    double is2 = 1.0 / (2 * sigma * sigma);
+    double r2max = 9 * sigma * sigma;
+    int rad = (int)ceil(3 * sigma);
+    float dtol = d + 0.25f + 0.05f * fabsf(d);
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = x - d * c->du[k] + c->ox[k], sy = y - d * c->dv[k] + c->oy[k];
+        if (sx < -0.5 || sy < -0.5 || sx > w - 0.5 || sy > h - 0.5)
+            continue;
+        float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
+        if (dk > dtol)
+            continue;
+        const float *img = lf_lf_view(c->lf, c->iu[k], c->iv[k]);
+        const float *valid = c->lf->valid ? c->lf->valid + ((size_t)c->iv[k] * c->lf->nu + c->iu[k]) * (size_t)w * h : NULL;
+        int xc = (int)lrint(sx), yc = (int)lrint(sy);
+        for (int j = yc - rad; j <= yc + rad; j++) {
+            if (j < 0 || j >= h)
+                continue;
+            double ey = j - sy;
+            for (int i = xc - rad; i <= xc + rad; i++) {
+                if (i < 0 || i >= w)
+                    continue;
+                double ex = i - sx, r2 = ex * ex + ey * ey;
+                if (r2 > r2max)
+                    continue;
+                if (c->dx[k][(size_t)j * w + i] > dtol || (valid && valid[(size_t)j * w + i] == 0.f))
+                    continue;
+                double wk = c->wv[k] * exp(-r2 * is2);
+                double f[6] = {1, ex, ey, ex * ex, ex * ey, ey * ey};
+                const float *p = img + ((size_t)j * w + i) * 3;
+                for (int a = 0; a < nb; a++) {
+                    double wf = wk * f[a];
+                    for (int bb = a; bb < nb; bb++)
+                        A[a * nb + bb] += wf * f[bb];
+                    b[a][0] += wf * p[0], b[a][1] += wf * p[1], b[a][2] += wf * p[2];
+                }
+                wsum += wk;
+                sq += wk * ((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+                if (r2 <= 1)
+                    for (int ch = 0; ch < 3; ch++) {
+                        lo[ch] = p[ch] < lo[ch] ? p[ch] : lo[ch];
+                        hi[ch] = p[ch] > hi[ch] ? p[ch] : hi[ch];
+                    }
+            }
+        }
+    }
+    *seen = wsum;
+    if (wsum <= 1e-6)
+        return -1;
+    for (int a = 0; a < nb; a++)
+        for (int bb = 0; bb < a; bb++)
+            A[a * nb + bb] = A[bb * nb + a];
+    double rhs[6][3];
+    for (int a = 0; a < nb; a++)
+        rhs[a][0] = b[a][0], rhs[a][1] = b[a][1], rhs[a][2] = b[a][2];
+    /* a little ridge on the higher terms keeps degenerate layouts finite */
+    for (int a = 1; a < nb; a++)
+        A[a * nb + a] += 1e-4 * wsum;
+    for (int a = 0; a < nb; a++)
+        b[a][3] = a == 0;
+    if (!solve4(A, b, nb)) {
+        for (int ch = 0; ch < 3; ch++)
+            rgb[ch] = (float)(rhs[0][ch] / wsum);
+        *res = 0;
+        return 1e30;
+    }
+    double cb = 0;
+    for (int a = 0; a < nb; a++)
+        cb += b[a][0] * rhs[a][0] + b[a][1] * rhs[a][1] + b[a][2] * rhs[a][2];
+    for (int ch = 0; ch < 3; ch++) {
+        rgb[ch] = (float)b[0][ch];
+        /* never outside the samples within 1 px: bounds what noise or an
+         * ill-placed sample can do to an extrapolating fit */
+        if (lo[ch] <= hi[ch])
+            rgb[ch] = rgb[ch] < lo[ch] ? lo[ch] : (rgb[ch] > hi[ch] ? hi[ch] : rgb[ch]);
+    }
+    double r = (sq - cb) / wsum;
+    *res = r > 0 ? r : 0;
+    return wsum * b[0][3];
+}
+
+/* The fit at the smallest kernel whose centre value the samples pin down:
+ * where every source lands at the same phase (e.g. all half a pixel off)
+ * a narrow quadratic is undetermined (variance gain of the centre value
+ * over a plain weighted mean above 1e4), and a wider kernel makes it an
+ * interpolation over the neighbours. */
+static double fit_at(const vs_ctx *c, int x, int y, float d, float rgb[3], double *seen)
+{
+    static const double scale[4] = {1.0, 1.43, 2.0, 2.86};
+    double res = 0;
+    for (int q = 0; q < 4; q++) {
+        double g = fit_sigma(c, x, y, d, c->sigma * scale[q], rgb, seen, &res);
+        if (g < 0)
+            return -1;
+        if (g <= 1e4)
+            break;
+    }
+    return res;
+}
+
+/* Colour of target pixel (x, y) at disparity d from the sources that see
+ * it: the scattered-data fit, or (blend) the bicubic lookups of the
+ * visible sources weighted by angular distance and resampling phase.
+ * Returns a photo-consistency score (the fit's weighted residual, or the
+ * weighted colour variance across the sources), -1 when no source sees
+ * the point (rgb then the blend of all sources). */
 static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], float all[3], double *seen)
 {
+    if (!c->blend) {
+        double v = fit_at(c, x, y, d, rgb, seen);
+        if (v >= 0)
+            return v;
+    }
     int w = c->lf->ns, h = c->lf->nt;
     double acc[3] = {0, 0, 0}, sq = 0, wsum = 0, acc_all[3] = {0, 0, 0}, wall = 0;
     for (int k = 0; k < c->nsrc; k++) {
@@ -200,6 +368,84 @@ static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], flo
     return var > 0 ? var : 0;
 }
 
+/* Background colour at target position (xf, yf) on the surface at
+ * disparity db: bicubic lookups in the sources that see it clear of
+ * nearer surfaces (within a pixel), weighted by angular distance.
+ * Returns 0 when no source sees it. */
+static int bg_at(const vs_ctx *c, double xf, double yf, float db, float rgb[3])
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    double acc[3] = {0, 0, 0}, wsum = 0;
+    float tol = db + 0.25f + 0.05f * fabsf(db);
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = xf - db * c->du[k] + c->ox[k], sy = yf - db * c->dv[k] + c->oy[k];
+        if (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1)
+            continue;
+        if (c->dx[k][(size_t)lrint(sy) * w + lrint(sx)] > tol)
+            continue;
+        float col[3];
+        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
+        for (int ch = 0; ch < 3; ch++)
+            acc[ch] += c->wv[k] * col[ch];
+        wsum += c->wv[k];
+    }
+    if (wsum <= 1e-9)
+        return 0;
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = (float)(acc[ch] / wsum);
+    return 1;
+}
+
+/* Two layers at a depth edge: the views' pixels on the nearer surface's
+ * outline (disparity df) mix its colour F with whatever lies behind by a
+ * coverage alpha that travels with the outline, I_k = alpha F + (1 - alpha)
+ * B_k, while the background behind (disparity db) differs from view to
+ * view by parallax.  With B_k looked up where the views see the background
+ * clear, least squares over the views gives 1 - alpha = Cov(B, I) / Var(B)
+ * (multi-background matting, as triangulation matting with backgrounds
+ * that parallax provides) and the target pixel is
+ * I_fit + (1 - alpha) (B_t - mean(B)): ifit the scattered-data fit at df
+ * (which averages the views' mixes), B_t the target's own background.
+ * Returns 0 when fewer than 3 views constrain it. */
+static int two_layer(const vs_ctx *c, int x, int y, float df, float db, const float bt[3], const float ifit[3],
+                     float rgb[3])
+{
+    int w = c->lf->ns, h = c->lf->nt;
+    double W = 0, sI[3] = {0, 0, 0}, sB[3] = {0, 0, 0}, sBI = 0, sBB = 0;
+    float tol = df + 0.25f + 0.05f * fabsf(df);
+    int n = 0;
+    for (int k = 0; k < c->nsrc; k++) {
+        double sx = x - df * c->du[k] + c->ox[k], sy = y - df * c->dv[k] + c->oy[k];
+        if (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1)
+            continue;
+        if (c->ds[k][(size_t)lrint(sy) * w + lrint(sx)] > tol)
+            continue;
+        float I[3], B[3];
+        if (!bg_at(c, x - (df - db) * c->du[k], y - (df - db) * c->dv[k], db, B))
+            continue;
+        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, I);
+        double wk = c->wv[k];
+        for (int ch = 0; ch < 3; ch++) {
+            sI[ch] += wk * I[ch], sB[ch] += wk * B[ch];
+            sBI += wk * (double)B[ch] * I[ch], sBB += wk * (double)B[ch] * B[ch];
+        }
+        W += wk, n++;
+    }
+    if (n < 3)
+        return 0;
+    double cov = sBI / W, var = sBB / W;
+    for (int ch = 0; ch < 3; ch++)
+        cov -= sB[ch] * sI[ch] / (W * W), var -= sB[ch] * sB[ch] / (W * W);
+    /* a weak prior (alpha 1/2, worth a colour spread of 0.01) where the
+     * backgrounds hardly differ; then alpha hardly matters either */
+    const double lam = 1e-4;
+    double oma = (cov + lam * 0.5) / (var + lam);
+    oma = oma < 0 ? 0 : (oma > 1 ? 1 : oma);
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = (float)(ifit[ch] + oma * (bt[ch] - sB[ch] / W));
+    return 1;
+}
+
 static void vs_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
@@ -224,7 +470,12 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
             float px[3], all[3];
             double seen, seen2;
             double best = blend_at(c, x, y, d, px, all, &seen);
-            if (dmax - dmin > 0.25f && best >= 0) {
+            float bt[3], tl[3];
+            double sb;
+            if (!c->blend && dmax - dmin > 0.25f && best >= 0 && blend_at(c, x, y, dmin, bt, all, &sb) >= 0 &&
+                two_layer(c, x, y, dmax, dmin, bt, px, tl)) {
+                px[0] = tl[0], px[1] = tl[1], px[2] = tl[2];
+            } else if (dmax - dmin > 0.25f && best >= 0) {
                 /* soft choice: candidates weighted by 1 / (variance + floor);
                  * a mixed edge pixel then gets a mix too */
                 const double floor_v = 1e-4;
@@ -290,8 +541,12 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     memset(&c, 0, sizeof c);
     c.lf = lf;
     /* sources: the views within a tent of radius R view steps around the
-     * target (R = 1: the 4 nearest, bilinear weights; R = 2: up to 16) */
-    double R = o->radius > 0 ? o->radius : 2.0;
+     * target (R = 1: the 4 nearest, bilinear weights; R = 3: up to 36;
+     * at most 4: 64) */
+    c.blend = o->blend;
+    c.sigma = o->kernel > 0 ? o->kernel : 0.35;
+    double R = o->radius > 0 ? o->radius : (o->blend ? 2.0 : 3.0);
+    R = R > 4 ? 4 : R;
     c.phase0 = o->phase_floor < 0 ? 0.05 : o->phase_floor;
     int rr = (int)ceil(R - 1e-9);
     double st[4]; /* the target's (su, sv, ox, oy) */
@@ -310,7 +565,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
             c.ox[c.nsrc] = sk[2] - st[2], c.oy[c.nsrc] = sk[3] - st[3];
             c.nsrc++;
         }
-    float *buf = malloc(sizeof(float) * np * (2 + (size_t)c.nsrc));
+    float *buf = malloc(sizeof(float) * np * (2 + 2 * (size_t)c.nsrc));
     lf_image plane = {0};
     if (!buf) {
         lf_image_free(&disp), lf_image_free(&conf);
@@ -324,6 +579,18 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         lf_lf_view_shift(lf, c.iu[k], c.iv[k], sk);
         splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
         c.ds[k] = dk;
+        float *dxk = buf + (2 + (size_t)c.nsrc + k) * np;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                float m = -FLT_MAX;
+                for (int j = -1; j <= 1; j++)
+                    for (int i = -1; i <= 1; i++) {
+                        float v = dk[(size_t)clampi(y + j, 0, h - 1) * w + clampi(x + i, 0, w - 1)];
+                        m = v > m ? v : m;
+                    }
+                dxk[(size_t)y * w + x] = m;
+            }
+        c.dx[k] = dxk;
     }
     c.dt = dt, c.ct = ct;
     c.cmin = o->min_confidence < 0 ? 0.05f : (float)o->min_confidence;

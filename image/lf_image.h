@@ -74,6 +74,8 @@ int lf_attrs_set_float(lf_attrs *a, const char *name, float value);
 int lf_attrs_set_double(lf_attrs *a, const char *name, double value);
 int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *v, int n);
 int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16]);
+/* Sets a copy of attribute x (its name, type and value) in a. */
+int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x);
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name);
 void lf_attrs_free(lf_attrs *a);
 
@@ -115,6 +117,9 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
 
 /* Number of NaN or Inf values. */
 size_t lf_image_count_nonfinite(const lf_image *img);
+/* 1 when every value is finite with magnitude <= 65504, the largest half
+ * float (an EXR written with opts.half keeps every value). */
+int lf_image_fits_half(const lf_image *img);
 
 /* Linear -> 8-bit sRGB (exposure in stops, clamp, sRGB curve), for previews. */
 unsigned char lf_srgb_encode(float linear);

@@ -85,6 +85,15 @@ int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err);
  * agree and that every pixel gets every sample exactly once. */
 int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *meta, lf_error *err);
 
+/* The disparity AOV (lf_renderer_disparity) as OUT.disparity.exr beside
+ * OUT.exr (path ends in ".exr"): 1 channel, 32-bit float, meta's
+ * attributes plus lensfield:aov.  meta (OUT's header) gets
+ * lensfield:disparity_file naming it and lensfield:disparity_range.
+ * written (may be NULL, path_size bytes) gets the file's path, range[2]
+ * the values' range. */
+int lf_render_write_disparity(lf_renderer *r, const char *path, lf_attrs *meta, char *written, size_t written_size,
+                              float range[2], lf_error *err);
+
 /* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
 const char *lf_renderer_film_filename(const lf_renderer *r);
 /* Film "savefp16" (pbrt default true): store EXR channels as half floats. */

@@ -8,11 +8,44 @@
  * Values may be quoted with '...' or "..." (no escapes).  Kinds and keys:
  * docs/grading.md. */
 #include <ctype.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "grade_internal.h"
+
+static int is_dir(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+int lf_grade_find_assignment(const char *a, char *out, size_t n, lf_error *err)
+{
+    char rubric[PATH_MAX + 16];
+    snprintf(rubric, sizeof rubric, "%s/rubric.txt", a);
+    if (is_dir(a) && access(rubric, R_OK) == 0 && snprintf(out, n, "%s", a) < (int)n)
+        return LF_OK;
+    if (snprintf(out, n, "assignments/%s", a) < (int)n && is_dir(out))
+        return LF_OK;
+    char exe[PATH_MAX];
+    ssize_t l = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    char *slash = NULL;
+    if (l > 0) {
+        exe[l] = 0;
+        slash = strrchr(exe, '/');
+    }
+    if (slash) {
+        *slash = 0;
+        if (snprintf(out, n, "%s/../../assignments/%s", exe, a) < (int)n && is_dir(out))
+            return LF_OK;
+    }
+    return lf_error_set(err, LF_ERR_PARAM,
+                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/)", a);
+}
 
 static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, char *why, size_t wn)
 {

@@ -99,6 +99,9 @@ typedef struct lf_write_opts {
 float lf_tonemap_apply(lf_tonemap op, float x);
 /* "clamp", "filmic", "aces" -> 0 and *op; -1 for another name. */
 int lf_tonemap_parse(const char *name, lf_tonemap *op);
+/* Write options for 8-bit pictures from a tool's --exposure EV and
+ * --tonemap NAME (NULL or an unknown name: clamp); the rest default. */
+lf_write_opts lf_write_opts_picture(double exposure_ev, const char *tonemap);
 
 /* A scalar image (channel 0 of src) as a colour picture: values in [lo, hi]
  * through the viridis colour map (NaN/Inf grey), with a legend strip below

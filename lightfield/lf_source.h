@@ -74,6 +74,13 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
 int lf_lf_write_stack(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
                       const char *dir, const char *ext, const lf_write_opts *wo, lf_error *err);
 
+/* Writes the centre view's disparity map disp (1 channel, searched over
+ * [d0, d1]): EXR/PFM get the values, with lensfield:disparity_search_range
+ * and lensfield:disparity_convention; PNG/JPEG a picture of them, the
+ * colour map over [d0, d1] with its legend (lf_image_colormap). */
+int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
+                          lf_error *err);
+
 /* Ng 2005's range of exact refocusing of a plenoptic capture
  * (docs/lightfield.md, "Refocusable range"): |d| <= 1 px/view.  Returns 1
  * and describes the range in buf ("Ng 2005: |disparity| <= 1 px/view,

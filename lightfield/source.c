@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../base/lf_file.h"
 #include "../base/lf_file_write.h"
 #include "../base/lf_keys.h"
 
@@ -213,6 +214,30 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
     snprintf(path, sizeof path, "%s/mosaic.%s", dir, ext);
     int rc = lf_image_write(path, &m, NULL, wo, err);
     lf_image_free(&m);
+    return rc;
+}
+
+int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
+                          lf_error *err)
+{
+    int rc;
+    if (lf_path_has_ext(path, ".png") || lf_path_has_ext(path, ".jpg") || lf_path_has_ext(path, ".jpeg")) {
+        lf_image pic;
+        if ((rc = lf_image_colormap(disp, d0, d1, &pic, err)))
+            return rc;
+        rc = lf_image_write(path, &pic, NULL, wo, err);
+        lf_image_free(&pic);
+        return rc;
+    }
+    lf_attrs a = {0};
+    float range[2] = {(float)d0, (float)d1};
+    if (lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2) ||
+        lf_attrs_set_string(&a, LF_KEY_DISPARITY_CONVENTION,
+                            "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step"))
+        rc = lf_error_set(err, LF_ERR_NOMEM, "cannot write '%s': out of memory", path);
+    else
+        rc = lf_image_write(path, disp, &a, wo, err);
+    lf_attrs_free(&a);
     return rc;
 }
 

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../base/lf_file.h"
 #include "../base/lf_keys.h"
 #include "lf_render.h"
 
@@ -11,7 +12,7 @@ int lf_render_write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, c
                               float range[2], lf_error *err)
 {
     size_t len = strlen(out);
-    if (len < 4 || strcmp(out + len - 4, ".exr"))
+    if (!lf_path_has_ext(out, ".exr"))
         return lf_error_set(err, LF_ERR_PARAM, "the disparity AOV needs an .exr output, not %s", out);
     lf_image d;
     int rc = lf_renderer_disparity(r, &d, err);

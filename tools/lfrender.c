@@ -15,9 +15,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <unistd.h>
 
+#include "base/lf_file.h"
 #include "base/lf_file_write.h"
 #include "base/lf_keys.h"
 #include "base/lf_progress.h"
@@ -107,12 +107,6 @@ static int render_opts_from_flags(lf_render_opts *o)
     return 0;
 }
 
-static int has_ext(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    return n >= e && !strcasecmp(path + n - e, ext);
-}
-
 static int run_render(int n, char **pos)
 {
     (void)n;
@@ -178,11 +172,11 @@ static int run_render(int n, char **pos)
     }
     if (!out)
         out = lf_renderer_film_filename(r);
-    if (rc < 0 && o.part && !has_ext(out, ".exr")) {
+    if (rc < 0 && o.part && !lf_path_has_ext(out, ".exr")) {
         fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
         rc = 2;
     }
-    if (rc < 0 && opt.aov && (o.part || !has_ext(out, ".exr"))) {
+    if (rc < 0 && opt.aov && (o.part || !lf_path_has_ext(out, ".exr"))) {
         fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
                         "--spp-range)\n");
         rc = 2;
@@ -215,10 +209,7 @@ static int run_render(int n, char **pos)
         if (st.nonfinite_samples)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
-        lf_write_opts wo = {0};
-        wo.exposure = (float)opt.exposure;
-        if (opt.tonemap)
-            lf_tonemap_parse(opt.tonemap, &wo.tonemap);
+        lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
         wo.half = !o.part && lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
         if (wo.half && !lf_image_fits_half(&img)) { /* half floats top out at 65504: keep bright renders exact */
             fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "

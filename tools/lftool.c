@@ -10,7 +10,6 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
-#include <strings.h>
 #include <time.h>
 
 #include "base/lf_file_write.h"
@@ -244,6 +243,17 @@ static void apply_flags(void)
 
 /* ---------- helpers ---------- */
 
+/* Every command starts here: its name, IN (and OUT) and the flags' values. */
+static const opts *begin(const char *cmd, int n, char **pos)
+{
+    opt.cmd = cmd;
+    opt.input = pos[0];
+    if (n > 1)
+        opt.output = pos[1];
+    apply_flags();
+    return &opt;
+}
+
 /* Prints a library error (after the input's name when given): exit 1. */
 static int fail(const lf_error *err, const char *name)
 {
@@ -268,26 +278,18 @@ static int load(const opts *o, lf_lf_source *s, int layout_only)
     return EXIT_OK;
 }
 
-static lf_write_opts picture_opts(void)
-{
-    lf_write_opts wo = {0};
-    wo.exposure = (float)opt.exposure;
-    if (opt.tonemap)
-        lf_tonemap_parse(opt.tonemap, &wo.tonemap);
-    return wo;
-}
-
 static int write_image(const char *path, const lf_image *img, const lf_attrs *a)
 {
     lf_error err = {0};
-    lf_write_opts wo = picture_opts();
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
     return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
 }
 
 /* ---------- commands ---------- */
 
-static int cmd_info(const opts *o)
+static int cmd_info(int n, char **pos)
 {
+    const opts *o = begin("info", n, pos);
     lf_lf_source s;
     int rc = load(o, &s, 1);
     if (rc)
@@ -319,15 +321,16 @@ static int decode_hci(const opts *o, const lf_lf_source *s)
     return rc;
 }
 
-static int cmd_decode(const opts *o)
+static int cmd_decode(int n, char **pos)
 {
+    const opts *o = begin("decode", n, pos);
     lf_lf_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
     const lf_lightfield *lf = &s.lf;
     lf_error err = {0};
-    lf_write_opts wo = picture_opts();
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
     if (o->hci)
         rc = decode_hci(o, &s);
     else if (lf_lf_write_views(lf, o->output, o->format ? o->format : "exr", &wo, &err))
@@ -363,8 +366,9 @@ static lf_lf_refocus_opts aperture_opts(const opts *o)
     return r;
 }
 
-static int cmd_refocus(const opts *o)
+static int cmd_refocus(int n, char **pos)
 {
+    const opts *o = begin("refocus", n, pos);
     if (o->have_alpha + o->have_depth + o->have_disp != 1)
         return usage("%s", "refocus needs exactly one of --alpha A, --depth METRES, --disparity PX");
     lf_lf_source s;
@@ -420,8 +424,9 @@ static void stack_range(const opts *o, double *d0, double *d1)
     *d0 = o->have_from ? o->from : -1, *d1 = o->have_to ? o->to : 1;
 }
 
-static int cmd_stack(const opts *o)
+static int cmd_stack(int n, char **pos)
 {
+    const opts *o = begin("stack", n, pos);
     lf_lf_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -453,7 +458,7 @@ static int cmd_stack(const opts *o)
     return rc;
 }
 
-static int cmd_allfocus_depth(const opts *o, int want_depth)
+static int allfocus_depth(const opts *o, int want_depth)
 {
     lf_lf_source s;
     int rc = load(o, &s, 0);
@@ -477,36 +482,16 @@ static int cmd_allfocus_depth(const opts *o, int want_depth)
     return rc;
 }
 
-static int cmd_allfocus(const opts *o) { return cmd_allfocus_depth(o, 0); }
-
-/* The disparity map as EXR/PFM values, or (PNG, JPEG) as a picture: the
- * colour map over the search range, with its legend. */
-static int write_disparity(const opts *o, const lf_image *disp, const lf_lf_depth_opts *d)
+static int cmd_allfocus(int n, char **pos)
 {
-    const char *dot = strrchr(o->output, '.');
-    if (!dot || (strcasecmp(dot, ".png") && strcasecmp(dot, ".jpg") && strcasecmp(dot, ".jpeg"))) {
-        lf_attrs a = {0};
-        float range[2] = {(float)d->d0, (float)d->d1};
-        lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2);
-        lf_attrs_set_string(&a, LF_KEY_DISPARITY_CONVENTION,
-                            "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step");
-        int rc = write_image(o->output, disp, &a);
-        lf_attrs_free(&a);
-        return rc;
-    }
-    lf_image pic;
-    lf_error err = {0};
-    if (lf_image_colormap(disp, d->d0, d->d1, &pic, &err))
-        return fail(&err, o->input);
-    int rc = write_image(o->output, &pic, NULL);
-    lf_image_free(&pic);
-    return rc;
+    return allfocus_depth(begin("allfocus", n, pos), 0);
 }
 
-static int cmd_depth(const opts *o)
+static int cmd_depth(int n, char **pos)
 {
+    const opts *o = begin("depth", n, pos);
     if (o->method && !strcmp(o->method, "stack"))
-        return cmd_allfocus_depth(o, 1);
+        return allfocus_depth(o, 1);
     if (o->have_from != o->have_to)
         return usage("%s", "depth: give both --from and --to, or neither (range from the file or the data)");
     if (o->have_from && !(o->from < o->to))
@@ -536,7 +521,8 @@ static int cmd_depth(const opts *o)
     }
     if (lf_lf_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
         goto failed;
-    rc = write_disparity(o, &disp, &d);
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    rc = lf_lf_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o->confidence, &conf, NULL);
     if (!rc)
@@ -567,8 +553,9 @@ static int calibrate_for_view(const opts *o, lf_lightfield *lf, const lf_image *
     return rc;
 }
 
-static int cmd_view(const opts *o)
+static int cmd_view(int n, char **pos)
 {
+    const opts *o = begin("view", n, pos);
     /* per-pixel geometry by default; the plane blend with --geometry plane
      * (or, as before, when a focus plane is given without --geometry) */
     int plane = o->geometry ? !strcmp(o->geometry, "plane") : (o->have_alpha + o->have_depth + o->have_disp) > 0;
@@ -608,8 +595,9 @@ done:
     return rc;
 }
 
-static int cmd_synth(const opts *o)
+static int cmd_synth(int n, char **pos)
 {
+    const opts *o = begin("synth", n, pos);
     if (o->dispmap && !(o->geometry && !strcmp(o->geometry, "depth")))
         return usage("%s", "--disparity-map needs --geometry depth");
     lf_lf_source s;
@@ -654,8 +642,9 @@ done:
     return rc;
 }
 
-static int cmd_calibrate(const opts *o)
+static int cmd_calibrate(int n, char **pos)
 {
+    const opts *o = begin("calibrate", n, pos);
     lf_image white;
     lf_attrs a = {0}; /* only the estimated layout: the input's own header is not carried over */
     lf_error err = {0};
@@ -684,8 +673,9 @@ static int cmd_calibrate(const opts *o)
 
 /* ---------- export-web and serve (web/lf_web.h, docs/web.md) ---------- */
 
-static int cmd_export_web(const opts *o)
+static int cmd_export_web(int n, char **pos)
 {
+    const opts *o = begin("export-web", n, pos);
     if (o->have_from != o->have_to)
         return usage("%s", "export-web: give both --from and --to, or neither");
     lf_web_export_opts wo = lf_web_export_defaults();
@@ -721,8 +711,9 @@ static void serve_on_signal(int sig)
     serve_stop = 1;
 }
 
-static int cmd_serve(const opts *o)
+static int cmd_serve(int n, char **pos)
 {
+    const opts *o = begin("serve", n, pos);
     lf_web_server *srv;
     lf_error err = {0};
     if (lf_web_server_open(o->input, o->port, &srv, &err)) {
@@ -748,29 +739,7 @@ static int cmd_serve(const opts *o)
     return EXIT_OK;
 }
 
-#define RUNNER(name, fn)                  \
-    static int run_##fn(int n, char **pos) \
-    {                                     \
-        opt.cmd = name;                   \
-        opt.input = pos[0];               \
-        if (n > 1)                        \
-            opt.output = pos[1];          \
-        apply_flags();                    \
-        return fn(&opt);                  \
-    }
-RUNNER("info", cmd_info)
-RUNNER("decode", cmd_decode)
-RUNNER("calibrate", cmd_calibrate)
-RUNNER("refocus", cmd_refocus)
-RUNNER("stack", cmd_stack)
-RUNNER("allfocus", cmd_allfocus)
-RUNNER("depth", cmd_depth)
-RUNNER("view", cmd_view)
-RUNNER("synth", cmd_synth)
-RUNNER("export-web", cmd_export_web)
-RUNNER("serve", cmd_serve)
-
-#define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, run_##fn, desc}
+#define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, fn, desc}
 static const lf_command commands[] = {
     CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
     CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
@@ -792,7 +761,7 @@ static const lf_command commands[] = {
     CMD("view", "IN --u U --v V -o OUT [--geometry depth|plane] [--disparity-map D.exr]",
         "synthesize a view from another viewpoint", view_args, cmd_view, NULL),
     {"synth", "LF OUT.exr [CS348B flags]", "the CS348B virtual camera between the data cameras", synth_args,
-     LF_ARRAY_LEN(synth_args), 2, 2, run_cmd_synth, NULL},
+     LF_ARRAY_LEN(synth_args), 2, 2, cmd_synth, NULL},
     CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
         "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
     CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),

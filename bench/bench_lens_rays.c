@@ -201,16 +201,17 @@ int main(int argc, char **argv)
     for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
         if (filter && !strstr(lenses[k], filter))
             continue;
-        char path[1024], err[1024];
+        char path[1024];
+        lf_error err = {0};
         snprintf(path, sizeof path, LF_SOURCE_DIR "/scenes/lenses/%s", lenses[k]);
         lf_lens L;
-        if (lf_lens_load(path, &L, err, sizeof err)) {
-            fprintf(stderr, "%s\n", err);
+        if (lf_lens_load(path, &L, &err)) {
+            fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         lf_lens_set_stop_diameter(&L, 1e3, NULL, 0);
-        if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, err, sizeof err)) {
-            fprintf(stderr, "%s\n", err);
+        if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, &err)) {
+            fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         lf_lens_pupil P;

@@ -125,8 +125,9 @@ double lf_grade_fit_blur(const lf_image *S, const lf_image *A);
 double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n);
 
 /* Submission.md commands as data: splits a line into words (quotes group,
- * nothing is expanded).  Fails (-1, reason in why) on shell syntax. */
-int lf_grade_tokenize(const char *line, char ***argv, int *argc, char *why, size_t why_size);
+ * nothing is expanded).  Fails with LF_ERR_PARSE (the reason in err) on
+ * shell syntax or an unterminated quote, LF_ERR_NOMEM when memory runs out. */
+int lf_grade_tokenize(const char *line, char ***argv, int *argc, lf_error *err);
 void lf_grade_free_argv(char **argv, int argc);
 
 #ifdef __cplusplus

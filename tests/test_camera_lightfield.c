@@ -758,16 +758,17 @@ static void test_plenoptic_compound(double mla_scale, double *outside_fraction)
     const lf_camera_type *t = lf_camera_find("plenoptic");
     const double stop_mm = 8, focus_m = 2, p_um = 100;
     lf_lens lens;
-    char err[512] = "";
-    if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
+    char err[512] = ""; /* the camera plugins' message buffer */
+    lf_error lerr = {0};
+    if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, &lerr)) {
+        CHECK_MSG(0, "%s", lerr.msg);
         return;
     }
     char warn[600];
     lf_lens_set_stop_diameter(&lens, stop_mm, warn, sizeof warn);
     lf_lens_paraxial px;
     CHECK(lf_lens_paraxial_analyse(&lens, &px) == 0);
-    CHECK(lf_lens_focus_thick(&lens, focus_m * 1e3, &lens.film_distance_mm, err, sizeof err) == 0);
+    CHECK(lf_lens_focus_thick(&lens, focus_m * 1e3, &lens.film_distance_mm, &lerr) == 0);
     double Nw = lf_lens_working_fnumber(&lens, &px, focus_m * 1e3, lens.film_distance_mm);
     double Z = lens.film_distance_mm - px.exit_pupil_mm; /* mm, MLA -> exit pupil */
     double p = p_um * 1e-3, fm = p * Nw * mla_scale, Pimg = p * (Z + fm) / Z;

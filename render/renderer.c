@@ -17,6 +17,7 @@
 #endif
 
 #include "../base/lf_keys.h"
+#include "../base/lf_parallel.h"
 #include "../base/lf_color.h"
 #include "film.h"
 #include "render_internal.h"
@@ -800,7 +801,6 @@ typedef struct job {
     lf_image *img;
     lf_pixel_acc *acc;        /* per-pixel sums when writing parts or checkpoints, else NULL */
     int tiles_x, tiles_y;
-    atomic_int next_tile;
     atomic_long done_tiles;
     atomic_uchar *tile_done;  /* 1 once a tile's pixels are final */
     int *order;               /* tiles still to render, in order */
@@ -971,8 +971,11 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
         }
 }
 
-static void *worker(void *arg)
+/* Tiles jb->order[k0, k1) (lf_parallel_fn: the threads take tiles one at a
+ * time, in order, from base/lf_parallel.h's counter). */
+static void render_tiles(void *arg, int k0, int k1, int tid)
 {
+    (void)tid;
     job *jb = arg;
 #if defined(__SSE__) || defined(__x86_64__)
     /* Denormals slow float math by orders of magnitude and carry no light. */
@@ -982,11 +985,8 @@ static void *worker(void *arg)
     long long rays = 0, paths = 0, nonfinite = 0, zero_weight = 0;
     int total = jb->tiles_x * jb->tiles_y;
     volatile int *stop = jb->r->opts.stop;
-    for (;;) {
+    for (int k = k0; k < k1; k++) {
         if (stop && *stop)
-            break;
-        int k = atomic_fetch_add(&jb->next_tile, 1);
-        if (k >= jb->n_order)
             break;
         int t = jb->order[k];
         render_tile(jb, t, &rays, &paths, &nonfinite, &zero_weight);
@@ -1002,7 +1002,6 @@ static void *worker(void *arg)
     atomic_fetch_add(&jb->paths, paths);
     atomic_fetch_add(&jb->nonfinite, nonfinite);
     atomic_fetch_add(&jb->zero_weight, zero_weight);
-    return NULL;
 }
 
 static void sink_string(void *ctx, const char *name, const char *value)
@@ -1259,37 +1258,16 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     atomic_store(&jb.done_tiles, total - jb.n_order);
     pthread_mutex_init(&jb.progress_lock, NULL);
     double t0 = now_seconds();
-    int nt = r->threads;
-    pthread_t *th = calloc((size_t)nt, sizeof *th);
-    if (!th) {
-        free(jb.tile_done), free(jb.order), free(jb.acc);
-        lf_image_free(img);
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-    }
     int rc = 0;
     if (!r->opts.checkpoint_path) {
-        /* the calling thread renders too */
-        for (int i = 1; i < nt; i++)
-            if (pthread_create(&th[i], NULL, worker, &jb) != 0)
-                th[i] = 0;
-        worker(&jb);
-        for (int i = 1; i < nt; i++)
-            if (th[i])
-                pthread_join(th[i], NULL);
+        lf_parallel_for(jb.n_order, r->threads, 1, render_tiles, &jb); /* the calling thread renders too */
     } else {
         /* the calling thread watches: periodic checkpoints and stop requests */
-        int started = 0;
-        for (int i = 0; i < nt; i++)
-            if (pthread_create(&th[i], NULL, worker, &jb) == 0)
-                started++;
-            else
-                th[i] = 0;
-        if (!started)
-            worker(&jb);
+        lf_parallel_job *pj = lf_parallel_start(jb.n_order, r->threads, 1, render_tiles, &jb);
         double last = now_seconds();
         for (;;) {
             long done = atomic_load(&jb.done_tiles);
-            if (done >= total || (r->opts.stop && *r->opts.stop) || !started)
+            if (done >= total || (r->opts.stop && *r->opts.stop))
                 break;
             struct timespec ts = {0, 20 * 1000 * 1000};
             nanosleep(&ts, NULL);
@@ -1300,9 +1278,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
                 last = now_seconds();
             }
         }
-        for (int i = 0; i < nt; i++)
-            if (th[i])
-                pthread_join(th[i], NULL);
+        lf_parallel_join(pj);
         if (atomic_load(&jb.done_tiles) < total) {
             /* stopped: the final checkpoint holds every finished tile */
             lf_error cerr = {0};
@@ -1315,7 +1291,6 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
                                   atomic_load(&jb.done_tiles), total, r->opts.checkpoint_path);
         }
     }
-    free(th);
     pthread_mutex_destroy(&jb.progress_lock);
     if (!rc && r->opts.part) {
         lf_image part;

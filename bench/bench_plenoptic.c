@@ -22,6 +22,7 @@
 
 #include "camera/lf_camera.h"
 #include "render/lf_render.h"
+#include "bench/bench_util.h"
 
 /* ---- a parameter store standing in for the scene file ---- */
 typedef struct kv {
@@ -77,25 +78,6 @@ static int g_image(void *c, const char *path, int *w, int *h, float **px, char *
     return -1;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 enum { W = 960, H = 640 };
 
 /* generate_ray calls per second, median over repeats; -1 if the camera fails */
@@ -117,7 +99,7 @@ static double camera_rate(const char *type, store *s, int repeats, double *zero_
     double rates[32], sink = 0;
     long zero = 0;
     for (int r = 0; r < repeats; r++) {
-        double t0 = now();
+        double t0 = lf_seconds();
         for (int k = 0; k < n; k++) {
             /* film point on a 1024 x 1024 lattice over the film, lens point by a
              * 2-d additive recurrence (R2), so both cover their domains */
@@ -129,13 +111,13 @@ static double camera_rate(const char *type, store *s, int repeats, double *zero_
             sink += w + ray.dir[2] * (w > 0);
             zero += !(w > 0);
         }
-        rates[r] = n / (now() - t0);
+        rates[r] = n / (lf_seconds() - t0);
     }
     if (sink == 12345.678)
         printf("(unlikely)\n");
     *zero_fraction = (double)zero / ((double)n * repeats);
     t->destroy(c);
-    return median(rates, repeats);
+    return bench_median(rates, repeats);
 }
 
 /* camera paths per second of a whole render of the demo world */
@@ -177,7 +159,7 @@ static double render_rate(const char *camera_line, int repeats)
         lf_renderer_free(rd);
         lf_scene_desc_free(&d);
     }
-    return median(rates, repeats);
+    return bench_median(rates, repeats);
 }
 
 int main(int argc, char **argv)

@@ -85,8 +85,10 @@ int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_re
 
 /* REPORT/gradebook.csv and REPORT/gradebook.json for n results. */
 int lf_grade_write_gradebook(const char *report_dir, const lf_grade_result *res, int n, lf_error *err);
-/* One result as a JSON object (malloc'ed). */
+/* One result as a JSON object (malloc'ed; NULL when memory runs out). */
 char *lf_grade_result_json(const lf_grade_result *r);
+/* How many of a result's checks failed. */
+int lf_grade_failed_checks(const lf_grade_result *r);
 
 /* ---- helpers shared with tests (and useful to build model submissions) ---- */
 

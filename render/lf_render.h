@@ -65,7 +65,8 @@ int lf_renderer_create(lf_scene_desc *desc, const lf_render_opts *opts, lf_rende
 void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts);
 /* Non-fatal notes gathered while building ("file:line:col: warning: ..."), or NULL. */
 const char *lf_renderer_warnings(const lf_renderer *r);
-/* The effect plan: camera model, which effects are simulated and why. malloc'ed. */
+/* The effect plan: camera model, which effects are simulated and why.
+ * malloc'ed; NULL when memory runs out. */
 char *lf_renderer_explain(const lf_renderer *r);
 /* Renders into *img (allocated here; the crop window's size) and fills meta
  * with lensfield:* attributes.  Samples whose radiance is NaN/Inf are

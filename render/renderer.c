@@ -16,8 +16,10 @@
 #include <xmmintrin.h>
 #endif
 
+#include "../base/lf_buf.h"
 #include "../base/lf_keys.h"
 #include "../base/lf_parallel.h"
+#include "../base/lf_progress.h"
 #include "../base/lf_color.h"
 #include "film.h"
 #include "render_internal.h"
@@ -676,37 +678,14 @@ void lf_renderer_free(lf_renderer *r)
 
 /* ---- the effect plan ---- */
 
-static void appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
-{
-    va_list ap;
-    for (;;) {
-        va_start(ap, fmt);
-        int n = vsnprintf(*buf ? *buf + *len : NULL, *buf ? *cap - *len : 0, fmt, ap);
-        va_end(ap);
-        if (n < 0)
-            return;
-        if (*buf && *len + (size_t)n < *cap) {
-            *len += (size_t)n;
-            return;
-        }
-        size_t nc = (*cap + (size_t)n + 256) * 2;
-        char *nb = realloc(*buf, nc);
-        if (!nb)
-            return;
-        *buf = nb;
-        *cap = nc;
-    }
-}
-
 char *lf_renderer_explain(const lf_renderer *r)
 {
-    char *b = NULL;
-    size_t len = 0, cap = 0;
+    lf_strbuf b = {0};
     const lf_scene *s = &r->scene;
-    appendf(&b, &len, &cap, "scene: %s\n", r->scene_path ? r->scene_path : "(memory)");
-    appendf(&b, &len, &cap, "film: %dx%d, rendering pixels [%d,%d) x [%d,%d), diagonal %g mm\n", r->xres, r->yres,
+    lf_strbuf_printf(&b, "scene: %s\n", r->scene_path ? r->scene_path : "(memory)");
+    lf_strbuf_printf(&b, "film: %dx%d, rendering pixels [%d,%d) x [%d,%d), diagonal %g mm\n", r->xres, r->yres,
             r->px0, r->px1, r->py0, r->py1, r->diagonal_mm);
-    appendf(&b, &len, &cap, "camera: \"%s\"\n", r->camera_name);
+    lf_strbuf_printf(&b, "camera: \"%s\"\n", r->camera_name);
     if (r->camera_type->describe) {
         char desc[4096];
         int n = r->camera_type->describe(r->camera, desc, sizeof desc);
@@ -716,39 +695,39 @@ char *lf_renderer_explain(const lf_renderer *r)
                 nl = strchr(line, '\n');
                 if (nl)
                     *nl = '\0';
-                appendf(&b, &len, &cap, "  %s\n", line);
+                lf_strbuf_printf(&b, "  %s\n", line);
                 line = nl ? nl + 1 : NULL;
             }
         }
     }
-    appendf(&b, &len, &cap, "effects:\n");
-    appendf(&b, &len, &cap, "  defocus: %s\n",
+    lf_strbuf_printf(&b, "effects:\n");
+    lf_strbuf_printf(&b, "  defocus: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_LENS ? "on (the camera samples its lens)"
                                                    : "off (pinhole: no lens samples drawn)");
     if (r->time_needed) {
         char shapes[512];
         lf_scene_motion_summary(s, shapes, sizeof shapes);
-        appendf(&b, &len, &cap, "  motion blur: on (%s; camera %s); one time sample per camera ray in [%g, %g]\n",
+        lf_strbuf_printf(&b, "  motion blur: on (%s; camera %s); one time sample per camera ray in [%g, %g]\n",
                 shapes, r->camera_moving ? "moving" : "static", r->shutter_open,
                 r->shutter_close + (r->rolling ? r->readout : 0));
     } else {
-        appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
+        lf_strbuf_printf(&b, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
                 r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");
     }
     if (r->rolling)
-        appendf(&b, &len, &cap, "  rolling shutter: on, readout %g s %s, exposure %g s per row%s\n", r->readout,
+        lf_strbuf_printf(&b, "  rolling shutter: on, readout %g s %s, exposure %g s per row%s\n", r->readout,
                 (const char *[]){"top to bottom", "bottom to top", "left to right", "right to left"}[r->readout_dir],
                 r->shutter_close - r->shutter_open, r->time_needed ? "" : " (nothing moves: no visible effect)");
     else
-        appendf(&b, &len, &cap, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
+        lf_strbuf_printf(&b, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
     if (r->has_curve)
-        appendf(&b, &len, &cap, "  shutter curve: mean efficiency %.4g, times importance-sampled\n", r->curve_mean);
-    appendf(&b, &len, &cap, "  dispersion: %s\n",
+        lf_strbuf_printf(&b, "  shutter curve: mean efficiency %.4g, times importance-sampled\n", r->curve_mean);
+    lf_strbuf_printf(&b, "  dispersion: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH ? "on (the camera samples wavelength)"
                                                          : "off (no wavelength samples)");
-    appendf(&b, &len, &cap, "  exposure: imaging ratio %g (shutter %g s x ISO/100)\n", r->imaging_ratio,
+    lf_strbuf_printf(&b, "  exposure: imaging ratio %g (shutter %g s x ISO/100)\n", r->imaging_ratio,
             r->shutter_close - r->shutter_open);
-    appendf(&b, &len, &cap, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
+    lf_strbuf_printf(&b, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
             r->sampler.kind == LF_SAMPLER_SOBOL        ? "Owen-scrambled Sobol, padded pairs"
             : r->sampler.kind == LF_SAMPLER_HALTON
                 ? (r->sampler.randomize == LF_HALTON_OWEN   ? "image-wide Halton, Owen-scrambled digits"
@@ -758,38 +737,42 @@ char *lf_renderer_explain(const lf_renderer *r)
             : r->sampler.kind == LF_SAMPLER_STRATIFIED ? "jittered strata"
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
-    appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
+    lf_strbuf_printf(&b, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
     char rr[96];
     snprintf(rr, sizeof rr, "Russian roulette %s after depth %d",
              r->integrator.rr_rule == LF_RR_SQRT ? "p = sqrt(max throughput)" : "p = max throughput (pbrt-v4)",
              r->integrator.rr_depth);
     if (s->has_media && r->integrator.volumetric)
-        appendf(&b, &len, &cap,
+        lf_strbuf_printf(&b,
                 "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, %s; %d "
                 "homogeneous media (closed-form transmittance, spectral-MIS distance sampling, Henyey-Greenstein), "
                 "camera in %s\n",
                 r->integrator_name, r->integrator.max_depth, rr, s->n_media,
                 s->camera_medium >= 0 ? "a medium" : "vacuum");
     else
-        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, %s%s\n",
+        lf_strbuf_printf(&b, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, %s%s\n",
                 r->integrator_name, r->integrator.max_depth, rr,
                 s->n_media ? " (media defined but no ray can enter one, or ignored by \"path\")" : "");
-    appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
+    lf_strbuf_printf(&b, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
     int counts[7] = {0};
     for (int i = 0; i < s->n_lights; i++)
         counts[s->lights[i].kind]++;
     lf_light_sampler lsm = lf_light_sampler_for(&r->integrator, s);
-    appendf(&b, &len, &cap,
+    lf_strbuf_printf(&b,
             "lights: %d (point %d, spot %d, distant %d, infinite %d, image infinite %d, area triangles %d, area "
             "spheres %d), %s\n",
             s->n_lights, counts[0], counts[1], counts[2], counts[3], counts[4], counts[5], counts[6],
             lsm == LF_LIGHTS_ALL       ? "every light sampled at every vertex (one shadow ray each)"
             : lsm == LF_LIGHTS_UNIFORM ? "one light per vertex, chosen uniformly"
                                        : "one light per vertex, chosen by power");
-    appendf(&b, &len, &cap, "threads: %d\n", r->threads);
-    return b;
+    lf_strbuf_printf(&b, "threads: %d\n", r->threads);
+    if (b.failed) { /* out of memory: no half a plan */
+        lf_strbuf_free(&b);
+        return NULL;
+    }
+    return lf_strbuf_take(&b);
 }
 
 /* ---- rendering ---- */
@@ -1072,13 +1055,6 @@ int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err)
     return LF_OK;
 }
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 /* ---- parts and checkpoints ---- */
 
 /* The image written for parts and checkpoints: RGB preview, then the four
@@ -1257,25 +1233,25 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
             jb.order[jb.n_order++] = t;
     atomic_store(&jb.done_tiles, total - jb.n_order);
     pthread_mutex_init(&jb.progress_lock, NULL);
-    double t0 = now_seconds();
+    double t0 = lf_seconds();
     int rc = 0;
     if (!r->opts.checkpoint_path) {
         lf_parallel_for(jb.n_order, r->threads, 1, render_tiles, &jb); /* the calling thread renders too */
     } else {
         /* the calling thread watches: periodic checkpoints and stop requests */
         lf_parallel_job *pj = lf_parallel_start(jb.n_order, r->threads, 1, render_tiles, &jb);
-        double last = now_seconds();
+        double last = lf_seconds();
         for (;;) {
             long done = atomic_load(&jb.done_tiles);
             if (done >= total || (r->opts.stop && *r->opts.stop))
                 break;
             struct timespec ts = {0, 20 * 1000 * 1000};
             nanosleep(&ts, NULL);
-            if (r->opts.checkpoint_every > 0 && now_seconds() - last >= r->opts.checkpoint_every) {
+            if (r->opts.checkpoint_every > 0 && lf_seconds() - last >= r->opts.checkpoint_every) {
                 lf_error cerr = {0};
                 if (write_checkpoint(r, &jb, &cerr) && !rc)
                     rc = lf_error_set(err, cerr.code, "checkpoint: %s", cerr.msg);
-                last = now_seconds();
+                last = lf_seconds();
             }
         }
         lf_parallel_join(pj);
@@ -1308,7 +1284,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
         lf_image_free(img);
         return rc;
     }
-    r->stats.seconds = now_seconds() - t0;
+    r->stats.seconds = lf_seconds() - t0;
     r->stats.rays = jb.rays;
     r->stats.camera_paths = jb.paths;
     r->stats.nonfinite_samples = jb.nonfinite;

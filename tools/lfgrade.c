@@ -54,21 +54,19 @@ static int run_grade(int n, char **pos)
             continue;
         }
         const lf_grade_result *r = &res[graded++];
-        int lost = 0;
-        for (int k = 0; k < r->nchecks; k++)
-            lost += r->checks[k].status == LF_GRADE_FAIL;
+        int lost = lf_grade_failed_checks(r);
         fprintf(stderr, "[%d/%d] %s: %d/%d (%d check%s failed, %.2f s)\n", i + 1, nsubs, r->student, r->score,
                 r->max, lost, lost == 1 ? "" : "s", r->seconds);
         for (int k = 0; k < r->nchecks; k++)
             if (r->checks[k].status == LF_GRADE_FAIL)
                 fprintf(stderr, "    %s -%d: %s\n", r->checks[k].id, r->checks[k].points - r->checks[k].earned,
                         r->checks[k].reason);
-        if (opt.json) {
-            char *j = lf_grade_result_json(r);
-            if (j)
-                printf("%s\n", j);
-            free(j);
-        }
+        char *j = opt.json ? lf_grade_result_json(r) : NULL;
+        if (j)
+            printf("%s\n", j);
+        else if (opt.json)
+            fprintf(stderr, "lfgrade: %s: out of memory for the JSON result\n", r->student);
+        free(j);
     }
     if (opt.report && graded) {
         if (lf_grade_write_gradebook(opt.report, res, graded, &err)) {

@@ -166,9 +166,12 @@ static int run_render(int n, char **pos)
     rc = -1;
     if (opt.explain) {
         char *plan = lf_renderer_explain(r);
-        fputs(plan ? plan : "", stdout);
+        if (plan)
+            fputs(plan, stdout);
+        else
+            fprintf(stderr, "lfrender: out of memory for the effect plan\n");
         free(plan);
-        rc = 0;
+        rc = plan ? 0 : 1;
     }
     if (!out)
         out = lf_renderer_film_filename(r);

@@ -234,20 +234,20 @@ int lf_grade_post(const char *op, lf_image *img, lf_error *err)
     return lf_error_set(err, LF_ERR_PARAM, "unknown post-processing op '%s'", op);
 }
 
+/* Clips the region [x0,x1) x [y0,y1) to the image. */
+static void clip_region(const lf_image *im, int *x0, int *y0, int *x1, int *y1)
+{
+    *x0 = *x0 < 0 ? 0 : *x0, *y0 = *y0 < 0 ? 0 : *y0;
+    *x1 = *x1 > im->width ? im->width : *x1, *y1 = *y1 > im->height ? im->height : *y1;
+}
+
 /* Contrast energy of a region: mean over pixels of the squared differences
  * of Rec. 709 luminance to the right and lower neighbours, over the squared
  * mean luminance (scale-free, so an exposure change does not move it).
  * Defocus blur lowers it; noise raises it a little. */
 double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1)
 {
-    if (x0 < 0)
-        x0 = 0;
-    if (y0 < 0)
-        y0 = 0;
-    if (x1 > im->width)
-        x1 = im->width;
-    if (y1 > im->height)
-        y1 = im->height;
+    clip_region(im, &x0, &y0, &x1, &y1);
     double e = 0, m = 0;
     long n = 0;
     int c = im->channels;
@@ -417,14 +417,7 @@ double lf_grade_fit_blur(const lf_image *S, const lf_image *A)
  * as n equal discs.  0 when the region holds no highlight. */
 double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n)
 {
-    if (x0 < 0)
-        x0 = 0;
-    if (y0 < 0)
-        y0 = 0;
-    if (x1 > im->width)
-        x1 = im->width;
-    if (y1 > im->height)
-        y1 = im->height;
+    clip_region(im, &x0, &y0, &x1, &y1);
     if (x1 <= x0 || y1 <= y0 || n < 1)
         return 0;
     size_t m = (size_t)(x1 - x0) * (y1 - y0), k = 0;

@@ -96,6 +96,32 @@ static void where_of(char *buf, size_t n, const lf_loc *loc)
     snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
 }
 
+/* An options-block directive (Film, Sampler, PixelFilter, Integrator,
+ * Camera) as the readers take it: its parameters (an empty list when the
+ * scene leaves the directive out), its type or pbrt's default, and
+ * "file:line:col" for messages. */
+typedef struct option_entity {
+    lf_paramset *ps, empty;
+    const char *type;
+    char where[512];
+} option_entity;
+
+static void option_entity_init(option_entity *o, lf_entity *e, const char *default_type)
+{
+    memset(&o->empty, 0, sizeof o->empty);
+    o->ps = e->type ? &e->params : &o->empty;
+    o->type = e->type ? e->type : default_type;
+    where_of(o->where, sizeof o->where, &e->loc);
+}
+
+/* Reports the directive's unused or mistyped parameters ("Sampler \"halton\""). */
+static int option_entity_finish(const option_entity *o, const char *directive, lf_error *err)
+{
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "%s \"%s\"", directive, o->type);
+    return lf_params_finish(o->ps, ctx, err);
+}
+
 /* ---- camera parameter adaptor (the plugin ABI's lf_camera_params) ---- */
 typedef struct camera_param_ctx {
     lf_paramset *ps;
@@ -170,10 +196,10 @@ static int cp_floats(void *ctx, const char *name, double *out, int max)
 static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_entity *f = &d->film;
-    lf_paramset empty = {0};
-    lf_paramset *ps = f->type ? &f->params : &empty;
-    char where[512];
-    where_of(where, sizeof where, &f->loc);
+    option_entity oe;
+    option_entity_init(&oe, f, "rgb");
+    lf_paramset *ps = oe.ps;
+    const char *where = oe.where;
     if (f->type && strcmp(f->type, "rgb") != 0)
         lf_warn_append(&r->warnings, "%s: warning: Film \"%s\" is rendered as Film \"rgb\"", where, f->type);
     r->xres = lf_params_int(ps, "xresolution", 1280);
@@ -220,12 +246,10 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 
 static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->sampler;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "zsobol";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->sampler, "zsobol");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     r->sampler.spp = lf_params_int(ps, "pixelsamples", 16);
     r->sampler.seed = (uint32_t)lf_params_int(ps, "seed", 0);
     if (!strcmp(type, "halton")) {
@@ -294,19 +318,15 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     }
     if (lf_sampler_prepare(&r->sampler, r->xres, r->yres))
         return lf_error_set(err, LF_ERR_NOMEM, "%s: cannot prepare Sampler \"%s\" (out of memory)", where, type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Sampler \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Sampler", err);
 }
 
 static int read_filter(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->filter;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "gaussian";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->filter, "gaussian");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     static const struct {
         const char *name;
         lf_filter_kind kind;
@@ -335,19 +355,15 @@ static int read_filter(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (lf_filter_init(&r->filter, kinds[k].kind, &fp, err))
         return err->code;
     r->filter_name = dupstr(type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "PixelFilter \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "PixelFilter", err);
 }
 
 static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->integrator;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "volpath";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->integrator, "volpath");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     if (!strcmp(type, "ambientocclusion") || !strcmp(type, "aov"))
         return lf_error_set(err, LF_ERR_UNSUPPORTED,
                             "%s: Integrator \"%s\" is not supported (it computes something other than radiance)", where,
@@ -391,19 +407,16 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (r->integrator.max_depth < 0)
         return lf_error_set(err, LF_ERR_PARAM, "%s: maxdepth must be >= 0", where);
     r->integrator_name = dupstr(type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Integrator \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Integrator", err);
 }
 
 static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_camera_desc *cd = &d->camera;
-    lf_paramset empty = {0};
-    lf_paramset *ps = cd->e.type ? &cd->e.params : &empty;
-    const char *type = cd->e.type ? cd->e.type : "perspective";
-    char where[512];
-    where_of(where, sizeof where, &cd->e.loc);
+    option_entity oe;
+    option_entity_init(&oe, &cd->e, "perspective");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     r->camera_type = lf_camera_find(type);
     if (!r->camera_type) {
         char names[512] = "";
@@ -523,9 +536,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         lf_motion_pair_prepare(&r->camera_keys[0], &r->camera_keys[1], &r->camera_motion);
         r->camera_moving = 1;
     }
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Camera \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Camera", err);
 }
 
 int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer **out, lf_error *err)

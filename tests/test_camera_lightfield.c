@@ -17,53 +17,8 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- a parameter store standing in for the scene file ---- */
-typedef struct kv {
-    const char *name;
-    double v[4];
-    int n;
-    const char *str;
-} kv;
-typedef struct store {
-    kv items[12];
-    int n;
-} store;
+#include "tests/camera_store.h"
 
-static const kv *find(store *s, const char *name)
-{
-    for (int i = 0; i < s->n; i++)
-        if (!strcmp(s->items[i].name, name))
-            return &s->items[i];
-    return NULL;
-}
-static double g_float(void *c, const char *name, double def)
-{
-    const kv *k = find(c, name);
-    return k ? k->v[0] : def;
-}
-static int g_int(void *c, const char *name, int def)
-{
-    const kv *k = find(c, name);
-    return k ? (int)k->v[0] : def;
-}
-static int g_bool(void *c, const char *name, int def)
-{
-    return g_int(c, name, def);
-}
-static const char *g_string(void *c, const char *name, const char *def)
-{
-    const kv *k = find(c, name);
-    return k && k->str ? k->str : def;
-}
-static int g_floats(void *c, const char *name, double *out, int max)
-{
-    const kv *k = find(c, name);
-    if (!k || k->str)
-        return 0;
-    for (int i = 0; i < k->n && i < max; i++)
-        out[i] = k->v[i];
-    return k->n;
-}
 static int g_image(void *c, const char *path, int *w, int *h, float **px, char *err, size_t n)
 {
     (void)c, (void)w, (void)h, (void)px;

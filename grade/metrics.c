@@ -21,6 +21,18 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* The mean of v[0..n) without its `drop` largest values (sorts v): robust to
+ * a few fireflies. */
+static double trimmed_mean(double *v, size_t n, size_t drop)
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    size_t keep = n - drop;
+    double sum = 0;
+    for (size_t i = 0; i < keep; i++)
+        sum += v[i];
+    return keep ? sum / (double)keep : 0;
+}
+
 double lf_grade_relmse(const lf_image *a, const lf_image *ref)
 {
     if (a->width != ref->width || a->height != ref->height)
@@ -41,13 +53,9 @@ double lf_grade_relmse(const lf_image *a, const lf_image *ref)
         }
         e[i] = isfinite(s) ? s / ch : 1e30;
     }
-    qsort(e, np, sizeof *e, cmp_double);
-    size_t keep = np - np / 1000;
-    double sum = 0;
-    for (size_t i = 0; i < keep; i++)
-        sum += e[i];
+    double m = trimmed_mean(e, np, np / 1000);
     free(e);
-    return keep ? sum / (double)keep : 0;
+    return m;
 }
 
 /* Per-pixel squared error of x against reference a, in units of the local
@@ -107,13 +115,9 @@ double lf_grade_noise_ratio(const lf_image *x, const lf_image *ref, const lf_ima
     if (!t)
         return INFINITY;
     size_t np = (size_t)a->width * a->height;
-    qsort(t, np, sizeof *t, cmp_double);
-    size_t keep = np - np / 200;
-    double sum = 0;
-    for (size_t i = 0; i < keep; i++)
-        sum += t[i];
+    double m = trimmed_mean(t, np, np / 200);
     free(t);
-    return keep ? sum / (double)keep : 0;
+    return m;
 }
 
 static double luma8(const lf_image *im, size_t i)

@@ -74,6 +74,11 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
 int lf_lf_write_stack(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
                       const char *dir, const char *ext, const lf_write_opts *wo, lf_error *err);
 
+/* Writes a refocused image with lensfield:refocus_disparity_px, the
+ * disparity (px per view step) it is focused at. */
+int lf_lf_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
+                          lf_error *err);
+
 /* Writes the centre view's disparity map disp (1 channel, searched over
  * [d0, d1]): EXR/PFM get the values, with lensfield:disparity_search_range
  * and lensfield:disparity_convention; PNG/JPEG a picture of them, the

@@ -217,6 +217,17 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
     return rc;
 }
 
+int lf_lf_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
+                          lf_error *err)
+{
+    lf_attrs a = {0};
+    int rc = lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, disparity_px)
+                 ? lf_error_set(err, LF_ERR_NOMEM, "cannot write '%s': out of memory", path)
+                 : lf_image_write(path, img, &a, wo, err);
+    lf_attrs_free(&a);
+    return rc;
+}
+
 int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
                           lf_error *err)
 {

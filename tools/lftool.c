@@ -406,11 +406,11 @@ static int cmd_refocus(int n, char **pos)
         rc = fail(&err, o->input);
         goto done;
     }
-    lf_attrs a = {0};
-    lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
-    if (!(rc = write_image(o->output, &out, &a)))
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    if (lf_lf_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
+        rc = fail(&err, NULL);
+    else
         printf("%s: refocused at disparity %.6g px/view -> %s\n", o->input, ro.disparity_px, o->output);
-    lf_attrs_free(&a);
 done:
     lf_image_free(&out);
     lf_lf_close(&s);
@@ -446,10 +446,8 @@ static int cmd_stack(int n, char **pos)
         }
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
-        lf_attrs a = {0};
-        lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
-        rc = write_image(path, &out, &a);
-        lf_attrs_free(&a);
+        lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+        rc = lf_lf_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
         lf_image_free(&out);
     }
     if (!rc)
@@ -727,11 +725,9 @@ static int cmd_serve(int n, char **pos)
     sigaction(SIGTERM, &sa, NULL);
     printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", lf_web_server_root(srv), lf_web_server_port(srv));
     fflush(stdout);
-    int rc = LF_OK;
-    while (!serve_stop && (rc == LF_OK || rc == LF_ERR_INTERRUPTED))
-        rc = lf_web_server_serve_one(srv, &err);
+    int rc = lf_web_server_run(srv, &serve_stop, &err);
     lf_web_server_close(srv);
-    if (rc != LF_OK && rc != LF_ERR_INTERRUPTED) {
+    if (rc) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
         return EXIT_INPUT;
     }

@@ -138,6 +138,12 @@ static void test_open_and_views(void)
     const lf_attr *r = lf_attrs_get(&a, LF_KEY_DISPARITY_SEARCH_RANGE);
     CHECK(r && r->type == LF_ATTR_FLOATS && r->n == 2 && r->v[0] == -1 && r->v[1] == 1);
     lf_image_free(&m), lf_attrs_free(&a);
+    snprintf(p, sizeof p, "%s/refocused.exr", dir);
+    CHECK(lf_lf_write_refocused(p, &disp, -0.75, NULL, &err) == 0);
+    CHECK(lf_image_read(p, &m, &a, &err) == 0 && m.data[3] == disp.data[3]);
+    r = lf_attrs_get(&a, LF_KEY_REFOCUS_DISPARITY_PX);
+    CHECK(r && (r->type == LF_ATTR_DOUBLE || r->type == LF_ATTR_FLOAT) && r->d == -0.75);
+    lf_image_free(&m), lf_attrs_free(&a);
     snprintf(p, sizeof p, "%s/disp.png", dir);
     CHECK(lf_lf_write_disparity(p, &disp, -1, 1, NULL, &err) == 0);
     CHECK(lf_image_read(p, &m, NULL, &err) == 0 && m.channels >= 3 && m.width == TW && m.height == TH);

@@ -11,19 +11,20 @@
 
 #include "lf_buf.h"
 
-static lf_args_status fail(char *err, size_t err_size, const char *fmt, ...)
+static lf_args_status fail(lf_error *err, const char *fmt, ...)
 #if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
+    __attribute__((format(printf, 2, 3)))
 #endif
     ;
 
-static lf_args_status fail(char *err, size_t err_size, const char *fmt, ...)
+static lf_args_status fail(lf_error *err, const char *fmt, ...)
 {
-    if (err && err_size) {
+    if (err && !err->code) { /* the first message stays, as lf_error_set */
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err, err_size, fmt, ap);
+        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
         va_end(ap);
+        err->code = LF_ERR_PARAM;
     }
     return LF_ARGS_ERROR;
 }
@@ -94,7 +95,7 @@ static int choice_ok(const char *choices, const char *v)
 }
 
 /* One value of flag a into slot k. */
-static lf_args_status store(const lf_arg *a, int k, const char *text, char *err, size_t err_size)
+static lf_args_status store(const lf_arg *a, int k, const char *text, lf_error *err)
 {
     char range[160];
     switch (a->type) {
@@ -104,7 +105,7 @@ static lf_args_status store(const lf_arg *a, int k, const char *text, char *err,
         long v = strtol(text, &end, 10);
         if (end == text || *end || errno == ERANGE || v < INT_MIN || v > INT_MAX || !in_range(a, (double)v)) {
             describe_range(a, range, sizeof range);
-            return fail(err, err_size, "%s wants %s, got \"%s\"", a->name, range, text);
+            return fail(err, "%s wants %s, got \"%s\"", a->name, range, text);
         }
         ((int *)a->value)[k] = (int)v;
         return LF_ARGS_OK;
@@ -115,7 +116,7 @@ static lf_args_status store(const lf_arg *a, int k, const char *text, char *err,
         long long v = strtoll(text, &end, 10);
         if (end == text || *end || errno == ERANGE || !in_range(a, (double)v)) {
             describe_range(a, range, sizeof range);
-            return fail(err, err_size, "%s wants %s, got \"%s\"", a->name, range, text);
+            return fail(err, "%s wants %s, got \"%s\"", a->name, range, text);
         }
         ((long long *)a->value)[k] = v;
         return LF_ARGS_OK;
@@ -128,14 +129,14 @@ static lf_args_status store(const lf_arg *a, int k, const char *text, char *err,
         if (end == text || *end || isnan(v) || (isinf(v) && !inf_ok) || (errno == ERANGE && !isinf(v) && v != 0) ||
             !in_range(a, v)) {
             describe_range(a, range, sizeof range);
-            return fail(err, err_size, "%s wants %s, got \"%s\"", a->name, range, text);
+            return fail(err, "%s wants %s, got \"%s\"", a->name, range, text);
         }
         ((double *)a->value)[k] = v;
         return LF_ARGS_OK;
     }
     case LF_ARG_CHOICE:
         if (!choice_ok(a->choices, text))
-            return fail(err, err_size, "%s wants one of %s, got \"%s\"", a->name, a->choices, text);
+            return fail(err, "%s wants one of %s, got \"%s\"", a->name, a->choices, text);
         *(const char **)a->value = text;
         return LF_ARGS_OK;
     case LF_ARG_STRING:
@@ -144,14 +145,14 @@ static lf_args_status store(const lf_arg *a, int k, const char *text, char *err,
     case LF_ARG_LIST: {
         int cap = a->count > 0 ? a->count : 1;
         if (*a->count_out >= cap)
-            return fail(err, err_size, "%s is given more than %d times", a->name, cap);
+            return fail(err, "%s is given more than %d times", a->name, cap);
         ((const char **)a->value)[(*a->count_out)++] = text;
         return LF_ARGS_OK;
     }
     case LF_ARG_FLAG:
         break;
     }
-    return fail(err, err_size, "%s takes no value", a->name);
+    return fail(err, "%s takes no value", a->name);
 }
 
 static const lf_arg *find_arg(const lf_command *cmd, const char *name, size_t len)
@@ -175,27 +176,26 @@ static int looks_like_flag(const char *s)
     return 1;
 }
 
-static lf_args_status unknown(const lf_tool *tool, const lf_command *cmd, const char *flag, size_t len, char *err,
-                              size_t err_size)
+static lf_args_status unknown(const lf_tool *tool, const lf_command *cmd, const char *flag, size_t len,
+                              lf_error *err)
 {
     for (int i = 0; tool && i < tool->n_commands; i++) {
         const lf_command *o = &tool->commands[i];
         if (o != cmd && o->name && find_arg(o, flag, len))
-            return fail(err, err_size, "%.*s is a flag of `%s %s`, not of `%s%s%s`", (int)len, flag, tool->name,
+            return fail(err, "%.*s is a flag of `%s %s`, not of `%s%s%s`", (int)len, flag, tool->name,
                         o->name, tool->name, cmd->name ? " " : "", cmd->name ? cmd->name : "");
     }
-    return fail(err, err_size, "unknown flag %.*s", (int)len, flag);
+    return fail(err, "unknown flag %.*s", (int)len, flag);
 }
 
 lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int argc, char **argv, int first,
-                             char **positional, int *n_positional, char *err, size_t err_size)
+                             char **positional, int *n_positional, lf_error *err)
 {
-    if (err && err_size)
-        err[0] = '\0';
+    lf_error_clear(err);
     *n_positional = 0;
     unsigned char seen[256] = {0};
     if (cmd->n_args > (int)sizeof seen)
-        return fail(err, err_size, "internal: more than %d flags in one command", (int)sizeof seen);
+        return fail(err, "internal: more than %d flags in one command", (int)sizeof seen);
     for (int i = 0; i < cmd->n_args; i++) {
         if (cmd->args[i].given)
             *cmd->args[i].given = 0;
@@ -221,19 +221,19 @@ lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int arg
         size_t len = eq ? (size_t)(eq - w) : strlen(w);
         const lf_arg *a = find_arg(cmd, w, len);
         if (!a)
-            return unknown(tool, cmd, w, len, err, err_size);
+            return unknown(tool, cmd, w, len, err);
         seen[a - cmd->args] = 1;
         if (a->given)
             *a->given = 1;
         if (a->type == LF_ARG_FLAG) {
             if (eq)
-                return fail(err, err_size, "%s takes no value", a->name);
+                return fail(err, "%s takes no value", a->name);
             *(int *)a->value = 1;
             continue;
         }
         int nval = (a->type == LF_ARG_INT || a->type == LF_ARG_DOUBLE) && a->count > 1 ? a->count : 1;
         if (eq && nval != 1)
-            return fail(err, err_size, "%s takes %d values (%s %s ...)", a->name, nval, a->name,
+            return fail(err, "%s takes %d values (%s %s ...)", a->name, nval, a->name,
                         a->metavar ? a->metavar : "V");
         for (int k = 0; k < nval; k++) {
             const char *text;
@@ -242,12 +242,12 @@ lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int arg
             } else {
                 if (i + 1 >= argc) {
                     if (nval > 1)
-                        return fail(err, err_size, "%s takes %d values, got %d", a->name, nval, k);
-                    return fail(err, err_size, "%s needs a value (%s)", a->name, a->metavar ? a->metavar : "value");
+                        return fail(err, "%s takes %d values, got %d", a->name, nval, k);
+                    return fail(err, "%s needs a value (%s)", a->name, a->metavar ? a->metavar : "value");
                 }
                 text = argv[++i];
             }
-            lf_args_status st = store(a, k, text, err, err_size);
+            lf_args_status st = store(a, k, text, err);
             if (st != LF_ARGS_OK)
                 return st;
         }
@@ -255,12 +255,12 @@ lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int arg
     for (int i = 0; i < cmd->n_args; i++) {
         const lf_arg *a = &cmd->args[i];
         if ((a->flags & LF_ARG_REQUIRED) && !seen[i])
-            return fail(err, err_size, "%s is required", a->name);
+            return fail(err, "%s is required", a->name);
     }
     if (*n_positional < cmd->min_positional)
-        return fail(err, err_size, "missing argument%s (see the usage below)", cmd->min_positional > 1 ? "s" : "");
+        return fail(err, "missing argument%s (see the usage below)", cmd->min_positional > 1 ? "s" : "");
     if (cmd->max_positional >= 0 && *n_positional > cmd->max_positional)
-        return fail(err, err_size, "unexpected argument \"%s\"", positional[cmd->max_positional]);
+        return fail(err, "unexpected argument \"%s\"", positional[cmd->max_positional]);
     return LF_ARGS_OK;
 }
 

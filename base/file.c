@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -191,4 +192,10 @@ int lf_file_read(const char *path, size_t max_bytes, char **data, size_t *len, i
     *data = buf;
     *len = n;
     return LF_OK;
+}
+
+int lf_path_has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && !strcasecmp(path + n - e, ext);
 }

@@ -143,3 +143,47 @@ int lf_file_write_atomic(const char *path, const void *data, size_t len, lf_erro
         unlink(tmp);
     return rc;
 }
+
+int lf_dir_create(const char *dir, lf_error *err)
+{
+    if (mkdir(dir, 0777) && errno != EEXIST)
+        return lf_error_set(err, LF_ERR_IO, "cannot create directory %s: %s", dir, strerror(errno));
+    return LF_OK;
+}
+
+int lf_dir_create_parents(const char *path, lf_error *err)
+{
+    char buf[PATH_MAX];
+    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf)
+        return lf_error_set(err, LF_ERR_PARAM, "path too long: %s", path);
+    char *slash = strrchr(buf, '/');
+    if (!slash || slash == buf)
+        return LF_OK;
+    *slash = '\0';
+    for (char *p = buf + 1;; p++)
+        if (*p == '/' || !*p) {
+            char c = *p;
+            *p = '\0';
+            if (mkdir(buf, 0777) && errno != EEXIST)
+                return lf_error_set(err, LF_ERR_IO, "cannot create the directory of %s: %s", path, strerror(errno));
+            if (!c)
+                return LF_OK;
+            *p = c;
+        }
+}
+
+int lf_file_check_writable(const char *path, lf_error *err)
+{
+    if (lf_dir_create_parents(path, err))
+        return err ? err->code : LF_ERR_IO;
+    char probe[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    int dir_len = slash ? (int)(slash - path) : 0;
+    snprintf(probe, sizeof probe, "%.*s%s.lensfield-probe-%ld", dir_len, path, slash ? "/" : "", (long)getpid());
+    FILE *f = fopen(probe, "wb");
+    if (!f)
+        return lf_error_set(err, LF_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+    fclose(f);
+    remove(probe);
+    return LF_OK;
+}

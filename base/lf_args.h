@@ -30,6 +30,8 @@
 
 #include <stddef.h>
 
+#include "lf_error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -104,9 +106,10 @@ const lf_command *lf_args_find(const lf_tool *tool, const char *name);
 
 /* Parses argv[first..argc) against cmd's flags.  Positional arguments are
  * collected in order into positional[] (room for argc entries is enough);
- * *n_positional counts them.  err gets a one-line message on LF_ARGS_ERROR. */
+ * *n_positional counts them.  err (cleared first) gets a one-line message
+ * and LF_ERR_PARAM on LF_ARGS_ERROR. */
 lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int argc, char **argv, int first,
-                             char **positional, int *n_positional, char *err, size_t err_size);
+                             char **positional, int *n_positional, lf_error *err);
 
 /* Usage text of one command (cmd) or of the whole tool (cmd NULL), ending
  * in a newline.  malloc'd (free it); NULL when memory runs out. */

@@ -43,6 +43,8 @@ int lf_gunzip(const unsigned char *in, size_t in_len, const char *name, size_t m
 
 /* 1 if the buffer starts with the gzip magic bytes 1f 8b. */
 int lf_is_gzip(const void *buf, size_t len);
+/* 1 when path ends in ext (".exr"), ignoring case. */
+int lf_path_has_ext(const char *path, const char *ext);
 
 #ifdef __cplusplus
 }

@@ -33,6 +33,14 @@ int lf_file_temp_commit(const char *tmp, const char *path, lf_error *err);
 /* Writes len bytes to path atomically. */
 int lf_file_write_atomic(const char *path, const void *data, size_t len, lf_error *err);
 
+/* Creates the directory dir (its parent must exist); one that exists is fine. */
+int lf_dir_create(const char *dir, lf_error *err);
+/* Creates the directories leading to the file path (mkdir -p of its folder). */
+int lf_dir_create_parents(const char *path, lf_error *err);
+/* Before long work: creates path's folder and a probe file beside path
+ * (removed again), so an unwritable output fails now, not at the end. */
+int lf_file_check_writable(const char *path, lf_error *err);
+
 #ifdef __cplusplus
 }
 #endif

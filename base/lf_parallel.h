@@ -6,7 +6,7 @@
 #ifndef LF_PARALLEL_H
 #define LF_PARALLEL_H
 
-#define LF_PARALLEL_MAX_THREADS 64 /* tid < this: size per-thread scratch with it */
+#define LF_PARALLEL_MAX_THREADS 1024 /* tid < this; size per-thread scratch with lf_parallel_threads() */
 
 typedef void (*lf_parallel_fn)(void *ctx, int i0, int i1, int tid);
 
@@ -15,5 +15,17 @@ typedef void (*lf_parallel_fn)(void *ctx, int i0, int i1, int tid);
  * an item never changes what the item computes, so results that are a
  * function of the item alone are the same for any thread count. */
 int lf_parallel_for(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx);
+/* The thread count lf_parallel_for(n, threads, ...) uses (tid < it). */
+int lf_parallel_threads(int threads);
+
+/* The same loop in the background, for a caller that watches while it runs
+ * (the renderer's checkpoints): `threads` new threads (tid 0 .. threads-1)
+ * take the items and lf_parallel_start returns at once; the caller does not
+ * take part.  When no thread can be created the loop runs on the calling
+ * thread before lf_parallel_start returns.  lf_parallel_join waits for
+ * every item and frees the job (NULL is fine). */
+typedef struct lf_parallel_job lf_parallel_job;
+lf_parallel_job *lf_parallel_start(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx);
+void lf_parallel_join(lf_parallel_job *job);
 
 #endif

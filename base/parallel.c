@@ -1,6 +1,7 @@
 /* A parallel for on pthreads (lf_parallel.h). */
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 #include "lf_parallel.h"
@@ -33,29 +34,80 @@ static void *par_worker(void *arg)
     return NULL;
 }
 
-int lf_parallel_for(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx)
+int lf_parallel_threads(int threads)
 {
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int nth = threads > 0 ? threads : (cores > 0 ? (int)cores : 1);
-    if (nth > MAX_THREADS)
-        nth = MAX_THREADS;
-    if (chunk <= 0)
-        chunk = 1;
-    if (n <= 0)
-        return nth;
+    return nth > MAX_THREADS ? MAX_THREADS : nth;
+}
+
+/* A loop's shared counter and its threads (tid 0 may be the caller). */
+struct lf_parallel_job {
     par_shared s;
-    atomic_init(&s.next, 0);
-    s.n = n, s.chunk = chunk, s.fn = fn, s.ctx = ctx;
+    int nth;
     par_job jobs[MAX_THREADS];
     pthread_t tid[MAX_THREADS];
-    int created[MAX_THREADS] = {0};
-    for (int t = 0; t < nth; t++)
-        jobs[t] = (par_job){&s, t};
-    for (int t = 1; t < nth; t++)
-        created[t] = pthread_create(&tid[t], NULL, par_worker, &jobs[t]) == 0;
-    par_worker(&jobs[0]);
-    for (int t = 1; t < nth; t++)
-        if (created[t])
-            pthread_join(tid[t], NULL);
+    int created[MAX_THREADS];
+};
+
+static void job_init(lf_parallel_job *j, int n, int nth, int chunk, lf_parallel_fn fn, void *ctx)
+{
+    atomic_init(&j->s.next, 0);
+    j->s.n = n, j->s.chunk = chunk > 0 ? chunk : 1, j->s.fn = fn, j->s.ctx = ctx;
+    j->nth = nth;
+    for (int t = 0; t < nth; t++) {
+        j->jobs[t] = (par_job){&j->s, t};
+        j->created[t] = 0;
+    }
+}
+
+/* Threads first..nth-1; returns how many were created. */
+static int job_spawn(lf_parallel_job *j, int first)
+{
+    int started = 0;
+    for (int t = first; t < j->nth; t++)
+        started += j->created[t] = pthread_create(&j->tid[t], NULL, par_worker, &j->jobs[t]) == 0;
+    return started;
+}
+
+static void job_wait(lf_parallel_job *j)
+{
+    for (int t = 0; t < j->nth; t++)
+        if (j->created[t])
+            pthread_join(j->tid[t], NULL);
+}
+
+int lf_parallel_for(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx)
+{
+    int nth = lf_parallel_threads(threads);
+    if (n <= 0)
+        return nth;
+    lf_parallel_job j;
+    job_init(&j, n, nth, chunk, fn, ctx);
+    job_spawn(&j, 1);
+    par_worker(&j.jobs[0]); /* takes items until none is left, also those of threads not created */
+    job_wait(&j);
     return nth;
+}
+
+lf_parallel_job *lf_parallel_start(int n, int threads, int chunk, lf_parallel_fn fn, void *ctx)
+{
+    int nth = lf_parallel_threads(threads);
+    lf_parallel_job *j = malloc(sizeof *j);
+    if (!j) { /* no memory for the job: run the loop here */
+        lf_parallel_for(n, 1, chunk, fn, ctx);
+        return NULL;
+    }
+    job_init(j, n > 0 ? n : 0, nth, chunk, fn, ctx);
+    if (n > 0 && !job_spawn(j, 0))
+        par_worker(&j->jobs[0]);
+    return j;
+}
+
+void lf_parallel_join(lf_parallel_job *job)
+{
+    if (!job)
+        return;
+    job_wait(job);
+    free(job);
 }

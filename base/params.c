@@ -268,13 +268,9 @@ int lf_params_vector3(lf_paramset *ps, const char *name, double out[3])
 const double *lf_params_nums(lf_paramset *ps, const char *name, lf_param_type type, size_t *count)
 {
     *count = 0;
-    lf_param *p = lf_params_find(ps, name);
+    lf_param *p = lookup(ps, name, type, 0); /* any count */
     if (!p)
         return NULL;
-    if (p->type != type) {
-        type_error(ps, p, lf_param_type_name(type));
-        return NULL;
-    }
     *count = p->n_nums;
     return p->nums;
 }

@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "camera/lf_camera.h"
+#include "bench/bench_util.h"
 
 typedef struct kv {
     const char *name;
@@ -79,19 +80,6 @@ static int g_image(void *ctx, const char *path, int *w, int *h, float **px, char
     return 0;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 enum { NS = 65536, W = 1920, H = 1280 };
 
 int main(int argc, char **argv)
@@ -150,27 +138,27 @@ int main(int argc, char **argv)
         }
         double times[101];
         for (int r = 0; r < repeats; r++) {
-            double t0 = now(), acc = 0;
+            double t0 = lf_seconds(), acc = 0;
             for (long i = 0; i < total; i++) {
                 lf_camera_ray ray;
                 acc += t->generate_ray(state, &samples[i & (NS - 1)], &ray) * ray.dir[2];
             }
-            times[r] = (now() - t0) / (double)total * 1e9;
+            times[r] = (lf_seconds() - t0) / (double)total * 1e9;
             checksum += acc;
         }
-        qsort(times, (size_t)repeats, sizeof times[0], cmp);
+        qsort(times, (size_t)repeats, sizeof times[0], bench_cmp_double);
         double med = times[repeats / 2];
         for (int r = 0; r < repeats; r++) {
-            double t0 = now(), acc = 0;
+            double t0 = lf_seconds(), acc = 0;
             for (long i = 0; i < total; i += B) {
                 lf_camera_generate_rays(t, state, B, &samples[i & (NS - 1)], rays, weights);
                 for (int k = 0; k < B; k++)
                     acc += weights[k] * rays[k].dir[2];
             }
-            times[r] = (now() - t0) / (double)total * 1e9;
+            times[r] = (lf_seconds() - t0) / (double)total * 1e9;
             checksum += acc;
         }
-        qsort(times, (size_t)repeats, sizeof times[0], cmp);
+        qsort(times, (size_t)repeats, sizeof times[0], bench_cmp_double);
         double med_b = times[repeats / 2];
         if (c == 0)
             pinhole = med, pinhole_b = med_b;

@@ -21,27 +21,9 @@
 
 #include "camera/lens.h"
 #include "camera/lf_camera.h"
+#include "bench/bench_util.h"
 
 enum { REPEATS = 5 };
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, n, sizeof *v, cmp);
-    return v[n / 2];
-}
 
 static double halton_slow(long i, int base)
 {
@@ -116,18 +98,18 @@ static double camera_ns(const char *type, const char *lensfile, long n, double *
     if (!t)
         return -1;
     void *st;
-    double t0 = now();
+    double t0 = lf_seconds();
     if (t->create(&a, &st)) {
         fprintf(stderr, "%s: %s\n", type, err);
         return -1;
     }
-    *setup_s = now() - t0;
+    *setup_s = lf_seconds() - t0;
     double ns[REPEATS];
     long ok = 0;
     for (int r = 0; r < REPEATS; r++) {
         double sink = 0;
         ok = 0;
-        t0 = now();
+        t0 = lf_seconds();
         for (long i = 0; i < n; i++) {
             lf_camera_sample cs = {halton(i, 2) * 1440, halton(i, 3) * 960, halton(i, 5), halton(i, 7), 0, 0.5};
             lf_camera_ray ray;
@@ -136,12 +118,12 @@ static double camera_ns(const char *type, const char *lensfile, long n, double *
             sink += w;
             ok += w > 0;
         }
-        ns[r] = (now() - t0) / n * 1e9;
+        ns[r] = (lf_seconds() - t0) / n * 1e9;
         if (sink < 0)
             printf("?");
     }
     *through = (double)ok / n;
-    double scalar_ns = median(ns, REPEATS);
+    double scalar_ns = bench_median(ns, REPEATS);
     *batch_ns = -1;
     if (t->generate_rays) {
         lf_camera_sample cs[BATCH];
@@ -149,7 +131,7 @@ static double camera_ns(const char *type, const char *lensfile, long n, double *
         double w[BATCH];
         for (int r = 0; r < REPEATS; r++) {
             double sink = 0;
-            t0 = now();
+            t0 = lf_seconds();
             for (long i0 = 0; i0 < n; i0 += BATCH) {
                 int m = n - i0 < BATCH ? (int)(n - i0) : BATCH;
                 for (int j = 0; j < m; j++) {
@@ -162,11 +144,11 @@ static double camera_ns(const char *type, const char *lensfile, long n, double *
                 for (int j = 0; j < m; j++)
                     sink += w[j];
             }
-            ns[r] = (now() - t0) / n * 1e9;
+            ns[r] = (lf_seconds() - t0) / n * 1e9;
             if (sink < 0)
                 printf("?");
         }
-        *batch_ns = median(ns, REPEATS);
+        *batch_ns = bench_median(ns, REPEATS);
     }
     t->destroy(st);
     return scalar_ns;
@@ -201,24 +183,25 @@ int main(int argc, char **argv)
     for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
         if (filter && !strstr(lenses[k], filter))
             continue;
-        char path[1024], err[1024];
+        char path[1024];
+        lf_error err = {0};
         snprintf(path, sizeof path, LF_SOURCE_DIR "/scenes/lenses/%s", lenses[k]);
         lf_lens L;
-        if (lf_lens_load(path, &L, err, sizeof err)) {
-            fprintf(stderr, "%s\n", err);
+        if (lf_lens_load(path, &L, &err)) {
+            fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         lf_lens_set_stop_diameter(&L, 1e3, NULL, 0);
-        if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, err, sizeof err)) {
-            fprintf(stderr, "%s\n", err);
+        if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, &err)) {
+            fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         lf_lens_pupil P;
         double build[REPEATS];
         for (int r = 0; r < REPEATS; r++) {
-            double t0 = now();
+            double t0 = lf_seconds();
             lf_lens_pupil_build(&L, film_r, 0, &P);
-            build[r] = now() - t0;
+            build[r] = lf_seconds() - t0;
         }
         double ns[2], useful[2];
         for (int mode = 0; mode < 2; mode++) {
@@ -226,7 +209,7 @@ int main(int argc, char **argv)
             long traced = 0, passed = 0;
             for (int r = 0; r < REPEATS; r++) {
                 traced = passed = 0;
-                double t0 = now();
+                double t0 = lf_seconds();
                 for (long i = 0; i < n; i++) {
                     double fx = (halton(i, 2) - 0.5) * film_w, fy = (halton(i, 3) - 0.5) * film_h;
                     double u = halton(i, 5), v = halton(i, 7), rx, ry;
@@ -236,9 +219,9 @@ int main(int argc, char **argv)
                     lf_lens_ray out;
                     passed += lf_lens_sample_ray(&L, &P, mode == 0, fx, fy, u, v, NULL, &out) > 0;
                 }
-                t[r] = (now() - t0) / n * 1e9;
+                t[r] = (lf_seconds() - t0) / n * 1e9;
             }
-            ns[mode] = median(t, REPEATS);
+            ns[mode] = bench_median(t, REPEATS);
             useful[mode] = traced ? (double)passed / traced : 0;
         }
         /* The same film samples with the bounds through lf_lens_sample_rays,
@@ -248,7 +231,7 @@ int main(int argc, char **argv)
         for (int r = 0; r < REPEATS; r++) {
             double fx[BATCH], fy[BATCH], u[BATCH], v[BATCH], w[BATCH], sink = 0;
             lf_lens_ray out[BATCH];
-            double t0 = now();
+            double t0 = lf_seconds();
             for (long i0 = 0; i0 < n; i0 += BATCH) {
                 int m = n - i0 < BATCH ? (int)(n - i0) : BATCH;
                 for (int j = 0; j < m; j++) {
@@ -260,14 +243,14 @@ int main(int argc, char **argv)
                 for (int j = 0; j < m; j++)
                     sink += w[j];
             }
-            tb[r] = (now() - t0) / n * 1e9;
+            tb[r] = (lf_seconds() - t0) / n * 1e9;
             if (sink < 0)
                 printf("?");
         }
         double cam_b;
         double cam = camera_ns("realistic", path, n, &setup, &thr, &cam_b);
         printf("%-20s %8.3f %9.1f %9.1f %7.1f%% %9.1f %7.1f%% %10.1f %10.1f %9.1f %8.3f\n", lenses[k],
-               median(build, REPEATS), ns[0], median(tb, REPEATS), 100 * useful[0], ns[1], 100 * useful[1], cam, cam_b,
+               bench_median(build, REPEATS), ns[0], bench_median(tb, REPEATS), 100 * useful[0], ns[1], 100 * useful[1], cam, cam_b,
                pin > 0 ? cam / pin : NAN, setup);
         lf_lens_free(&L);
     }

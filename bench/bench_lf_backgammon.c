@@ -24,20 +24,7 @@
 #include "../image/lf_image.h"
 #include "../lightfield/lf_depth.h"
 #include "../lightfield/lf_lightfield.h"
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+#include "bench/bench_util.h"
 
 /* The views through the library's folder reader (lightfield/folder.c):
  * HCI layout, parameters.cfg, every view. */
@@ -131,12 +118,6 @@ static double psnr8(const lf_image *a, const float *b, int border)
     return se > 0 ? 10 * log10(255.0 * 255.0 / (se / n)) : INFINITY;
 }
 
-static int cmpd(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 int main(int argc, char **argv)
 {
     const char *dir = NULL, *save = NULL;
@@ -169,10 +150,10 @@ int main(int argc, char **argv)
         return 2;
     }
     lf_lightfield lf = {0};
-    double t0 = now();
+    double t0 = lf_seconds();
     if (load_hci_views(dir, &lf))
         return 1;
-    printf("%s: %dx%d views of %dx%d (loaded in %.2f s), %d threads\n", dir, lf.nu, lf.nv, lf.ns, lf.nt, now() - t0,
+    printf("%s: %dx%d views of %dx%d (loaded in %.2f s), %d threads\n", dir, lf.nu, lf.nv, lf.ns, lf.nt, lf_seconds() - t0,
            threads);
     lf_error err = {0};
     if (do_depth) {
@@ -187,12 +168,12 @@ int main(int argc, char **argv)
             lf_image af, dm;
             lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
             ro.threads = threads;
-            double s = now();
+            double s = lf_seconds();
             if (lf_lf_allfocus(&lf, &ro, -1.7, 0.7, 82, &af, &dm, &err)) {
                 fprintf(stderr, "%s\n", err.msg);
                 return 1;
             }
-            score("focal stack (82 slices)", &dm, &gt, now() - s);
+            score("focal stack (82 slices)", &dm, &gt, lf_seconds() - s);
             lf_image_free(&af), lf_image_free(&dm);
         }
         double times[16], cpus[16];
@@ -221,26 +202,26 @@ int main(int argc, char **argv)
                 o.defocus_weight = atof(getenv("LFD_ALPHA"));
             if (getenv("LFD_OCC"))
                 o.occlusion = atoi(getenv("LFD_OCC"));
-            double s = now(), sc = cpu_now();
+            double s = lf_seconds(), sc = bench_cpu_seconds();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
-            times[r] = now() - s, cpus[r] = cpu_now() - sc;
+            times[r] = lf_seconds() - s, cpus[r] = bench_cpu_seconds() - sc;
         }
-        qsort(times, (size_t)runs, sizeof(double), cmpd);
-        qsort(cpus, (size_t)runs, sizeof(double), cmpd);
+        qsort(times, (size_t)runs, sizeof(double), bench_cmp_double);
+        qsort(cpus, (size_t)runs, sizeof(double), bench_cmp_double);
         score("lf_lf_depth (range auto)", &disp, &gt, times[runs / 2]);
         printf("  depth: median of %d runs: wall %.2f s, CPU %.2f s (all threads)\n", runs, times[runs / 2],
                cpus[runs / 2]);
         if (calibrate) { /* self-calibrated view positions, depth again */
             double *rep = malloc(sizeof(double) * 6 * lf.nu * lf.nv);
-            double s = now();
+            double s = lf_seconds();
             if (!rep || lf_lf_calibrate_views(&lf, &disp, &conf, threads, rep, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", rep ? err.msg : "out of memory");
                 return 1;
             }
-            double tc = now() - s, worst = 0;
+            double tc = lf_seconds() - s, worst = 0;
             for (int k = 0; k < lf.nu * lf.nv; k++) {
                 int iu = k % lf.nu, iv = k / lf.nu;
                 double e = fmax(fabs(rep[6 * k] - (iu - lf.nu / 2)), fabs(rep[6 * k + 1] - (iv - lf.nv / 2)));
@@ -254,12 +235,12 @@ int main(int argc, char **argv)
             lf_image_free(&disp), lf_image_free(&conf);
             lf_lf_depth_opts o = lf_lf_depth_defaults();
             o.threads = threads;
-            s = now();
+            s = lf_seconds();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
-            score("lf_lf_depth (calibrated)", &disp, &gt, now() - s);
+            score("lf_lf_depth (calibrated)", &disp, &gt, lf_seconds() - s);
             free(lf.view_shift);
             lf.view_shift = NULL;
         }
@@ -322,12 +303,12 @@ int main(int argc, char **argv)
         {
             lf_lf_depth_opts o = lf_lf_depth_defaults();
             o.threads = threads;
-            double s = now();
+            double s = lf_seconds();
             if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
-            printf("5x5 depth (range auto) %.2f s\n", now() - s);
+            printf("5x5 depth (range auto) %.2f s\n", lf_seconds() - s);
             if (getenv("LFD_VERBOSE")) { /* the 5x5 map (per view step of the 9x9 grid) against the ground truth */
                 char gtp[4096];
                 snprintf(gtp, sizeof gtp, "%s/gt_disp_lowres.pfm", dir);
@@ -343,7 +324,7 @@ int main(int argc, char **argv)
                 }
             }
             if (calibrate) {
-                s = now();
+                s = lf_seconds();
                 if (lf_lf_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
                     fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                     return 1;
@@ -353,7 +334,7 @@ int main(int argc, char **argv)
                     fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                     return 1;
                 }
-                printf("5x5 views calibrated, depth again: %.2f s\n", now() - s);
+                printf("5x5 views calibrated, depth again: %.2f s\n", lf_seconds() - s);
             }
             if (getenv("LFD_GTVIEW")) { /* diagnostic: ground-truth geometry */
                 char gtp[4096];
@@ -373,7 +354,7 @@ int main(int argc, char **argv)
                 for (int c = 1; c < lf.nu; c += 2) {
                     double u = c / 2.0 - (n5 - 1) / 2.0, v = r / 2.0 - (n5 - 1) / 2.0;
                     lf_image out;
-                    double s = now();
+                    double s = lf_seconds();
                     int rc;
                     if (method == 0) {
                         rc = lf_lf_view_at(&sub, u, v, 0.0, &out, &err);
@@ -384,7 +365,7 @@ int main(int argc, char **argv)
                         vo.blend = getenv("LFD_BLEND") && *getenv("LFD_BLEND") == '1'; /* diagnostic: the bicubic blend */
                         rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
                     }
-                    secs += now() - s;
+                    secs += lf_seconds() - s;
                     if (rc) {
                         fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                         return 1;

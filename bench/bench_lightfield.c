@@ -18,32 +18,7 @@
 
 #include "image/lf_image.h"
 #include "lightfield/lf_lightfield.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + t.tv_nsec * 1e-9;
-}
-
-static double cpu_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return t.tv_sec + t.tv_nsec * 1e-9;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+#include "bench/bench_util.h"
 
 static void fill(lf_lightfield *lf)
 {
@@ -92,16 +67,16 @@ int main(int argc, char **argv)
             double cpu[64];
             for (int k = 0; k < reps; k++) {
                 o.disparity_px = pass ? 0.0 : 0.37 + 0.113 * k;
-                double t0 = now(), c0 = cpu_now();
+                double t0 = lf_seconds(), c0 = bench_cpu_seconds();
                 lf_lf_refocus(&lf, &o, &img, &err);
-                t[k] = now() - t0, cpu[k] = cpu_now() - c0;
+                t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
                 lf_image_free(&img);
             }
-            double m = median(t, reps);
+            double m = bench_median(t, reps);
             printf("refocus 9x9x512x512 RGB float, 2 threads, %s: median %.1f ms = %.1f frames/s, %.1f ms CPU "
                    "(%d frames)\n",
                    pass ? "disparity 0 (plain sum of views)" : "sub-pixel disparities", m * 1e3, 1 / m,
-                   median(cpu, reps) * 1e3, reps);
+                   bench_median(cpu, reps) * 1e3, reps);
         }
         /* half-float storage */
         if (lf_lf_make_half(&lf, &err) == 0) {
@@ -109,15 +84,15 @@ int main(int argc, char **argv)
             double cpu[64];
             for (int k = 0; k < reps; k++) {
                 o.disparity_px = 0.37 + 0.113 * k;
-                double t0 = now(), c0 = cpu_now();
+                double t0 = lf_seconds(), c0 = bench_cpu_seconds();
                 lf_lf_refocus(&lf, &o, &img, &err);
-                t[k] = now() - t0, cpu[k] = cpu_now() - c0;
+                t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
                 lf_image_free(&img);
             }
-            double m = median(t, reps);
+            double m = bench_median(t, reps);
             printf("refocus 9x9x512x512 RGB half, 2 threads, sub-pixel disparities: median %.1f ms = %.1f frames/s, "
                    "%.1f ms CPU (%d frames)\n",
-                   m * 1e3, 1 / m, median(cpu, reps) * 1e3, reps);
+                   m * 1e3, 1 / m, bench_median(cpu, reps) * 1e3, reps);
         }
         lf_lf_free(&lf);
     }
@@ -128,32 +103,32 @@ int main(int argc, char **argv)
         lf_lf_alloc(&lf, 9, 9, 256, 256, &err);
         fill(&lf);
         lf_lf_fourier *fs = NULL;
-        double t0 = now();
+        double t0 = lf_seconds();
         if (lf_lf_fourier_new(&lf, NULL, 2.0, &fs, &err)) {
             fprintf(stderr, "%s\n", err.msg);
         } else {
-            double pre = now() - t0, t[64];
+            double pre = lf_seconds() - t0, t[64];
             for (int k = 0; k < reps; k++) {
                 lf_image img;
-                double t1 = now();
+                double t1 = lf_seconds();
                 lf_lf_fourier_refocus(fs, 0.37 + 0.113 * k, &img, &err);
-                t[k] = now() - t1;
+                t[k] = lf_seconds() - t1;
                 lf_image_free(&img);
             }
-            double m = median(t, reps);
+            double m = bench_median(t, reps);
             lf_lf_refocus_opts o = lf_lf_refocus_defaults();
             double ts[64];
             for (int k = 0; k < reps; k++) {
                 lf_image img;
                 o.disparity_px = 0.37 + 0.113 * k;
-                double t1 = now();
+                double t1 = lf_seconds();
                 lf_lf_refocus(&lf, &o, &img, &err);
-                ts[k] = now() - t1;
+                ts[k] = lf_seconds() - t1;
                 lf_image_free(&img);
             }
             printf("fourier slice 9x9x256x256 (u,v padded to 18x18): precompute %.2f s, per frame median %.1f ms "
                    "(shift-and-add on the same field: %.1f ms)\n",
-                   pre, m * 1e3, median(ts, reps) * 1e3);
+                   pre, m * 1e3, bench_median(ts, reps) * 1e3);
             lf_lf_fourier_release(fs);
         }
         lf_lf_free(&lf);
@@ -179,15 +154,15 @@ int main(int argc, char **argv)
         double t[8];
         lf_lightfield lf = {0};
         for (int k = 0; k < n; k++) {
-            double t0 = now();
+            double t0 = lf_seconds();
             lf_lf_decode(&raw, &r, NULL, &lf, &err);
-            t[k] = now() - t0;
+            t[k] = lf_seconds() - t0;
             if (k + 1 < n)
                 lf_lf_free(&lf);
         }
         printf("decode 4096x4096 plenoptic raw (pitch 10.3 px, %d x %d lenses -> %d x %d views of %d x %d): median %.0f ms "
                "(%d runs, 1 thread)\n",
-               r.lens_x, r.lens_y, lf.nu, lf.nv, lf.ns, lf.nt, median(t, n) * 1e3, n);
+               r.lens_x, r.lens_y, lf.nu, lf.nv, lf.ns, lf.nt, bench_median(t, n) * 1e3, n);
         lf_lf_free(&lf);
         lf_image_free(&raw);
     }
@@ -209,15 +184,15 @@ int main(int argc, char **argv)
         double t[8], cpu[8];
         for (int k = 0; k < n; k++) {
             lf_image img;
-            double t0 = now(), c0 = cpu_now();
+            double t0 = lf_seconds(), c0 = bench_cpu_seconds();
             lf_lf_synth(&lf, &o, &img, NULL, NULL, &err);
-            t[k] = now() - t0, cpu[k] = cpu_now() - c0;
+            t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
             lf_image_free(&img);
         }
-        double mc = median(cpu, n);
+        double mc = bench_median(cpu, n);
         printf("synth 600x600, 64 spp, lens radius 0.05, 16x16 cameras of 128x128, 2 threads: median %.2f s wall, "
                "%.2f s CPU = %.0f ns CPU per sample (%d runs; target: under 2 s on 2 cores)\n",
-               median(t, n), mc, mc * 1e9 / (600.0 * 600 * 64), n);
+               bench_median(t, n), mc, mc * 1e9 / (600.0 * 600 * 64), n);
         lf_lf_free(&lf);
     }
     return 0;

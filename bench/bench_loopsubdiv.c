@@ -21,25 +21,7 @@
 #include "render/lf_render.h"
 #include "render/lf_scene_desc.h"
 #include "render/lf_subdiv.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+#include "bench/bench_util.h"
 
 /* midpoint-split icosahedron */
 static int nv, nf;
@@ -128,40 +110,40 @@ int main(int argc, char **argv)
         for (int r = 0; r < runs; r++) {
             lf_scene_desc d;
             lf_error err = {0};
-            double t0 = now();
+            double t0 = lf_seconds();
             if (lf_scene_parse_string(text, "bench.pbrt", &d, &err)) {
                 fprintf(stderr, "%s\n", err.msg);
                 return 1;
             }
-            double t1 = now();
+            double t1 = lf_seconds();
             lf_ply_mesh m;
             double *dp = malloc(sizeof(double) * 3 * nv);
             for (int i = 0; i < 3 * nv; i++)
                 dp[i] = P[i];
-            double t2 = now();
+            double t2 = lf_seconds();
             if (lf_loop_subdivide(dp, (size_t)nv, F, (size_t)nf, levels, &m, &err)) {
                 fprintf(stderr, "%s\n", err.msg);
                 return 1;
             }
-            double t3 = now();
+            double t3 = lf_seconds();
             tris = m.n_triangles;
             lf_ply_free(&m);
             free(dp);
             lf_render_opts o = lf_render_opts_default();
             o.threads = 2;
             lf_renderer *rr;
-            double t4 = now();
+            double t4 = lf_seconds();
             if (lf_renderer_create(&d, &o, &rr, &err)) {
                 fprintf(stderr, "%s\n", err.msg);
                 return 1;
             }
-            double t5 = now();
+            double t5 = lf_seconds();
             lf_renderer_free(rr);
             lf_scene_desc_free(&d);
             tp[r] = 1e3 * (t1 - t0), ts[r] = 1e3 * (t3 - t2), tc[r] = 1e3 * (t5 - t4);
         }
-        printf("| %d | %zu | %.2f | %.2f | %.2f |\n", levels, tris, median(tp, runs), median(ts, runs),
-               median(tc, runs));
+        printf("| %d | %zu | %.2f | %.2f | %.2f |\n", levels, tris, bench_median(tp, runs), bench_median(ts, runs),
+               bench_median(tc, runs));
         free(text);
         free(tp), free(ts), free(tc);
     }

@@ -22,78 +22,15 @@
 
 #include "camera/lf_camera.h"
 #include "render/lf_render.h"
+#include "bench/bench_util.h"
 
-/* ---- a parameter store standing in for the scene file ---- */
-typedef struct kv {
-    const char *name;
-    double v[2];
-    int n;
-    const char *str;
-} kv;
-typedef struct store {
-    kv items[8];
-    int n;
-} store;
+#include "tests/camera_store.h"
 
-static const kv *find(store *s, const char *name)
-{
-    for (int i = 0; i < s->n; i++)
-        if (!strcmp(s->items[i].name, name))
-            return &s->items[i];
-    return NULL;
-}
-static double g_float(void *c, const char *name, double def)
-{
-    const kv *k = find(c, name);
-    return k ? k->v[0] : def;
-}
-static int g_int(void *c, const char *name, int def)
-{
-    const kv *k = find(c, name);
-    return k ? (int)k->v[0] : def;
-}
-static int g_bool(void *c, const char *name, int def)
-{
-    return g_int(c, name, def);
-}
-static const char *g_string(void *c, const char *name, const char *def)
-{
-    const kv *k = find(c, name);
-    return k && k->str ? k->str : def;
-}
-static int g_floats(void *c, const char *name, double *out, int max)
-{
-    const kv *k = find(c, name);
-    if (!k || k->str)
-        return 0;
-    for (int i = 0; i < k->n && i < max; i++)
-        out[i] = k->v[i];
-    return k->n;
-}
 static int g_image(void *c, const char *path, int *w, int *h, float **px, char *err, size_t n)
 {
     (void)c, (void)w, (void)h, (void)px;
     snprintf(err, n, "no images (%s)", path);
     return -1;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 enum { W = 960, H = 640 };
@@ -117,7 +54,7 @@ static double camera_rate(const char *type, store *s, int repeats, double *zero_
     double rates[32], sink = 0;
     long zero = 0;
     for (int r = 0; r < repeats; r++) {
-        double t0 = now();
+        double t0 = lf_seconds();
         for (int k = 0; k < n; k++) {
             /* film point on a 1024 x 1024 lattice over the film, lens point by a
              * 2-d additive recurrence (R2), so both cover their domains */
@@ -129,13 +66,13 @@ static double camera_rate(const char *type, store *s, int repeats, double *zero_
             sink += w + ray.dir[2] * (w > 0);
             zero += !(w > 0);
         }
-        rates[r] = n / (now() - t0);
+        rates[r] = n / (lf_seconds() - t0);
     }
     if (sink == 12345.678)
         printf("(unlikely)\n");
     *zero_fraction = (double)zero / ((double)n * repeats);
     t->destroy(c);
-    return median(rates, repeats);
+    return bench_median(rates, repeats);
 }
 
 /* camera paths per second of a whole render of the demo world */
@@ -177,7 +114,7 @@ static double render_rate(const char *camera_line, int repeats)
         lf_renderer_free(rd);
         lf_scene_desc_free(&d);
     }
-    return median(rates, repeats);
+    return bench_median(rates, repeats);
 }
 
 int main(int argc, char **argv)

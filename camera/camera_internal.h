@@ -3,7 +3,9 @@
 #define LF_CAMERA_INTERNAL_H
 
 #include <math.h>
+#include <stdio.h>
 
+#include "../base/lf_error.h"
 #include "../base/lf_math.h"
 #include "lf_camera.h"
 
@@ -45,6 +47,15 @@ static inline void lf_cam_chunks(lf_cam_chunk_fn chunk, const void *state, int n
 {
     for (int i = 0; i < n; i += LF_CAM_CHUNK)
         chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
+}
+
+/* A library's lf_error into a create call's message buffer (the plugin
+ * ABI, lf_camera.h, keeps char buffers).  Returns rc. */
+static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size)
+{
+    if (rc && buf && size)
+        snprintf(buf, size, "%s", e->msg);
+    return rc;
 }
 
 /* "string sensor" (named format) or "float sensorsize" [w h] mm; default

@@ -46,7 +46,7 @@ static void cauchy_fit(lf_lens_surface *s)
     }
 }
 
-int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *err, size_t err_size)
+int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_error *err)
 {
     memset(lens, 0, sizeof *lens);
     lens->stop = -1;
@@ -59,7 +59,7 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *e
         size_t len = eol ? (size_t)(eol - p) : strlen(p);
         char line[1024];
         if (len >= sizeof line) {
-            snprintf(err, err_size, "%s:%d: line too long", filename, line_no);
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: line too long", filename, line_no);
             goto fail;
         }
         memcpy(line, p, len);
@@ -78,7 +78,7 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *e
         if (nt == 0)
             continue;
         if (nt != 4 && nt != 5) {
-            snprintf(err, err_size, "%s:%d: expected 4 or 5 columns (radius thickness ior aperture [abbe]), got %d",
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected 4 or 5 columns (radius thickness ior aperture [abbe]), got %d",
                      filename, line_no, nt);
             goto fail;
         }
@@ -86,32 +86,32 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *e
         static const char *const col[5] = {"radius", "thickness", "ior", "aperture", "abbe"};
         for (int i = 0; i < nt; i++)
             if (parse_number(tok[i], &v[i])) {
-                snprintf(err, err_size, "%s:%d: %s \"%s\" is not a number", filename, line_no, col[i], tok[i]);
+                lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s \"%s\" is not a number", filename, line_no, col[i], tok[i]);
                 goto fail;
             }
         if (v[1] < 0.0) {
-            snprintf(err, err_size, "%s:%d: thickness %g must be >= 0", filename, line_no, v[1]);
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: thickness %g must be >= 0", filename, line_no, v[1]);
             goto fail;
         }
         if (v[2] != 0.0 && v[2] < 1.0) {
-            snprintf(err, err_size, "%s:%d: ior %g must be >= 1 (0 or 1 = air)", filename, line_no, v[2]);
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: ior %g must be >= 1 (0 or 1 = air)", filename, line_no, v[2]);
             goto fail;
         }
         if (!(v[3] > 0.0)) {
-            snprintf(err, err_size, "%s:%d: aperture diameter %g must be > 0", filename, line_no, v[3]);
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: aperture diameter %g must be > 0", filename, line_no, v[3]);
             goto fail;
         }
         if (v[0] != 0.0 && v[3] > 2.0 * fabs(v[0])) {
-            snprintf(err, err_size, "%s:%d: aperture diameter %g exceeds the sphere's diameter 2|%g|", filename,
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: aperture diameter %g exceeds the sphere's diameter 2|%g|", filename,
                      line_no, v[3], v[0]);
             goto fail;
         }
         if (v[4] < 0.0) {
-            snprintf(err, err_size, "%s:%d: Abbe number %g must be >= 0", filename, line_no, v[4]);
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: Abbe number %g must be >= 0", filename, line_no, v[4]);
             goto fail;
         }
         if (v[0] == 0.0 && lens->stop >= 0) {
-            snprintf(err, err_size, "%s:%d: a second aperture stop (radius 0); the first is on line %d", filename,
+            lf_error_set(err, LF_ERR_PARSE, "%s:%d: a second aperture stop (radius 0); the first is on line %d", filename,
                      line_no, lens->s[lens->stop].line);
             goto fail;
         }
@@ -119,7 +119,7 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *e
             cap = cap ? 2 * cap : 16;
             lf_lens_surface *ns = realloc(lens->s, (size_t)cap * sizeof *ns);
             if (!ns) {
-                snprintf(err, err_size, "out of memory");
+                lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", filename);
                 goto fail;
             }
             lens->s = ns;
@@ -142,12 +142,12 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *e
         lens->n++;
     }
     if (lens->n == 0) {
-        snprintf(err, err_size, "%s: no lens surfaces (expected rows: radius thickness ior aperture [abbe])",
+        lf_error_set(err, LF_ERR_PARSE, "%s: no lens surfaces (expected rows: radius thickness ior aperture [abbe])",
                  filename);
         goto fail;
     }
     if (lens->s[lens->n - 1].ior != 1.0) {
-        snprintf(err, err_size, "%s:%d: the last surface must leave into air (ior 0 or 1), got %g", filename,
+        lf_error_set(err, LF_ERR_PARSE, "%s:%d: the last surface must leave into air (ior 0 or 1), got %g", filename,
                  lens->s[lens->n - 1].line, lens->s[lens->n - 1].ior);
         goto fail;
     }
@@ -163,10 +163,10 @@ fail:
     free(lens->s);
     lens->s = NULL;
     lens->n = 0;
-    return -1;
+    return err && err->code ? err->code : LF_ERR_PARSE;
 }
 
-int lf_lens_load(const char *path, lf_lens *lens, char *err, size_t err_size)
+int lf_lens_load(const char *path, lf_lens *lens, lf_error *err)
 {
     memset(lens, 0, sizeof *lens);
     /* The prescription may be gzipped (the magic bytes decide). */
@@ -174,16 +174,14 @@ int lf_lens_load(const char *path, lf_lens *lens, char *err, size_t err_size)
     size_t len;
     lf_error ferr = {0};
     if (lf_file_read(path, (size_t)1 << 24, &buf, &len, NULL, &ferr)) {
-        snprintf(err, err_size, "lens file %s", ferr.msg);
-        return -1;
+        return lf_error_set(err, ferr.code, "lens file %s", ferr.msg);
     }
     buf[len] = 0;
     if (strlen(buf) != len) {
         free(buf);
-        snprintf(err, err_size, "%s: not a text lens file (contains NUL bytes)", path);
-        return -1;
+        return lf_error_set(err, LF_ERR_PARSE, "%s: not a text lens file (contains NUL bytes)", path);
     }
-    int rc = lf_lens_parse(buf, path, lens, err, err_size);
+    int rc = lf_lens_parse(buf, path, lens, err);
     free(buf);
     return rc;
 }
@@ -381,17 +379,15 @@ double lf_lens_closest_focus_mm(const lf_lens_paraxial *px)
     return 4.0 * px->efl_mm + hiatus(px);
 }
 
-int lf_lens_focus_thick(const lf_lens *L, double D, double *film_distance_mm, char *err, size_t err_size)
+int lf_lens_focus_thick(const lf_lens *L, double D, double *film_distance_mm, lf_error *err)
 {
     lf_lens_paraxial px;
     if (lf_lens_paraxial_analyse(L, &px)) {
-        snprintf(err, err_size, "%s: the lens has no focal power (afocal): it cannot focus", L->path);
-        return -1;
+        return lf_error_set(err, LF_ERR_PARAM, "%s: the lens has no focal power (afocal): it cannot focus", L->path);
     }
     double f = px.efl_mm;
     if (!(f > 0.0)) {
-        snprintf(err, err_size, "%s: negative focal length %g mm: the lens forms no real image", L->path, f);
-        return -1;
+        return lf_error_set(err, LF_ERR_PARAM, "%s: negative focal length %g mm: the lens forms no real image", L->path, f);
     }
     if (isinf(D)) {
         *film_distance_mm = px.bfl_mm;
@@ -402,18 +398,16 @@ int lf_lens_focus_thick(const lf_lens *L, double D, double *film_distance_mm, ch
      * FocusThickLens). */
     double e = D - hiatus(&px), c = e * (e - 4.0 * f);
     if (!(D > 0.0) || !(e > 4.0 * f) || !(c > 0.0)) {
-        snprintf(err, err_size,
+        return lf_error_set(err, LF_ERR_PARAM,
                  "focus distance %g m is closer than %s can focus: the closest is %.4g m from the film "
                  "(unit magnification)",
                  D * 1e-3, L->path, lf_lens_closest_focus_mm(&px) * 1e-3);
-        return -1;
     }
     double v = 2.0 * f * e / (e + sqrt(c)); /* the smaller root, without cancellation */
     *film_distance_mm = px.rear_principal_mm + v;
     if (!(*film_distance_mm > 0.0)) {
-        snprintf(err, err_size, "%s: focusing at %g m would put the film inside the lens (%g mm)", L->path, D * 1e-3,
+        return lf_error_set(err, LF_ERR_PARAM, "%s: focusing at %g m would put the film inside the lens (%g mm)", L->path, D * 1e-3,
                  *film_distance_mm);
-        return -1;
     }
     return 0;
 }
@@ -450,11 +444,12 @@ static double spot_rms(const lf_lens *L0, const lf_lens_paraxial *px, double D, 
     return sw > 0 ? sqrt(sy2 / sw) : INFINITY;
 }
 
-int lf_lens_focus_search(const lf_lens *L, double D, double *film_distance_mm, char *err, size_t err_size)
+int lf_lens_focus_search(const lf_lens *L, double D, double *film_distance_mm, lf_error *err)
 {
     double d0;
-    if (lf_lens_focus_thick(L, D, &d0, err, err_size))
-        return -1;
+    int rc = lf_lens_focus_thick(L, D, &d0, err);
+    if (rc)
+        return rc;
     lf_lens_paraxial px;
     lf_lens_paraxial_analyse(L, &px);
     double Dm = D;
@@ -463,10 +458,8 @@ int lf_lens_focus_search(const lf_lens *L, double D, double *film_distance_mm, c
         lo = 1e-3;
     int np;
     if (!isfinite(spot_rms(L, &px, Dm, d0, &np)) || np < 3) {
-        snprintf(err, err_size, "%s: no real ray from the axial object point at %g m reaches the film", L->path,
+        return lf_error_set(err, LF_ERR_PARAM, "%s: no real ray from the axial object point at %g m reaches the film", L->path,
                  Dm * 1e-3);
-        /* (INFINITY prints as inf m) */
-        return -1;
     }
     /* Golden-section search for the smallest RMS spot. */
     const double g = 0.5 * (sqrt(5.0) - 1.0);

@@ -5,10 +5,11 @@
  * Graphics" (SIGGRAPH 1995) and pbrt-v4's RealisticCamera.
  *
  *   lf_lens lens;
- *   if (lf_lens_load("scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) ...
+ *   lf_error err = {0};
+ *   if (lf_lens_load("scenes/lenses/dgauss.50mm.dat", &lens, &err)) ... err.msg ...
  *   lf_lens_paraxial px; lf_lens_paraxial_analyse(&lens, &px);   // px.efl_mm ...
  *   lf_lens_set_stop_diameter(&lens, 10.0, warn, sizeof warn);
- *   lf_lens_focus_thick(&lens, 1000.0, &lens.film_distance_mm, err, sizeof err);
+ *   lf_lens_focus_thick(&lens, 1000.0, &lens.film_distance_mm, &err);
  *   lf_lens_pupil pupil; lf_lens_pupil_build(&lens, 43.3, 0, &pupil);
  *   double w = lf_lens_sample_ray(&lens, &pupil, 1, fx, fy, u, v, NULL, &ray);
  *   lf_lens_sample_rays(&lens, &pupil, 1, n, fxs, fys, us, vs, NULL, NULL, NULL, rays, ws); // n at once
@@ -35,6 +36,8 @@
 #define LF_LENS_H
 
 #include <stddef.h>
+
+#include "../base/lf_error.h"
 
 #define LF_LENS_LAMBDA_D 587.56 /* helium d line, nm: n_d */
 #define LF_LENS_LAMBDA_F 486.13 /* hydrogen F line */
@@ -63,10 +66,12 @@ typedef struct lf_lens {
 } lf_lens;
 
 /* Parses prescription text; `filename` is used in messages
- * ("x.dat:7: expected 4 or 5 columns ..., got 3").  0 or -1 with a message. */
-int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, char *err, size_t err_size);
-/* Reads and parses a file. */
-int lf_lens_load(const char *path, lf_lens *lens, char *err, size_t err_size);
+ * ("x.dat:7: expected 4 or 5 columns ..., got 3").  0, or LF_ERR_PARSE
+ * (LF_ERR_NOMEM) with the message in err. */
+int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_error *err);
+/* Reads (at most 16 MiB, gzip-aware) and parses a file; LF_ERR_IO when it
+ * cannot be read. */
+int lf_lens_load(const char *path, lf_lens *lens, lf_error *err);
 void lf_lens_free(lf_lens *lens);
 /* Sets the stop's clear diameter (pbrt "aperturediameter"), clamped to the
  * file's value with a message in warn.  Returns 1 if clamped, 0 if not. */
@@ -107,14 +112,13 @@ double lf_lens_working_fnumber(const lf_lens *lens, const lf_lens_paraxial *px, 
 /* Closest focus of the thick-lens model: 4 f + hiatus (unit magnification). */
 double lf_lens_closest_focus_mm(const lf_lens_paraxial *px);
 /* pbrt-v4 FocusThickLens: film distance from the thick-lens (cardinal point)
- * model.  0, or -1 with a message if the distance is closer than possible. */
-int lf_lens_focus_thick(const lf_lens *lens, double focus_distance_mm, double *film_distance_mm, char *err,
-                        size_t err_size);
+ * model.  0, or LF_ERR_PARAM with a message if the lens cannot focus there
+ * (afocal, negative focal length, closer than possible). */
+int lf_lens_focus_thick(const lf_lens *lens, double focus_distance_mm, double *film_distance_mm, lf_error *err);
 /* Exact search: the film distance that minimises the RMS spot radius of real
  * rays from the axial point at focus_distance_mm through the whole stop
  * (golden-section search around the thick-lens estimate). */
-int lf_lens_focus_search(const lf_lens *lens, double focus_distance_mm, double *film_distance_mm, char *err,
-                         size_t err_size);
+int lf_lens_focus_search(const lf_lens *lens, double focus_distance_mm, double *film_distance_mm, lf_error *err);
 
 /* ---- exact ray tracing (Snell's law at spherical surfaces) ---- */
 typedef struct lf_lens_ray {

@@ -17,7 +17,6 @@ int lf_lens_report_compute(lf_lens *L, double sensor_w, double sensor_h, double 
                            lf_error *err)
 {
     memset(r, 0, sizeof *r);
-    char msg[1024];
     if (lf_lens_paraxial_analyse(L, &r->px))
         return lf_error_set(err, LF_ERR_PARAM, "%s: the lens has no focal power (afocal)", L->path);
     r->sensor_w_mm = sensor_w;
@@ -25,9 +24,10 @@ int lf_lens_report_compute(lf_lens *L, double sensor_w, double sensor_h, double 
     r->diagonal_mm = hypot(sensor_w, sensor_h);
     r->focus_m = focus_m;
     double D = isinf(focus_m) ? INFINITY : focus_m * 1000.0;
-    if (lf_lens_focus_thick(L, D, &r->film_thick_mm, msg, sizeof msg))
-        return lf_error_set(err, LF_ERR_PARAM, "%s", msg);
-    if (lf_lens_focus_search(L, D, &r->film_search_mm, msg, sizeof msg))
+    int rc = lf_lens_focus_thick(L, D, &r->film_thick_mm, err);
+    if (rc)
+        return rc;
+    if (lf_lens_focus_search(L, D, &r->film_search_mm, NULL))
         r->film_search_mm = NAN;
     r->closest_focus_m = lf_lens_closest_focus_mm(&r->px) * 1e-3;
     L->film_distance_mm = r->film_thick_mm;

@@ -226,7 +226,8 @@ static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, cons
         snprintf(path, sizeof path, "%s", lensfile);
     else
         snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
-    if (lf_lens_load(path, &c->lens, a->error, a->error_size))
+    lf_error lerr = {0};
+    if (lf_cam_error(lf_lens_load(path, &c->lens, &lerr), &lerr, a->error, a->error_size))
         return -1;
     lf_lens *L = &c->lens;
     if (L->stop < 0) {
@@ -241,7 +242,7 @@ static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, cons
         return -1;
     }
     double focus_mm = zo == 0.0 || isinf(zo) ? INFINITY : zo * 1e3;
-    if (lf_lens_focus_thick(L, focus_mm, &L->film_distance_mm, a->error, a->error_size))
+    if (lf_cam_error(lf_lens_focus_thick(L, focus_mm, &L->film_distance_mm, &lerr), &lerr, a->error, a->error_size))
         return -1;
     c->compound = 1;
     c->focus_from_mla_m = isinf(focus_mm) ? INFINITY : zo;

@@ -170,7 +170,8 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
         snprintf(path, sizeof path, "%s", lensfile);
     else
         snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
-    if (lf_lens_load(path, &c->lens, a->error, a->error_size))
+    lf_error lerr = {0};
+    if (lf_cam_error(lf_lens_load(path, &c->lens, &lerr), &lerr, a->error, a->error_size))
         goto fail;
     size_t wlen = a->warning && a->warning_size ? strlen(a->warning) : 0;
 #define WARN(...)                                                                                 \
@@ -201,10 +202,10 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
         goto fail;
     }
     c->focus_distance_mm = focus_m * 1000.0;
-    if (lf_lens_focus_thick(&c->lens, c->focus_distance_mm, &c->lens.film_distance_mm, a->error, a->error_size))
+    if (lf_cam_error(lf_lens_focus_thick(&c->lens, c->focus_distance_mm, &c->lens.film_distance_mm, &lerr), &lerr,
+                     a->error, a->error_size))
         goto fail;
-    char scratch[256];
-    if (lf_lens_focus_search(&c->lens, c->focus_distance_mm, &c->film_distance_search_mm, scratch, sizeof scratch))
+    if (lf_lens_focus_search(&c->lens, c->focus_distance_mm, &c->film_distance_search_mm, NULL))
         c->film_distance_search_mm = NAN;
     c->working_fnumber =
         lf_lens_working_fnumber(&c->lens, &c->px, c->focus_distance_mm, c->lens.film_distance_mm);

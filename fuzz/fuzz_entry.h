@@ -147,16 +147,15 @@ static int lf_fuzz_lens_file(const uint8_t *data, size_t size)
         return 0;
     lf_lens lens;
     memset(&lens, 0, sizeof lens);
-    char err[512] = "";
-    int rc = lf_lens_parse(text, "fuzz.dat", &lens, err, sizeof err);
+    lf_error err = {0};
+    int rc = lf_lens_parse(text, "fuzz.dat", &lens, &err);
     free(text);
     if (rc != 0)
-        return lf_fuzz_refused(err);
+        return lf_fuzz_refused(err.msg);
     lf_lens_paraxial px;
     if (lf_lens_paraxial_analyse(&lens, &px) == 0) {
         double film = 0;
-        char ferr[512] = "";
-        (void)lf_lens_focus_thick(&lens, 1000.0, &film, ferr, sizeof ferr);
+        (void)lf_lens_focus_thick(&lens, 1000.0, &film, NULL);
     }
     lf_lens_free(&lens);
     return 0;

@@ -547,9 +547,9 @@ static void parse_declared(const char *md, const char *word, declared *d)
     }
     char **v;
     int n;
-    char why[400];
-    if (lf_grade_tokenize(line, &v, &n, why, sizeof why)) {
-        snprintf(d->why, sizeof d->why, "Submission.md: the lftool %s command %s", word, why);
+    lf_error why = {0};
+    if (lf_grade_tokenize(line, &v, &n, &why)) {
+        snprintf(d->why, sizeof d->why, "Submission.md: the lftool %s command %.400s", word, why.msg);
         return;
     }
     static const struct {

@@ -66,6 +66,11 @@ typedef struct lf_grade_result {
 void lf_grade_result_free(lf_grade_result *r);
 
 typedef struct lf_grade_ctx lf_grade_ctx;
+/* The assignment folder a command line names: NAME itself when it holds
+ * rubric.txt, else assignments/NAME under the working directory, else
+ * assignments/NAME beside the executable's folder (build/bin/../../).
+ * LF_ERR_PARAM when none exists. */
+int lf_grade_find_assignment(const char *name, char *dir, size_t dir_size, lf_error *err);
 /* Loads ASSIGNMENT_DIR/rubric.txt (LF_ERR_PARSE with file:line on errors). */
 int lf_grade_ctx_new(const char *assignment_dir, const lf_grade_opts *o, lf_grade_ctx **out, lf_error *err);
 void lf_grade_ctx_release(lf_grade_ctx *g);
@@ -80,8 +85,10 @@ int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_re
 
 /* REPORT/gradebook.csv and REPORT/gradebook.json for n results. */
 int lf_grade_write_gradebook(const char *report_dir, const lf_grade_result *res, int n, lf_error *err);
-/* One result as a JSON object (malloc'ed). */
+/* One result as a JSON object (malloc'ed; NULL when memory runs out). */
 char *lf_grade_result_json(const lf_grade_result *r);
+/* How many of a result's checks failed. */
+int lf_grade_failed_checks(const lf_grade_result *r);
 
 /* ---- helpers shared with tests (and useful to build model submissions) ---- */
 
@@ -120,8 +127,9 @@ double lf_grade_fit_blur(const lf_image *S, const lf_image *A);
 double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n);
 
 /* Submission.md commands as data: splits a line into words (quotes group,
- * nothing is expanded).  Fails (-1, reason in why) on shell syntax. */
-int lf_grade_tokenize(const char *line, char ***argv, int *argc, char *why, size_t why_size);
+ * nothing is expanded).  Fails with LF_ERR_PARSE (the reason in err) on
+ * shell syntax or an unterminated quote, LF_ERR_NOMEM when memory runs out. */
+int lf_grade_tokenize(const char *line, char ***argv, int *argc, lf_error *err);
 void lf_grade_free_argv(char **argv, int argc);
 
 #ifdef __cplusplus

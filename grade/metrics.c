@@ -21,6 +21,18 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* The mean of v[0..n) without its `drop` largest values (sorts v): robust to
+ * a few fireflies. */
+static double trimmed_mean(double *v, size_t n, size_t drop)
+{
+    qsort(v, n, sizeof *v, cmp_double);
+    size_t keep = n - drop;
+    double sum = 0;
+    for (size_t i = 0; i < keep; i++)
+        sum += v[i];
+    return keep ? sum / (double)keep : 0;
+}
+
 double lf_grade_relmse(const lf_image *a, const lf_image *ref)
 {
     if (a->width != ref->width || a->height != ref->height)
@@ -41,13 +53,9 @@ double lf_grade_relmse(const lf_image *a, const lf_image *ref)
         }
         e[i] = isfinite(s) ? s / ch : 1e30;
     }
-    qsort(e, np, sizeof *e, cmp_double);
-    size_t keep = np - np / 1000;
-    double sum = 0;
-    for (size_t i = 0; i < keep; i++)
-        sum += e[i];
+    double m = trimmed_mean(e, np, np / 1000);
     free(e);
-    return keep ? sum / (double)keep : 0;
+    return m;
 }
 
 /* Per-pixel squared error of x against reference a, in units of the local
@@ -107,13 +115,9 @@ double lf_grade_noise_ratio(const lf_image *x, const lf_image *ref, const lf_ima
     if (!t)
         return INFINITY;
     size_t np = (size_t)a->width * a->height;
-    qsort(t, np, sizeof *t, cmp_double);
-    size_t keep = np - np / 200;
-    double sum = 0;
-    for (size_t i = 0; i < keep; i++)
-        sum += t[i];
+    double m = trimmed_mean(t, np, np / 200);
     free(t);
-    return keep ? sum / (double)keep : 0;
+    return m;
 }
 
 static double luma8(const lf_image *im, size_t i)
@@ -234,20 +238,20 @@ int lf_grade_post(const char *op, lf_image *img, lf_error *err)
     return lf_error_set(err, LF_ERR_PARAM, "unknown post-processing op '%s'", op);
 }
 
+/* Clips the region [x0,x1) x [y0,y1) to the image. */
+static void clip_region(const lf_image *im, int *x0, int *y0, int *x1, int *y1)
+{
+    *x0 = *x0 < 0 ? 0 : *x0, *y0 = *y0 < 0 ? 0 : *y0;
+    *x1 = *x1 > im->width ? im->width : *x1, *y1 = *y1 > im->height ? im->height : *y1;
+}
+
 /* Contrast energy of a region: mean over pixels of the squared differences
  * of Rec. 709 luminance to the right and lower neighbours, over the squared
  * mean luminance (scale-free, so an exposure change does not move it).
  * Defocus blur lowers it; noise raises it a little. */
 double lf_grade_sharpness(const lf_image *im, int x0, int y0, int x1, int y1)
 {
-    if (x0 < 0)
-        x0 = 0;
-    if (y0 < 0)
-        y0 = 0;
-    if (x1 > im->width)
-        x1 = im->width;
-    if (y1 > im->height)
-        y1 = im->height;
+    clip_region(im, &x0, &y0, &x1, &y1);
     double e = 0, m = 0;
     long n = 0;
     int c = im->channels;
@@ -417,14 +421,7 @@ double lf_grade_fit_blur(const lf_image *S, const lf_image *A)
  * as n equal discs.  0 when the region holds no highlight. */
 double lf_grade_highlight_diameter(const lf_image *im, int x0, int y0, int x1, int y1, int n)
 {
-    if (x0 < 0)
-        x0 = 0;
-    if (y0 < 0)
-        y0 = 0;
-    if (x1 > im->width)
-        x1 = im->width;
-    if (y1 > im->height)
-        y1 = im->height;
+    clip_region(im, &x0, &y0, &x1, &y1);
     if (x1 <= x0 || y1 <= y0 || n < 1)
         return 0;
     size_t m = (size_t)(x1 - x0) * (y1 - y0), k = 0;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "../base/lf_buf.h"
 #include "grade_internal.h"
 
 int lf_grade_report_student(const char *dir, const char *title, const lf_grade_result *r, lf_error *err);
@@ -116,86 +117,72 @@ int lf_grade_report_student(const char *dir, const char *title, const lf_grade_r
 }
 
 /* JSON string with the required escapes. */
-static void json_str(char **buf, size_t *len, size_t *cap, const char *s);
-static void put(char **buf, size_t *len, size_t *cap, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
-
-#include <stdarg.h>
-static void put(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+static void json_str(lf_strbuf *b, const char *s)
 {
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        int n = vsnprintf(*buf ? *buf + *len : NULL, *buf ? *cap - *len : 0, fmt, ap);
-        va_end(ap);
-        if (n < 0)
-            return;
-        if (*buf && *len + (size_t)n < *cap) {
-            *len += (size_t)n;
-            return;
-        }
-        size_t nc = (*cap + (size_t)n + 1) * 2;
-        char *nb = realloc(*buf, nc);
-        if (!nb)
-            return;
-        *buf = nb, *cap = nc;
-    }
-}
-
-static void json_str(char **buf, size_t *len, size_t *cap, const char *s)
-{
-    put(buf, len, cap, "\"");
+    lf_strbuf_puts(b, "\"");
     for (; *s; s++) {
         unsigned char ch = (unsigned char)*s;
         if (ch == '"' || ch == '\\')
-            put(buf, len, cap, "\\%c", ch);
+            lf_strbuf_printf(b, "\\%c", ch);
         else if (ch < 32)
-            put(buf, len, cap, "\\u%04x", ch);
+            lf_strbuf_printf(b, "\\u%04x", ch);
         else
-            put(buf, len, cap, "%c", ch);
+            lf_strbuf_append(b, s, 1);
     }
-    put(buf, len, cap, "\"");
+    lf_strbuf_puts(b, "\"");
 }
 
-static void json_num(char **buf, size_t *len, size_t *cap, double v)
+static void json_num(lf_strbuf *b, double v)
 {
     if (isfinite(v))
-        put(buf, len, cap, "%.6g", v);
+        lf_strbuf_printf(b, "%.6g", v);
     else
-        put(buf, len, cap, "null");
+        lf_strbuf_puts(b, "null");
+}
+
+int lf_grade_failed_checks(const lf_grade_result *r)
+{
+    int n = 0;
+    for (int k = 0; k < r->nchecks; k++)
+        n += r->checks[k].status == LF_GRADE_FAIL;
+    return n;
 }
 
 char *lf_grade_result_json(const lf_grade_result *r)
 {
-    char *b = NULL;
-    size_t len = 0, cap = 0;
-    put(&b, &len, &cap, "{\"student\": ");
-    json_str(&b, &len, &cap, r->student);
-    put(&b, &len, &cap, ", \"path\": ");
-    json_str(&b, &len, &cap, r->path);
-    put(&b, &len, &cap, ", \"score\": %d, \"max\": %d, \"seconds\": %.3f, \"checks\": [", r->score, r->max, r->seconds);
+    lf_strbuf b = {0};
+    lf_strbuf_printf(&b, "{\"student\": ");
+    json_str(&b, r->student);
+    lf_strbuf_printf(&b, ", \"path\": ");
+    json_str(&b, r->path);
+    lf_strbuf_printf(&b, ", \"score\": %d, \"max\": %d, \"seconds\": %.3f, \"checks\": [", r->score, r->max, r->seconds);
     for (int i = 0; i < r->nchecks; i++) {
         const lf_grade_check_result *c = &r->checks[i];
-        put(&b, &len, &cap, "%s{\"id\": ", i ? ", " : "");
-        json_str(&b, &len, &cap, c->id);
-        put(&b, &len, &cap, ", \"kind\": ");
-        json_str(&b, &len, &cap, c->kind);
-        put(&b, &len, &cap, ", \"points\": %d, \"earned\": %d, \"passed\": %s, \"reason\": ", c->points, c->earned,
+        lf_strbuf_printf(&b, "%s{\"id\": ", i ? ", " : "");
+        json_str(&b, c->id);
+        lf_strbuf_printf(&b, ", \"kind\": ");
+        json_str(&b, c->kind);
+        lf_strbuf_printf(&b, ", \"points\": %d, \"earned\": %d, \"passed\": %s, \"reason\": ", c->points, c->earned,
             c->status == LF_GRADE_PASS ? "true" : "false");
-        json_str(&b, &len, &cap, c->reason);
-        put(&b, &len, &cap, ", \"noise_ratio\": ");
-        json_num(&b, &len, &cap, c->noise_ratio);
-        put(&b, &len, &cap, ", \"ssim\": ");
-        json_num(&b, &len, &cap, c->ssim);
-        put(&b, &len, &cap, ", \"psnr_db\": ");
-        json_num(&b, &len, &cap, c->psnr_db);
-        put(&b, &len, &cap, ", \"closest_mistake\": ");
-        json_str(&b, &len, &cap, c->best_variant);
-        put(&b, &len, &cap, ", \"measurements\": ");
-        json_str(&b, &len, &cap, c->measurements);
-        put(&b, &len, &cap, "}");
+        json_str(&b, c->reason);
+        lf_strbuf_printf(&b, ", \"noise_ratio\": ");
+        json_num(&b, c->noise_ratio);
+        lf_strbuf_printf(&b, ", \"ssim\": ");
+        json_num(&b, c->ssim);
+        lf_strbuf_printf(&b, ", \"psnr_db\": ");
+        json_num(&b, c->psnr_db);
+        lf_strbuf_printf(&b, ", \"closest_mistake\": ");
+        json_str(&b, c->best_variant);
+        lf_strbuf_printf(&b, ", \"measurements\": ");
+        json_str(&b, c->measurements);
+        lf_strbuf_printf(&b, "}");
     }
-    put(&b, &len, &cap, "]}");
-    return b;
+    lf_strbuf_printf(&b, "]}");
+    if (b.failed) { /* out of memory: no half a document */
+        lf_strbuf_free(&b);
+        return NULL;
+    }
+    return lf_strbuf_take(&b);
 }
 
 static void csv_field(FILE *f, const char *s)
@@ -250,7 +237,12 @@ int lf_grade_write_gradebook(const char *dir, const lf_grade_result *res, int n,
     fputs("[\n", f);
     for (int s = 0; s < n; s++) {
         char *j = lf_grade_result_json(&res[s]);
-        fprintf(f, "  %s%s\n", j ? j : "null", s + 1 < n ? "," : "");
+        if (!j) {
+            fclose(f);
+            remove(path);
+            return lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", path);
+        }
+        fprintf(f, "  %s%s\n", j, s + 1 < n ? "," : "");
         free(j);
     }
     fputs("]\n", f);

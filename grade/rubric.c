@@ -8,21 +8,54 @@
  * Values may be quoted with '...' or "..." (no escapes).  Kinds and keys:
  * docs/grading.md. */
 #include <ctype.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "grade_internal.h"
 
-static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, char *why, size_t wn)
+static int is_dir(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+int lf_grade_find_assignment(const char *a, char *out, size_t n, lf_error *err)
+{
+    char rubric[PATH_MAX + 16];
+    snprintf(rubric, sizeof rubric, "%s/rubric.txt", a);
+    if (is_dir(a) && access(rubric, R_OK) == 0 && snprintf(out, n, "%s", a) < (int)n)
+        return LF_OK;
+    if (snprintf(out, n, "assignments/%s", a) < (int)n && is_dir(out))
+        return LF_OK;
+    char exe[PATH_MAX];
+    ssize_t l = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    char *slash = NULL;
+    if (l > 0) {
+        exe[l] = 0;
+        slash = strrchr(exe, '/');
+    }
+    if (slash) {
+        *slash = 0;
+        if (snprintf(out, n, "%s/../../assignments/%s", exe, a) < (int)n && is_dir(out))
+            return LF_OK;
+    }
+    return lf_error_set(err, LF_ERR_PARAM,
+                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/)", a);
+}
+
+static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, lf_error *err)
 {
     if (strict) {
         const char *bad = strpbrk(line, ";|&$`<>\\(){}\n\r");
         if (bad) {
-            snprintf(why, wn, "contains shell syntax '%c': commands are read as data and never run, so this line is "
-                              "not accepted",
-                     *bad == '\n' || *bad == '\r' ? ' ' : *bad);
-            return -1;
+            return lf_error_set(err, LF_ERR_PARSE,
+                                "contains shell syntax '%c': commands are read as data and never run, so this line is "
+                                "not accepted",
+                                *bad == '\n' || *bad == '\r' ? ' ' : *bad);
         }
     }
     int cap = 16, n = 0;
@@ -31,8 +64,7 @@ static int tokenize(const char *line, int strict, char ***argv_out, int *argc_ou
     char *buf = malloc(len + 1);
     if (!v || !buf) {
         free(v), free(buf);
-        snprintf(why, wn, "out of memory");
-        return -1;
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     const char *p = line;
     for (;;) {
@@ -46,11 +78,9 @@ static int tokenize(const char *line, int strict, char ***argv_out, int *argc_ou
                 char q = *p++;
                 const char *e = strchr(p, q);
                 if (!e) {
-                    for (int i = 0; i < n; i++)
-                        free(v[i]);
-                    free(v), free(buf);
-                    snprintf(why, wn, "unterminated %c quote", q);
-                    return -1;
+                    lf_grade_free_argv(v, n);
+                    free(buf);
+                    return lf_error_set(err, LF_ERR_PARSE, "unterminated %c quote", q);
                 }
                 memcpy(buf + k, p, (size_t)(e - p));
                 k += (size_t)(e - p);
@@ -61,23 +91,28 @@ static int tokenize(const char *line, int strict, char ***argv_out, int *argc_ou
         }
         buf[k] = 0;
         if (n == cap) {
-            cap *= 2;
-            char **nv = realloc(v, sizeof *v * (size_t)cap);
+            char **nv = realloc(v, sizeof *v * (size_t)cap * 2);
             if (!nv)
-                break;
-            v = nv;
+                goto oom;
+            v = nv, cap *= 2;
         }
-        v[n++] = strdup(buf);
+        if (!(v[n] = strdup(buf)))
+            goto oom;
+        n++;
     }
     free(buf);
     *argv_out = v;
     *argc_out = n;
     return 0;
+oom:
+    lf_grade_free_argv(v, n);
+    free(buf);
+    return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
 }
 
-int lf_grade_tokenize(const char *line, char ***argv, int *argc, char *why, size_t why_size)
+int lf_grade_tokenize(const char *line, char ***argv, int *argc, lf_error *err)
 {
-    return tokenize(line, 1, argv, argc, why, why_size);
+    return tokenize(line, 1, argv, argc, err);
 }
 
 void lf_grade_free_argv(char **argv, int argc)
@@ -123,9 +158,9 @@ int lf_grade_rubric_parse(const char *path, lf_grade_rubric *r, lf_error *err)
         lineno++;
         char **v;
         int n;
-        char why[256];
-        if (tokenize(line, 0, &v, &n, why, sizeof why)) {
-            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s", path, lineno, why);
+        lf_error why = {0};
+        if (tokenize(line, 0, &v, &n, &why)) {
+            rc = lf_error_set(err, why.code, "%s:%d: %s", path, lineno, why.msg);
             break;
         }
         if (n == 0) {

@@ -181,6 +181,19 @@ int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16])
     return attrs_put(a, name, &v);
 }
 
+int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x)
+{
+    switch (x->type) {
+    case LF_ATTR_STRING: return lf_attrs_set_string(a, x->name, x->s);
+    case LF_ATTR_INT: return lf_attrs_set_int(a, x->name, x->i);
+    case LF_ATTR_FLOAT: return lf_attrs_set_float(a, x->name, (float)x->d);
+    case LF_ATTR_DOUBLE: return lf_attrs_set_double(a, x->name, x->d);
+    case LF_ATTR_FLOATS: return lf_attrs_set_floats(a, x->name, x->v, x->n);
+    case LF_ATTR_M44D: return lf_attrs_set_m44d(a, x->name, x->m);
+    }
+    return LF_ERR_PARAM;
+}
+
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name)
 {
     if (!a || !name)
@@ -351,6 +364,12 @@ static size_t count_beyond(const lf_image *img, float limit, size_t *first_pixel
         }
     }
     return bad;
+}
+
+int lf_image_fits_half(const lf_image *img)
+{
+    size_t first;
+    return count_beyond(img, LF_HALF_MAX, &first) == 0;
 }
 
 int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs, const lf_write_opts *opts,

@@ -74,6 +74,8 @@ int lf_attrs_set_float(lf_attrs *a, const char *name, float value);
 int lf_attrs_set_double(lf_attrs *a, const char *name, double value);
 int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *v, int n);
 int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16]);
+/* Sets a copy of attribute x (its name, type and value) in a. */
+int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x);
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name);
 void lf_attrs_free(lf_attrs *a);
 
@@ -97,6 +99,9 @@ typedef struct lf_write_opts {
 float lf_tonemap_apply(lf_tonemap op, float x);
 /* "clamp", "filmic", "aces" -> 0 and *op; -1 for another name. */
 int lf_tonemap_parse(const char *name, lf_tonemap *op);
+/* Write options for 8-bit pictures from a tool's --exposure EV and
+ * --tonemap NAME (NULL or an unknown name: clamp); the rest default. */
+lf_write_opts lf_write_opts_picture(double exposure_ev, const char *tonemap);
 
 /* A scalar image (channel 0 of src) as a colour picture: values in [lo, hi]
  * through the viridis colour map (NaN/Inf grey), with a legend strip below
@@ -115,6 +120,9 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
 
 /* Number of NaN or Inf values. */
 size_t lf_image_count_nonfinite(const lf_image *img);
+/* 1 when every value is finite with magnitude <= 65504, the largest half
+ * float (an EXR written with opts.half keeps every value). */
+int lf_image_fits_half(const lf_image *img);
 
 /* Linear -> 8-bit sRGB (exposure in stops, clamp, sRGB curve), for previews. */
 unsigned char lf_srgb_encode(float linear);

@@ -141,3 +141,12 @@ int lf_image_colormap(const lf_image *src, double lo, double hi, lf_image *out, 
     draw_text(out, w - bw - scale, ty, scale, b);
     return LF_OK;
 }
+
+lf_write_opts lf_write_opts_picture(double exposure_ev, const char *tonemap)
+{
+    lf_write_opts wo = {0};
+    wo.exposure = (float)exposure_ev;
+    if (tonemap && lf_tonemap_parse(tonemap, &wo.tonemap))
+        wo.tonemap = LF_TONEMAP_CLAMP;
+    return wo;
+}

@@ -251,12 +251,13 @@ int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image
     }
     refocus_job job = {lf, vs, n, (float)(1.0 / wsum), out, {NULL}};
     int rc = LF_OK, nblocks = (lf->nt + BLOCK_ROWS - 1) / BLOCK_ROWS;
-    for (int t = 0; lf->valid && t < LF_PARALLEL_MAX_THREADS && !rc; t++)
+    int nth = lf_parallel_threads(o->threads);
+    for (int t = 0; lf->valid && t < nth && !rc; t++)
         if (!(job.wacc[t] = malloc(sizeof(float) * (size_t)BLOCK_ROWS * lf->ns)))
             rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     if (!rc)
         lf_parallel_for(nblocks, o->threads, 1, refocus_blocks, &job);
-    for (int t = 0; t < LF_PARALLEL_MAX_THREADS; t++)
+    for (int t = 0; t < nth; t++)
         free(job.wacc[t]);
     free(vs);
     if (rc)

@@ -8,15 +8,14 @@
  * coordinates (origin at the grid's top-left camera, y down), so positions
  * stay small; the per-pixel film position is added in double first.  Random
  * numbers are counter-based (splitmix64 of the pixel's key), rows are handed
- * to the threads one at a time, and texels are read from the views in place
+ * to the threads one at a time (base/lf_parallel.h), and texels are read from the views in place
  * (RGB interleaved per row) with 4-float loads. */
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_parallel.h"
 #include "lf_lightfield.h"
 
 lf_lf_synth_opts lf_lf_synth_defaults(void)
@@ -54,12 +53,12 @@ typedef struct synth_ctx {
     size_t cam_view[4];            /* view index steps to the 4 cameras (0 along a 1-wide grid) */
     size_t cam_texel[4];           /* the same in texels */
     lf_image *out, *cov;
-    atomic_int *next_row;          /* rows are handed out one at a time */
+    float *strata[LF_PARALLEL_MAX_THREADS]; /* per thread: film strata FU, FV, FW and the lens permutation */
+    size_t uncovered[LF_PARALLEL_MAX_THREADS]; /* per thread: pixels with no covered sample */
     /* per-pixel geometry (o->disparity): reference camera, map range */
     const float *disp;
     double ref_x, ref_y;           /* reference camera, grid-relative */
     float dmin, dmax;
-    size_t uncovered;
 } synth_ctx;
 
 static inline uint64_t mix64(uint64_t z)
@@ -382,24 +381,18 @@ static inline int group_gather(const synth_ctx *c, const synth_group *g, v4f acc
     return -(cov[0] + cov[1] + cov[2] + cov[3]);
 }
 
-static void *synth_worker(void *arg)
+/* The stratum table of spp samples (padded to a multiple of 4): film
+ * strata in order (column FU, row FV, width FW), then room for the lens
+ * strata's per-pixel permutation.  m columns by rows = ceil(spp / m)
+ * strata; a last, partial row spreads its samples over the full width, so
+ * every spp covers the pixel (and the lens) uniformly.  NULL: no memory. */
+static float *strata_new(int spp)
 {
-    synth_ctx *c = arg;
-    const lf_lf_synth_opts *o = c->o;
-    const int spp = o->spp > 0 ? o->spp : 1, spp4 = (spp + 3) & ~3;
-    /* m columns by rows = ceil(spp / m) strata; a last, partial row spreads
-     * its samples over the full width, so every spp covers the pixel (and
-     * the lens) uniformly. */
-    const int m = (int)ceil(sqrt((double)spp)), rows = (spp + m - 1) / m;
-    const float u24 = 1.0f / 16777216.0f;
-    const int finite_focus = o->focal_distance > 0, lens = o->lens_radius > 0;
-    /* film strata in order (column FU, row FV); lens strata a random
-     * permutation of them per pixel, so film and lens positions are
-     * uncorrelated.  Padded to a multiple of 4 samples. */
+    const int spp4 = (spp + 3) & ~3, m = (int)ceil(sqrt((double)spp)), rows = (spp + m - 1) / m;
     float *FU = malloc(sizeof(float) * (size_t)spp4 * 4);
     if (!FU)
         return NULL;
-    float *FV = FU + spp4, *FW = FV + spp4; /* stratum origin (u, v) and width, in [0,1] */
+    float *FV = FU + spp4, *FW = FV + spp4;
     uint32_t *perm = (uint32_t *)(FW + spp4);
     for (int k = 0; k < spp4; k++) {
         int row = k / m, in_row = spp - row * m < m ? spp - row * m : m;
@@ -410,14 +403,27 @@ static void *synth_worker(void *arg)
         FV[k] = (float)row / (float)rows;
         perm[k] = 0;
     }
+    return FU;
+}
+
+/* Rows [y0, y1) on thread tid (lf_parallel_fn). */
+static void synth_rows(void *arg, int y0, int y1, int tid)
+{
+    synth_ctx *c = arg;
+    const lf_lf_synth_opts *o = c->o;
+    const int spp = o->spp > 0 ? o->spp : 1, spp4 = (spp + 3) & ~3;
+    const int m = (int)ceil(sqrt((double)spp)), rows = (spp + m - 1) / m;
+    const float u24 = 1.0f / 16777216.0f;
+    const int finite_focus = o->focal_distance > 0, lens = o->lens_radius > 0;
+    /* lens strata: a random permutation of the film strata per pixel, so
+     * film and lens positions are uncorrelated */
+    float *FU = c->strata[tid], *FV = FU + spp4, *FW = FV + spp4;
+    uint32_t *perm = (uint32_t *)(FW + spp4);
     const float inv_rows = 1.0f / (float)rows;
     synth_group groups[SYNTH_GROUPS];
     const v4i lane = {0, 1, 2, 3};
     const v4f half = vsplat(0.5f);
-    for (;;) {
-        int y = atomic_fetch_add(c->next_row, 1);
-        if (y >= o->height)
-            break;
+    for (int y = y0; y < y1; y++) {
         float *row = lf_image_px(c->out, 0, y);
         for (int x = 0; x < o->width; x++) {
             /* counter-based: the pixel's stream depends on (seed, x, y) only */
@@ -483,11 +489,9 @@ static void *synth_worker(void *arg)
             if (c->cov)
                 *lf_image_px(c->cov, x, y) = (float)covered / spp;
             if (!covered)
-                c->uncovered++;
+                c->uncovered[tid]++;
         }
     }
-    free(FU);
-    return NULL;
 }
 
 int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *out, lf_image *coverage,
@@ -603,33 +607,25 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
     for (int q = 0; q < 4; q++)
         c.cam_view[q] = (size_t)((q & 1) && lf->nu > 1) + (size_t)((q & 2) && lf->nv > 1) * lf->nu,
         c.cam_texel[q] = c.cam_view[q] * c.view_texels;
-    atomic_int next_row;
-    atomic_init(&next_row, 0);
-    c.next_row = &next_row;
     int nth = o->threads > 0 ? o->threads : 2;
-    if (nth > 64)
-        nth = 64;
+    if (nth > LF_PARALLEL_MAX_THREADS)
+        nth = LF_PARALLEL_MAX_THREADS;
     if (nth > o->height)
         nth = o->height;
-    synth_ctx jobs[64];
-    pthread_t tid[64];
-    int created[64] = {0};
     for (int t = 0; t < nth; t++)
-        jobs[t] = c;
-    for (int t = 1; t < nth; t++)
-        created[t] = pthread_create(&tid[t], NULL, synth_worker, &jobs[t]) == 0;
-    synth_worker(&jobs[0]); /* takes rows until none is left, also those of threads not created */
-    size_t unc = jobs[0].uncovered;
-    for (int t = 1; t < nth; t++) {
-        if (created[t])
-            pthread_join(tid[t], NULL);
-        unc += jobs[t].uncovered;
-    }
-    if (atomic_load(&next_row) < o->height) { /* every worker failed to allocate its strata */
-        lf_image_free(out);
-        if (coverage)
-            lf_image_free(coverage);
-        return lf_error_set(err, LF_ERR_NOMEM, "synth: out of memory for %d samples per pixel", o->spp);
+        if (!(c.strata[t] = strata_new(o->spp > 0 ? o->spp : 1))) {
+            for (int q = 0; q < t; q++)
+                free(c.strata[q]);
+            lf_image_free(out);
+            if (coverage)
+                lf_image_free(coverage);
+            return lf_error_set(err, LF_ERR_NOMEM, "synth: out of memory for %d samples per pixel", o->spp);
+        }
+    lf_parallel_for(o->height, nth, 1, synth_rows, &c);
+    size_t unc = 0;
+    for (int t = 0; t < nth; t++) {
+        free(c.strata[t]);
+        unc += c.uncovered[t];
     }
     if (uncovered)
         *uncovered = unc;

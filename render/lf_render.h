@@ -65,7 +65,8 @@ int lf_renderer_create(lf_scene_desc *desc, const lf_render_opts *opts, lf_rende
 void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts);
 /* Non-fatal notes gathered while building ("file:line:col: warning: ..."), or NULL. */
 const char *lf_renderer_warnings(const lf_renderer *r);
-/* The effect plan: camera model, which effects are simulated and why. malloc'ed. */
+/* The effect plan: camera model, which effects are simulated and why.
+ * malloc'ed; NULL when memory runs out. */
 char *lf_renderer_explain(const lf_renderer *r);
 /* Renders into *img (allocated here; the crop window's size) and fills meta
  * with lensfield:* attributes.  Samples whose radiance is NaN/Inf are
@@ -84,6 +85,15 @@ int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err);
  * bit for bit: parts carry exact fixed-point sums.  Checks that the parts
  * agree and that every pixel gets every sample exactly once. */
 int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *meta, lf_error *err);
+
+/* The disparity AOV (lf_renderer_disparity) as OUT.disparity.exr beside
+ * OUT.exr (path ends in ".exr"): 1 channel, 32-bit float, meta's
+ * attributes plus lensfield:aov.  meta (OUT's header) gets
+ * lensfield:disparity_file naming it and lensfield:disparity_range.
+ * written (may be NULL, path_size bytes) gets the file's path, range[2]
+ * the values' range. */
+int lf_render_write_disparity(lf_renderer *r, const char *path, lf_attrs *meta, char *written, size_t written_size,
+                              float range[2], lf_error *err);
 
 /* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
 const char *lf_renderer_film_filename(const lf_renderer *r);

@@ -183,31 +183,43 @@ static int one_ring(const topo *t, int v, int **ring, size_t *cap)
 
 static double loop_beta(int n) { return n == 3 ? 3.0 / 16.0 : 3.0 / (8.0 * n); }
 
+/* Vertex v's new position q from its one ring: a boundary vertex takes
+ * ws p + wn (a + b) with its two boundary neighbours, (3/4, 1/8) when
+ * refining and (3/5, 1/5) for the limit; an interior one (1 - n w) p +
+ * w (sum of the ring), w = beta(n) when refining and 1 / (n + 3 / (8 beta))
+ * for the limit (Loop 1987; pbrt-v4's LoopSubdivide).  Returns the ring
+ * size (0: an unused vertex, copied), or -1 when memory runs out. */
+static int vertex_mask(const topo *t, const double *P, size_t v, int limit, int **ring, size_t *rcap, double *q)
+{
+    const double *p = P + 3 * v;
+    int n = one_ring(t, (int)v, ring, rcap);
+    if (n == 0)
+        memcpy(q, p, 3 * sizeof *q);
+    if (n <= 0)
+        return n;
+    if (t->vbound[v]) {
+        const double *a = P + 3 * (size_t)(*ring)[0], *b = P + 3 * (size_t)(*ring)[n - 1];
+        const double ws = limit ? 0.6 : 0.75, wn = limit ? 0.2 : 0.125;
+        for (int c = 0; c < 3; c++)
+            q[c] = ws * p[c] + wn * (a[c] + b[c]);
+        return n;
+    }
+    double beta = loop_beta(n), w = limit ? 1.0 / (n + 3.0 / (8.0 * beta)) : beta, s[3] = {0, 0, 0};
+    for (int j = 0; j < n; j++)
+        for (int c = 0; c < 3; c++)
+            s[c] += P[3 * (size_t)(*ring)[j] + c];
+    for (int c = 0; c < 3; c++)
+        q[c] = (1.0 - n * w) * p[c] + w * s[c];
+    return n;
+}
+
 /* One level: P (3 * nv) and the faces of t -> P2 (3 * (nv + ne)), F2 (12 * nf). */
 static int refine(const topo *t, const double *P, double *P2, int *F2, int **ring, size_t *rcap, lf_error *err)
 {
     size_t nv = t->nv;
-    for (size_t v = 0; v < nv; v++) { /* even vertices */
-        const double *p = P + 3 * v;
-        double *q = P2 + 3 * v;
-        int n = one_ring(t, (int)v, ring, rcap);
-        if (n < 0)
+    for (size_t v = 0; v < nv; v++) /* even vertices */
+        if (vertex_mask(t, P, v, 0, ring, rcap, P2 + 3 * v) < 0)
             return lf_error_set(err, LF_ERR_NOMEM, "loopsubdiv: out of memory");
-        if (n == 0) {
-            memcpy(q, p, 3 * sizeof *q);
-        } else if (t->vbound[v]) {
-            const double *a = P + 3 * (size_t)(*ring)[0], *b = P + 3 * (size_t)(*ring)[n - 1];
-            for (int c = 0; c < 3; c++)
-                q[c] = 0.75 * p[c] + 0.125 * (a[c] + b[c]);
-        } else {
-            double beta = loop_beta(n), s[3] = {0, 0, 0};
-            for (int j = 0; j < n; j++)
-                for (int c = 0; c < 3; c++)
-                    s[c] += P[3 * (size_t)(*ring)[j] + c];
-            for (int c = 0; c < 3; c++)
-                q[c] = (1.0 - n * beta) * p[c] + beta * s[c];
-        }
-    }
     unsigned char *done = calloc(t->ne ? t->ne : 1, 1);
     if (!done)
         return lf_error_set(err, LF_ERR_NOMEM, "loopsubdiv: out of memory");
@@ -258,29 +270,11 @@ static int limit_surface(const topo *t, const double *P, float *outP, float *out
     double *L = malloc((t->nv ? t->nv : 1) * 3 * sizeof *L);
     if (!L)
         return lf_error_set(err, LF_ERR_NOMEM, "loopsubdiv: out of memory");
-    for (size_t v = 0; v < t->nv; v++) {
-        const double *p = P + 3 * v;
-        double *q = L + 3 * v;
-        int n = one_ring(t, (int)v, ring, rcap);
-        if (n < 0) {
+    for (size_t v = 0; v < t->nv; v++)
+        if (vertex_mask(t, P, v, 1, ring, rcap, L + 3 * v) < 0) {
             free(L);
             return lf_error_set(err, LF_ERR_NOMEM, "loopsubdiv: out of memory");
         }
-        if (n == 0) {
-            memcpy(q, p, 3 * sizeof *q);
-        } else if (t->vbound[v]) {
-            const double *a = P + 3 * (size_t)(*ring)[0], *b = P + 3 * (size_t)(*ring)[n - 1];
-            for (int c = 0; c < 3; c++)
-                q[c] = 0.6 * p[c] + 0.2 * (a[c] + b[c]);
-        } else {
-            double g = 1.0 / (n + 3.0 / (8.0 * loop_beta(n))), s[3] = {0, 0, 0};
-            for (int j = 0; j < n; j++)
-                for (int c = 0; c < 3; c++)
-                    s[c] += P[3 * (size_t)(*ring)[j] + c];
-            for (int c = 0; c < 3; c++)
-                q[c] = (1.0 - n * g) * p[c] + g * s[c];
-        }
-    }
     for (size_t v = 0; v < t->nv; v++) {
         int n = one_ring(t, (int)v, ring, rcap);
         if (n < 0) {

@@ -109,25 +109,22 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
                 out->data[3 * (size_t)k + c] = lf_acc_value(&acc[k], c);
         if (meta) {
             const lf_attrs *a0 = &parts[0].attrs;
+            int oom = 0;
             for (size_t j = 0; j < a0->count; j++) {
                 const lf_attr *x = &a0->items[j];
                 if (strncmp(x->name, LF_KEY_PREFIX, sizeof LF_KEY_PREFIX - 1) != 0 || !strcmp(x->name, LF_KEY_PART) ||
                     !strcmp(x->name, LF_KEY_SPP_BEGIN) || !strcmp(x->name, LF_KEY_SPP_END))
                     continue;
-                switch (x->type) {
-                case LF_ATTR_STRING: lf_attrs_set_string(meta, x->name, x->s); break;
-                case LF_ATTR_INT: lf_attrs_set_int(meta, x->name, x->i); break;
-                case LF_ATTR_FLOAT: lf_attrs_set_float(meta, x->name, (float)x->d); break;
-                case LF_ATTR_DOUBLE: lf_attrs_set_double(meta, x->name, x->d); break;
-                case LF_ATTR_FLOATS: lf_attrs_set_floats(meta, x->name, x->v, x->n); break;
-                case LF_ATTR_M44D: lf_attrs_set_m44d(meta, x->name, x->m); break;
-                }
+                oom |= lf_attrs_set_copy(meta, x);
             }
-            lf_attrs_set_int(meta, LF_KEY_SPP, spp_total);
-            lf_attrs_set_int(meta, LF_KEY_MERGED_PARTS, n);
-            lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, seconds);
             float b[4] = {(float)bx0, (float)bx1, (float)by0, (float)by1};
-            lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, b, 4);
+            oom |= lf_attrs_set_int(meta, LF_KEY_SPP, spp_total) | lf_attrs_set_int(meta, LF_KEY_MERGED_PARTS, n) |
+                   lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, seconds) |
+                   lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, b, 4);
+            if (oom) {
+                lf_image_free(out);
+                rc = lf_error_set(err, LF_ERR_NOMEM, "merge: out of memory for the merged image's attributes");
+            }
         }
     } else if (!rc) {
         rc = err->code;

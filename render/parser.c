@@ -31,6 +31,7 @@
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -1641,25 +1642,52 @@ static int merge_attrs(parser *P, lf_paramset *ps, int which)
     return lf_params_merge_defaults(ps, &P->gs.attrs[which]) ? nomem(P) : LF_OK;
 }
 
-static int d_material(parser *P, lexer *L, const token *dir)
+/* The start of a world-block directive that adds an element to one of the
+ * scene's arrays: checks the block and makes room for one more element of
+ * elem_size bytes, zeroed, at *elem (the count is not advanced). */
+static int world_slot(parser *P, const token *dir, void **array, size_t *cap, size_t count, size_t elem_size,
+                      void **elem)
 {
     int rc = require_world(P, dir);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *d->materials))
+    if (grow(array, cap, count, elem_size))
         return nomem(P);
-    lf_material_desc *m = &d->materials[d->n_materials];
-    memset(m, 0, sizeof *m);
-    rc = parse_entity(P, L, dir, "a material type", &m->e);
+    *elem = (char *)*array + count * elem_size;
+    memset(*elem, 0, elem_size);
+    return LF_OK;
+}
+
+/* world_slot, then the directive's type and parameters into the entity at
+ * entity_offset of the new element, with the graphics state's attributes of
+ * kind `attrs` merged in.  On failure the entity is freed. */
+static int world_entity(parser *P, lexer *L, const token *dir, void **array, size_t *cap, size_t count,
+                        size_t elem_size, size_t entity_offset, const char *what, int attrs, void **elem)
+{
+    int rc = world_slot(P, dir, array, cap, count, elem_size, elem);
+    if (rc)
+        return rc;
+    lf_entity *e = (lf_entity *)((char *)*elem + entity_offset);
+    rc = parse_entity(P, L, dir, what, e);
     if (!rc)
-        rc = merge_attrs(P, &m->e.params, ATTR_MATERIAL);
-    if (!rc) {
-        rc = check_supported(P, dir, m->e.type, pbrt_materials, refused_materials, "rendered as \"diffuse\" 0.5");
-        if (rc == 1) {
-            make_default_material(&m->e);
-            rc = m->e.type ? LF_OK : nomem(P);
-        }
+        rc = merge_attrs(P, &e->params, attrs);
+    if (rc)
+        entity_free(e);
+    return rc;
+}
+
+static int d_material(parser *P, lexer *L, const token *dir)
+{
+    lf_scene_desc *d = P->d;
+    lf_material_desc *m;
+    int rc = world_entity(P, L, dir, (void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *m,
+                          offsetof(lf_material_desc, e), "a material type", ATTR_MATERIAL, (void **)&m);
+    if (rc)
+        return rc;
+    rc = check_supported(P, dir, m->e.type, pbrt_materials, refused_materials, "rendered as \"diffuse\" 0.5");
+    if (rc == 1) {
+        make_default_material(&m->e);
+        rc = m->e.type ? LF_OK : nomem(P);
     }
     if (rc) {
         entity_free(&m->e);
@@ -1671,14 +1699,11 @@ static int d_material(parser *P, lexer *L, const token *dir)
 
 static int d_make_named_material(parser *P, lexer *L, const token *dir)
 {
-    int rc = require_world(P, dir);
+    lf_scene_desc *d = P->d;
+    lf_material_desc *m;
+    int rc = world_slot(P, dir, (void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *m, (void **)&m);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->materials, &P->cap_materials, d->n_materials, sizeof *d->materials))
-        return nomem(P);
-    lf_material_desc *m = &d->materials[d->n_materials];
-    memset(m, 0, sizeof *m);
     m->e.loc = dir->loc;
     lf_loc name_loc;
     rc = expect_string(P, L, dir, "a material name", &m->name, &name_loc);
@@ -1747,14 +1772,11 @@ static int d_named_material(parser *P, lexer *L, const token *dir)
 
 static int d_texture(parser *P, lexer *L, const token *dir)
 {
-    int rc = require_world(P, dir);
+    lf_scene_desc *d = P->d;
+    lf_texture_desc *t;
+    int rc = world_slot(P, dir, (void **)&d->textures, &P->cap_textures, d->n_textures, sizeof *t, (void **)&t);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->textures, &P->cap_textures, d->n_textures, sizeof *d->textures))
-        return nomem(P);
-    lf_texture_desc *t = &d->textures[d->n_textures];
-    memset(t, 0, sizeof *t);
     t->e.loc = dir->loc;
     char *kind = NULL;
     lf_loc name_loc, kind_loc;
@@ -1804,19 +1826,13 @@ static int d_texture(parser *P, lexer *L, const token *dir)
 
 static int d_light_source(parser *P, lexer *L, const token *dir)
 {
-    int rc = require_world(P, dir);
+    lf_scene_desc *d = P->d;
+    lf_light_desc *l;
+    int rc = world_entity(P, L, dir, (void **)&d->lights, &P->cap_lights, d->n_lights, sizeof *l,
+                          offsetof(lf_light_desc, e), "a light type", ATTR_LIGHT, (void **)&l);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->lights, &P->cap_lights, d->n_lights, sizeof *d->lights))
-        return nomem(P);
-    lf_light_desc *l = &d->lights[d->n_lights];
-    memset(l, 0, sizeof *l);
-    rc = parse_entity(P, L, dir, "a light type", &l->e);
-    if (!rc)
-        rc = merge_attrs(P, &l->e.params, ATTR_LIGHT);
-    if (!rc)
-        rc = check_supported(P, dir, l->e.type, pbrt_lights, refused_lights, "it is left out");
+    rc = check_supported(P, dir, l->e.type, pbrt_lights, refused_lights, "it is left out");
     if (rc) {
         entity_free(&l->e);
         return rc == 1 ? LF_OK : rc;
@@ -1829,39 +1845,25 @@ static int d_light_source(parser *P, lexer *L, const token *dir)
 
 static int d_area_light_source(parser *P, lexer *L, const token *dir)
 {
-    int rc = require_world(P, dir);
+    lf_scene_desc *d = P->d;
+    lf_entity *e;
+    int rc = world_entity(P, L, dir, (void **)&d->area_lights, &P->cap_area_lights, d->n_area_lights, sizeof *e, 0,
+                          "an area light type", ATTR_LIGHT, (void **)&e);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->area_lights, &P->cap_area_lights, d->n_area_lights, sizeof *d->area_lights))
-        return nomem(P);
-    lf_entity *e = &d->area_lights[d->n_area_lights];
-    rc = parse_entity(P, L, dir, "an area light type", e);
-    if (!rc)
-        rc = merge_attrs(P, &e->params, ATTR_LIGHT);
-    if (rc) {
-        entity_free(e);
-        return rc;
-    }
     P->gs.area_light = (int)d->n_area_lights++;
     return LF_OK;
 }
 
 static int d_shape(parser *P, lexer *L, const token *dir)
 {
-    int rc = require_world(P, dir);
+    lf_scene_desc *d = P->d;
+    lf_shape_desc *s;
+    int rc = world_entity(P, L, dir, (void **)&d->shapes, &P->cap_shapes, d->n_shapes, sizeof *s,
+                          offsetof(lf_shape_desc, e), "a shape type", ATTR_SHAPE, (void **)&s);
     if (rc)
         return rc;
-    lf_scene_desc *d = P->d;
-    if (grow((void **)&d->shapes, &P->cap_shapes, d->n_shapes, sizeof *d->shapes))
-        return nomem(P);
-    lf_shape_desc *s = &d->shapes[d->n_shapes];
-    memset(s, 0, sizeof *s);
-    rc = parse_entity(P, L, dir, "a shape type", &s->e);
-    if (!rc)
-        rc = merge_attrs(P, &s->e.params, ATTR_SHAPE);
-    if (!rc)
-        rc = check_supported(P, dir, s->e.type, pbrt_shapes, refused_shapes, "it is left out");
+    rc = check_supported(P, dir, s->e.type, pbrt_shapes, refused_shapes, "it is left out");
     if (rc) {
         entity_free(&s->e);
         return rc == 1 ? LF_OK : rc;

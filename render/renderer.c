@@ -16,7 +16,10 @@
 #include <xmmintrin.h>
 #endif
 
+#include "../base/lf_buf.h"
 #include "../base/lf_keys.h"
+#include "../base/lf_parallel.h"
+#include "../base/lf_progress.h"
 #include "../base/lf_color.h"
 #include "film.h"
 #include "render_internal.h"
@@ -94,6 +97,32 @@ static void where_of(char *buf, size_t n, const lf_loc *loc)
     snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
 }
 
+/* An options-block directive (Film, Sampler, PixelFilter, Integrator,
+ * Camera) as the readers take it: its parameters (an empty list when the
+ * scene leaves the directive out), its type or pbrt's default, and
+ * "file:line:col" for messages. */
+typedef struct option_entity {
+    lf_paramset *ps, empty;
+    const char *type;
+    char where[512];
+} option_entity;
+
+static void option_entity_init(option_entity *o, lf_entity *e, const char *default_type)
+{
+    memset(&o->empty, 0, sizeof o->empty);
+    o->ps = e->type ? &e->params : &o->empty;
+    o->type = e->type ? e->type : default_type;
+    where_of(o->where, sizeof o->where, &e->loc);
+}
+
+/* Reports the directive's unused or mistyped parameters ("Sampler \"halton\""). */
+static int option_entity_finish(const option_entity *o, const char *directive, lf_error *err)
+{
+    char ctx[128];
+    snprintf(ctx, sizeof ctx, "%s \"%s\"", directive, o->type);
+    return lf_params_finish(o->ps, ctx, err);
+}
+
 /* ---- camera parameter adaptor (the plugin ABI's lf_camera_params) ---- */
 typedef struct camera_param_ctx {
     lf_paramset *ps;
@@ -168,10 +197,10 @@ static int cp_floats(void *ctx, const char *name, double *out, int max)
 static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_entity *f = &d->film;
-    lf_paramset empty = {0};
-    lf_paramset *ps = f->type ? &f->params : &empty;
-    char where[512];
-    where_of(where, sizeof where, &f->loc);
+    option_entity oe;
+    option_entity_init(&oe, f, "rgb");
+    lf_paramset *ps = oe.ps;
+    const char *where = oe.where;
     if (f->type && strcmp(f->type, "rgb") != 0)
         lf_warn_append(&r->warnings, "%s: warning: Film \"%s\" is rendered as Film \"rgb\"", where, f->type);
     r->xres = lf_params_int(ps, "xresolution", 1280);
@@ -218,12 +247,10 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 
 static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->sampler;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "zsobol";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->sampler, "zsobol");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     r->sampler.spp = lf_params_int(ps, "pixelsamples", 16);
     r->sampler.seed = (uint32_t)lf_params_int(ps, "seed", 0);
     if (!strcmp(type, "halton")) {
@@ -292,19 +319,15 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     }
     if (lf_sampler_prepare(&r->sampler, r->xres, r->yres))
         return lf_error_set(err, LF_ERR_NOMEM, "%s: cannot prepare Sampler \"%s\" (out of memory)", where, type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Sampler \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Sampler", err);
 }
 
 static int read_filter(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->filter;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "gaussian";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->filter, "gaussian");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     static const struct {
         const char *name;
         lf_filter_kind kind;
@@ -333,19 +356,15 @@ static int read_filter(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (lf_filter_init(&r->filter, kinds[k].kind, &fp, err))
         return err->code;
     r->filter_name = dupstr(type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "PixelFilter \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "PixelFilter", err);
 }
 
 static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
-    lf_entity *e = &d->integrator;
-    lf_paramset empty = {0};
-    lf_paramset *ps = e->type ? &e->params : &empty;
-    const char *type = e->type ? e->type : "volpath";
-    char where[512];
-    where_of(where, sizeof where, &e->loc);
+    option_entity oe;
+    option_entity_init(&oe, &d->integrator, "volpath");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     if (!strcmp(type, "ambientocclusion") || !strcmp(type, "aov"))
         return lf_error_set(err, LF_ERR_UNSUPPORTED,
                             "%s: Integrator \"%s\" is not supported (it computes something other than radiance)", where,
@@ -389,19 +408,16 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (r->integrator.max_depth < 0)
         return lf_error_set(err, LF_ERR_PARAM, "%s: maxdepth must be >= 0", where);
     r->integrator_name = dupstr(type);
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Integrator \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Integrator", err);
 }
 
 static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_camera_desc *cd = &d->camera;
-    lf_paramset empty = {0};
-    lf_paramset *ps = cd->e.type ? &cd->e.params : &empty;
-    const char *type = cd->e.type ? cd->e.type : "perspective";
-    char where[512];
-    where_of(where, sizeof where, &cd->e.loc);
+    option_entity oe;
+    option_entity_init(&oe, &cd->e, "perspective");
+    lf_paramset *ps = oe.ps;
+    const char *type = oe.type, *where = oe.where;
     r->camera_type = lf_camera_find(type);
     if (!r->camera_type) {
         char names[512] = "";
@@ -526,9 +542,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         lf_motion_table_init(&r->camera_motion, 1e-9, 16384, &r->camera_table);
         r->camera_moving = 1;
     }
-    char ctx[128];
-    snprintf(ctx, sizeof ctx, "Camera \"%s\"", type);
-    return lf_params_finish(ps, ctx, err);
+    return option_entity_finish(&oe, "Camera", err);
 }
 
 int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer **out, lf_error *err)
@@ -682,37 +696,14 @@ void lf_renderer_free(lf_renderer *r)
 
 /* ---- the effect plan ---- */
 
-static void appendf(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
-{
-    va_list ap;
-    for (;;) {
-        va_start(ap, fmt);
-        int n = vsnprintf(*buf ? *buf + *len : NULL, *buf ? *cap - *len : 0, fmt, ap);
-        va_end(ap);
-        if (n < 0)
-            return;
-        if (*buf && *len + (size_t)n < *cap) {
-            *len += (size_t)n;
-            return;
-        }
-        size_t nc = (*cap + (size_t)n + 256) * 2;
-        char *nb = realloc(*buf, nc);
-        if (!nb)
-            return;
-        *buf = nb;
-        *cap = nc;
-    }
-}
-
 char *lf_renderer_explain(const lf_renderer *r)
 {
-    char *b = NULL;
-    size_t len = 0, cap = 0;
+    lf_strbuf b = {0};
     const lf_scene *s = &r->scene;
-    appendf(&b, &len, &cap, "scene: %s\n", r->scene_path ? r->scene_path : "(memory)");
-    appendf(&b, &len, &cap, "film: %dx%d, rendering pixels [%d,%d) x [%d,%d), diagonal %g mm\n", r->xres, r->yres,
+    lf_strbuf_printf(&b, "scene: %s\n", r->scene_path ? r->scene_path : "(memory)");
+    lf_strbuf_printf(&b, "film: %dx%d, rendering pixels [%d,%d) x [%d,%d), diagonal %g mm\n", r->xres, r->yres,
             r->px0, r->px1, r->py0, r->py1, r->diagonal_mm);
-    appendf(&b, &len, &cap, "camera: \"%s\"\n", r->camera_name);
+    lf_strbuf_printf(&b, "camera: \"%s\"\n", r->camera_name);
     if (r->camera_type->describe) {
         char desc[4096];
         int n = r->camera_type->describe(r->camera, desc, sizeof desc);
@@ -722,39 +713,39 @@ char *lf_renderer_explain(const lf_renderer *r)
                 nl = strchr(line, '\n');
                 if (nl)
                     *nl = '\0';
-                appendf(&b, &len, &cap, "  %s\n", line);
+                lf_strbuf_printf(&b, "  %s\n", line);
                 line = nl ? nl + 1 : NULL;
             }
         }
     }
-    appendf(&b, &len, &cap, "effects:\n");
-    appendf(&b, &len, &cap, "  defocus: %s\n",
+    lf_strbuf_printf(&b, "effects:\n");
+    lf_strbuf_printf(&b, "  defocus: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_LENS ? "on (the camera samples its lens)"
                                                    : "off (pinhole: no lens samples drawn)");
     if (r->time_needed) {
         char shapes[512];
         lf_scene_motion_summary(s, shapes, sizeof shapes);
-        appendf(&b, &len, &cap, "  motion blur: on (%s; camera %s); one time sample per camera ray in [%g, %g]\n",
+        lf_strbuf_printf(&b, "  motion blur: on (%s; camera %s); one time sample per camera ray in [%g, %g]\n",
                 shapes, r->camera_moving ? "moving" : "static", r->shutter_open,
                 r->shutter_close + (r->rolling ? r->readout : 0));
     } else {
-        appendf(&b, &len, &cap, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
+        lf_strbuf_printf(&b, "  motion blur: off (nothing moves%s; static BVH, no time samples)\n",
                 r->shutter_close > r->shutter_open ? "" : " and the shutter is an instant");
     }
     if (r->rolling)
-        appendf(&b, &len, &cap, "  rolling shutter: on, readout %g s %s, exposure %g s per row%s\n", r->readout,
+        lf_strbuf_printf(&b, "  rolling shutter: on, readout %g s %s, exposure %g s per row%s\n", r->readout,
                 (const char *[]){"top to bottom", "bottom to top", "left to right", "right to left"}[r->readout_dir],
                 r->shutter_close - r->shutter_open, r->time_needed ? "" : " (nothing moves: no visible effect)");
     else
-        appendf(&b, &len, &cap, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
+        lf_strbuf_printf(&b, "  rolling shutter: off (global shutter %g..%g)\n", r->shutter_open, r->shutter_close);
     if (r->has_curve)
-        appendf(&b, &len, &cap, "  shutter curve: mean efficiency %.4g, times importance-sampled\n", r->curve_mean);
-    appendf(&b, &len, &cap, "  dispersion: %s\n",
+        lf_strbuf_printf(&b, "  shutter curve: mean efficiency %.4g, times importance-sampled\n", r->curve_mean);
+    lf_strbuf_printf(&b, "  dispersion: %s\n",
             r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH ? "on (the camera samples wavelength)"
                                                          : "off (no wavelength samples)");
-    appendf(&b, &len, &cap, "  exposure: imaging ratio %g (shutter %g s x ISO/100)\n", r->imaging_ratio,
+    lf_strbuf_printf(&b, "  exposure: imaging ratio %g (shutter %g s x ISO/100)\n", r->imaging_ratio,
             r->shutter_close - r->shutter_open);
-    appendf(&b, &len, &cap, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
+    lf_strbuf_printf(&b, "sampler: %s (%s), %d spp, seed %u\n", r->sampler_name,
             r->sampler.kind == LF_SAMPLER_SOBOL        ? "Owen-scrambled Sobol, padded pairs"
             : r->sampler.kind == LF_SAMPLER_HALTON
                 ? (r->sampler.randomize == LF_HALTON_OWEN   ? "image-wide Halton, Owen-scrambled digits"
@@ -764,30 +755,30 @@ char *lf_renderer_explain(const lf_renderer *r)
             : r->sampler.kind == LF_SAMPLER_STRATIFIED ? "jittered strata"
                                                        : "independent uniform",
             r->sampler.spp, r->sampler.seed);
-    appendf(&b, &len, &cap, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
+    lf_strbuf_printf(&b, "filter: %s, radius %g x %g\n", r->filter_name, r->filter.radius[0], r->filter.radius[1]);
     char rr[96];
     snprintf(rr, sizeof rr, "Russian roulette %s after depth %d",
              r->integrator.rr_rule == LF_RR_SQRT ? "p = sqrt(max throughput)" : "p = max throughput (pbrt-v4)",
              r->integrator.rr_depth);
     if (s->has_media && r->integrator.volumetric)
-        appendf(&b, &len, &cap,
+        lf_strbuf_printf(&b,
                 "integrator: %s -> volumetric path tracing with NEE + MIS, maxdepth %d, %s; %d "
                 "homogeneous media (closed-form transmittance, spectral-MIS distance sampling, Henyey-Greenstein), "
                 "camera in %s\n",
                 r->integrator_name, r->integrator.max_depth, rr, s->n_media,
                 s->camera_medium >= 0 ? "a medium" : "vacuum");
     else
-        appendf(&b, &len, &cap, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, %s%s\n",
+        lf_strbuf_printf(&b, "integrator: %s -> path tracing with NEE + MIS, maxdepth %d, %s%s\n",
                 r->integrator_name, r->integrator.max_depth, rr,
                 s->n_media ? " (media defined but no ray can enter one, or ignored by \"path\")" : "");
-    appendf(&b, &len, &cap, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
+    lf_strbuf_printf(&b, "geometry: %lld triangles in %d meshes, %d analytic spheres (Embree %s)\n",
             s->n_triangles, s->n_meshes, s->n_spheres,
             s->moving_shapes ? "BVH with motion nodes for the moving shapes" : "static BVH");
     int counts[LF_LIGHT_SPHERE + 1] = {0};
     for (int i = 0; i < s->n_lights; i++)
         counts[s->lights[i].kind]++;
     lf_light_sampler lsm = lf_light_sampler_for(&r->integrator, s);
-    appendf(&b, &len, &cap,
+    lf_strbuf_printf(&b,
             "lights: %d (point %d, spot %d, distant %d, infinite %d, image infinite %d, area triangles %d, area "
             "quads %d, area spheres %d), %s\n",
             s->n_lights, counts[LF_LIGHT_POINT], counts[LF_LIGHT_SPOT], counts[LF_LIGHT_DISTANT],
@@ -796,8 +787,12 @@ char *lf_renderer_explain(const lf_renderer *r)
             lsm == LF_LIGHTS_ALL       ? "every light sampled at every vertex (one shadow ray each)"
             : lsm == LF_LIGHTS_UNIFORM ? "one light per vertex, chosen uniformly"
                                        : "one light per vertex, chosen by power");
-    appendf(&b, &len, &cap, "threads: %d\n", r->threads);
-    return b;
+    lf_strbuf_printf(&b, "threads: %d\n", r->threads);
+    if (b.failed) { /* out of memory: no half a plan */
+        lf_strbuf_free(&b);
+        return NULL;
+    }
+    return lf_strbuf_take(&b);
 }
 
 /* ---- rendering ---- */
@@ -809,7 +804,6 @@ typedef struct job {
     lf_image *img;
     lf_pixel_acc *acc;        /* per-pixel sums when writing parts or checkpoints, else NULL */
     int tiles_x, tiles_y;
-    atomic_int next_tile;
     atomic_long done_tiles;
     atomic_uchar *tile_done;  /* 1 once a tile's pixels are final */
     int *order;               /* tiles still to render, in order */
@@ -988,8 +982,11 @@ static void render_tile(job *jb, int tile, long long *rays, long long *paths, lo
         }
 }
 
-static void *worker(void *arg)
+/* Tiles jb->order[k0, k1) (lf_parallel_fn: the threads take tiles one at a
+ * time, in order, from base/lf_parallel.h's counter). */
+static void render_tiles(void *arg, int k0, int k1, int tid)
 {
+    (void)tid;
     job *jb = arg;
 #if defined(__SSE__) || defined(__x86_64__)
     /* Denormals slow float math by orders of magnitude and carry no light. */
@@ -999,11 +996,8 @@ static void *worker(void *arg)
     long long rays = 0, paths = 0, nonfinite = 0, zero_weight = 0;
     int total = jb->tiles_x * jb->tiles_y;
     volatile int *stop = jb->r->opts.stop;
-    for (;;) {
+    for (int k = k0; k < k1; k++) {
         if (stop && *stop)
-            break;
-        int k = atomic_fetch_add(&jb->next_tile, 1);
-        if (k >= jb->n_order)
             break;
         int t = jb->order[k];
         render_tile(jb, t, &rays, &paths, &nonfinite, &zero_weight);
@@ -1019,7 +1013,6 @@ static void *worker(void *arg)
     atomic_fetch_add(&jb->paths, paths);
     atomic_fetch_add(&jb->nonfinite, nonfinite);
     atomic_fetch_add(&jb->zero_weight, zero_weight);
-    return NULL;
 }
 
 static void sink_string(void *ctx, const char *name, const char *value)
@@ -1088,13 +1081,6 @@ int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err)
             out->data[(size_t)(y - r->py0) * out->width + (x - r->px0)] = disp;
         }
     return LF_OK;
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 /* ---- parts and checkpoints ---- */
@@ -1275,51 +1261,28 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
             jb.order[jb.n_order++] = t;
     atomic_store(&jb.done_tiles, total - jb.n_order);
     pthread_mutex_init(&jb.progress_lock, NULL);
-    double t0 = now_seconds();
-    int nt = r->threads;
-    pthread_t *th = calloc((size_t)nt, sizeof *th);
-    if (!th) {
-        free(jb.tile_done), free(jb.order), free(jb.acc);
-        lf_image_free(img);
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-    }
+    double t0 = lf_seconds();
     int rc = 0;
     if (!r->opts.checkpoint_path) {
-        /* the calling thread renders too */
-        for (int i = 1; i < nt; i++)
-            if (pthread_create(&th[i], NULL, worker, &jb) != 0)
-                th[i] = 0;
-        worker(&jb);
-        for (int i = 1; i < nt; i++)
-            if (th[i])
-                pthread_join(th[i], NULL);
+        lf_parallel_for(jb.n_order, r->threads, 1, render_tiles, &jb); /* the calling thread renders too */
     } else {
         /* the calling thread watches: periodic checkpoints and stop requests */
-        int started = 0;
-        for (int i = 0; i < nt; i++)
-            if (pthread_create(&th[i], NULL, worker, &jb) == 0)
-                started++;
-            else
-                th[i] = 0;
-        if (!started)
-            worker(&jb);
-        double last = now_seconds();
+        lf_parallel_job *pj = lf_parallel_start(jb.n_order, r->threads, 1, render_tiles, &jb);
+        double last = lf_seconds();
         for (;;) {
             long done = atomic_load(&jb.done_tiles);
-            if (done >= total || (r->opts.stop && *r->opts.stop) || !started)
+            if (done >= total || (r->opts.stop && *r->opts.stop))
                 break;
             struct timespec ts = {0, 20 * 1000 * 1000};
             nanosleep(&ts, NULL);
-            if (r->opts.checkpoint_every > 0 && now_seconds() - last >= r->opts.checkpoint_every) {
+            if (r->opts.checkpoint_every > 0 && lf_seconds() - last >= r->opts.checkpoint_every) {
                 lf_error cerr = {0};
                 if (write_checkpoint(r, &jb, &cerr) && !rc)
                     rc = lf_error_set(err, cerr.code, "checkpoint: %s", cerr.msg);
-                last = now_seconds();
+                last = lf_seconds();
             }
         }
-        for (int i = 0; i < nt; i++)
-            if (th[i])
-                pthread_join(th[i], NULL);
+        lf_parallel_join(pj);
         if (atomic_load(&jb.done_tiles) < total) {
             /* stopped: the final checkpoint holds every finished tile */
             lf_error cerr = {0};
@@ -1332,7 +1295,6 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
                                   atomic_load(&jb.done_tiles), total, r->opts.checkpoint_path);
         }
     }
-    free(th);
     pthread_mutex_destroy(&jb.progress_lock);
     if (!rc && r->opts.part) {
         lf_image part;
@@ -1350,7 +1312,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
         lf_image_free(img);
         return rc;
     }
-    r->stats.seconds = now_seconds() - t0;
+    r->stats.seconds = lf_seconds() - t0;
     r->stats.rays = jb.rays;
     r->stats.camera_paths = jb.paths;
     r->stats.nonfinite_samples = jb.nonfinite;

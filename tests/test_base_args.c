@@ -41,7 +41,7 @@ static const lf_command cmds[] = {
 };
 static const lf_tool tool = {"lftool", "light-field tool", "9.8", cmds, LF_ARRAY_LEN(cmds), NULL};
 
-static char err[512];
+static char err[1024]; /* the last parse's message */
 static char *pos[32];
 static int npos;
 
@@ -53,7 +53,12 @@ static lf_args_status parse(const char *cmd, int argc, const char **words)
     for (int i = 0; i < argc; i++)
         argv[i + 2] = (char *)words[i];
     memset(&o, 0, sizeof o);
-    return lf_args_parse(&tool, lf_args_find(&tool, cmd), argc + 2, argv, 2, pos, &npos, err, sizeof err);
+    lf_error e = {0};
+    e.code = LF_ERR_IO; /* a stale error is cleared */
+    lf_args_status st = lf_args_parse(&tool, lf_args_find(&tool, cmd), argc + 2, argv, 2, pos, &npos, &e);
+    snprintf(err, sizeof err, "%s", e.msg);
+    CHECK((st == LF_ARGS_ERROR) == (e.code == LF_ERR_PARAM) && (st == LF_ARGS_ERROR || e.code == LF_OK));
+    return st;
 }
 
 #define ARGS(...) (int)(sizeof((const char *[]){__VA_ARGS__}) / sizeof(const char *)), (const char *[]){__VA_ARGS__}

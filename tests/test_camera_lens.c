@@ -18,11 +18,11 @@
 
 static int load(const char *name, lf_lens *L)
 {
-    char err[1024];
+    lf_error err = {0};
     char path[1024];
     snprintf(path, sizeof path, "%s%s", LENSES, name);
-    if (lf_lens_load(path, L, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
+    if (lf_lens_load(path, L, &err)) {
+        CHECK_MSG(0, "%s", err.msg);
         return -1;
     }
     return 0;
@@ -30,9 +30,9 @@ static int load(const char *name, lf_lens *L)
 
 static int parse(const char *text, lf_lens *L)
 {
-    char err[1024];
-    if (lf_lens_parse(text, "test.dat", L, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
+    lf_error err = {0};
+    if (lf_lens_parse(text, "test.dat", L, &err)) {
+        CHECK_MSG(0, "%s", err.msg);
         return -1;
     }
     return 0;
@@ -143,8 +143,8 @@ static void test_singlet(void)
     CHECK_NEAR(px.fnumber, thin / 20.0, 1e-6);
     /* Thin lens focus: 1/u + 1/v = 1/f with D = u + v (distances from the film). */
     double D = 1000, v;
-    char err[256];
-    CHECK(lf_lens_focus_thick(&L, D, &v, err, sizeof err) == 0);
+    lf_error err = {0};
+    CHECK(lf_lens_focus_thick(&L, D, &v, &err) == 0);
     double u = D - v;
     CHECK_NEAR(1 / u + 1 / v, 1 / thin, 1e-6 / thin);
     lf_lens_free(&L);
@@ -269,14 +269,14 @@ static void test_parse_errors(void)
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         lf_lens L;
-        char err[512] = "";
-        CHECK(lf_lens_parse(bad[i].text, "test.dat", &L, err, sizeof err) != 0);
-        CHECK_MSG(strstr(err, bad[i].want) != NULL, "got \"%s\", want \"%s\"", err, bad[i].want);
+        lf_error err = {0};
+        CHECK(lf_lens_parse(bad[i].text, "test.dat", &L, &err) != 0);
+        CHECK_MSG(strstr(err.msg, bad[i].want) != NULL, "got \"%s\", want \"%s\"", err.msg, bad[i].want);
     }
     lf_lens L;
-    char err[512] = "";
-    CHECK(lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/no-such.dat", &L, err, sizeof err) != 0);
-    CHECK(strstr(err, "no-such.dat") != NULL);
+    lf_error err = {0};
+    CHECK(lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/no-such.dat", &L, &err) != 0);
+    CHECK(strstr(err.msg, "no-such.dat") != NULL && err.code == LF_ERR_IO);
 }
 
 static void test_focus(void)
@@ -305,8 +305,8 @@ static void test_focus(void)
         }
 #undef B_OF
         double v_ref = 0.5 * (lo + hi), v;
-        char err[256];
-        CHECK(lf_lens_focus_thick(&L, Ds[k], &v, err, sizeof err) == 0);
+        lf_error err = {0};
+        CHECK(lf_lens_focus_thick(&L, Ds[k], &v, &err) == 0);
         CHECK_NEAR(v, v_ref, 1e-6);
         CHECK_NEAR(lf_lens_paraxial_focus_distance(&L, &px, v_ref), Ds[k], 1e-6 * Ds[k]);
         /* Stopped down to 2 mm (f/25), real rays focus where paraxial ones do,
@@ -317,17 +317,17 @@ static void test_focus(void)
         S.s = surf;
         lf_lens_set_stop_diameter(&S, 2.0, NULL, 0);
         double v_search;
-        CHECK(lf_lens_focus_search(&S, Ds[k], &v_search, err, sizeof err) == 0);
+        CHECK(lf_lens_focus_search(&S, Ds[k], &v_search, &err) == 0);
         CHECK_NEAR(v_search, v_ref, 0.02);
     }
     /* Closer than possible: a clear error, the film distance untouched. */
     double v = -1;
-    char err[512] = "";
-    CHECK(lf_lens_focus_thick(&L, 100.0, &v, err, sizeof err) != 0);
+    lf_error err = {0};
+    CHECK(lf_lens_focus_thick(&L, 100.0, &v, &err) != 0);
     CHECK(v == -1);
-    CHECK_MSG(strstr(err, "closer than") != NULL, "%s", err);
+    CHECK_MSG(strstr(err.msg, "closer than") != NULL, "%s", err.msg);
     /* ... and the closest possible (unit magnification) is 4f + hiatus. */
-    CHECK(lf_lens_focus_thick(&L, lf_lens_closest_focus_mm(&px) * 1.0001, &v, err, sizeof err) == 0);
+    CHECK(lf_lens_focus_thick(&L, lf_lens_closest_focus_mm(&px) * 1.0001, &v, &err) == 0);
     CHECK_NEAR(v, px.rear_principal_mm + 2 * px.efl_mm, 0.02 * px.efl_mm);
     /* Aperture larger than the stop: clamped with a warning. */
     char warn[512] = "";
@@ -354,8 +354,8 @@ static void test_pupil_unbiased(void)
         if (load(files[k], &L))
             continue;
         lf_lens_set_stop_diameter(&L, 1e3, NULL, 0); /* wide open: the hardest bounds */
-        char err[256];
-        CHECK(lf_lens_focus_thick(&L, 10000.0, &L.film_distance_mm, err, sizeof err) == 0);
+        lf_error err = {0};
+        CHECK(lf_lens_focus_thick(&L, 10000.0, &L.film_distance_mm, &err) == 0);
         lf_lens_pupil P;
         CHECK(lf_lens_pupil_build(&L, film_r, 0, &P) > 0);
         uint64_t seed = 1234 + k;
@@ -772,8 +772,9 @@ static void test_batch_matches_scalar(void)
         if (load(de->d_name, &L))
             continue;
         n_lenses++;
-        char err[256], what[512];
-        CHECK(lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, err, sizeof err) == 0);
+        char what[512];
+        lf_error err = {0};
+        CHECK(lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, &err) == 0);
         /* Glass gets dispersion for the wavelength cases (Cauchy B = 0.005 um^2
          * through n_d) unless the file has Abbe numbers. */
         lf_lens D = L;
@@ -897,8 +898,7 @@ static void test_batch_matches_scalar(void)
                                 2.0 + 10.0 * rnd(&seed));
         }
         lf_lens L;
-        char err[512];
-        if (lf_lens_parse(text, "random.dat", &L, err, sizeof err))
+        if (lf_lens_parse(text, "random.dat", &L, NULL))
             continue; /* e.g. glass right after a stop row (ior 1 there): skip */
         L.film_distance_mm = 5.0 + 40.0 * rnd(&seed);
         L.dispersive = k % 2;

@@ -95,10 +95,9 @@ static double reference_rms(double film_mm, double theta)
 int main(void)
 {
     lf_lens L;
-    char msg[512];
-    CHECK(lf_lens_parse(prescription, "singlet.dat", &L, msg, sizeof msg) == 0);
-    lf_lens_report r;
     lf_error err = {0};
+    CHECK(lf_lens_parse(prescription, "singlet.dat", &L, &err) == 0);
+    lf_lens_report r;
     CHECK(lf_lens_report_compute(&L, 36, 24, INFINITY, &r, &err) == 0);
 
     /* First order from the thick-lens formulas. */

@@ -17,53 +17,8 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- a parameter store standing in for the scene file ---- */
-typedef struct kv {
-    const char *name;
-    double v[4];
-    int n;
-    const char *str;
-} kv;
-typedef struct store {
-    kv items[12];
-    int n;
-} store;
+#include "tests/camera_store.h"
 
-static const kv *find(store *s, const char *name)
-{
-    for (int i = 0; i < s->n; i++)
-        if (!strcmp(s->items[i].name, name))
-            return &s->items[i];
-    return NULL;
-}
-static double g_float(void *c, const char *name, double def)
-{
-    const kv *k = find(c, name);
-    return k ? k->v[0] : def;
-}
-static int g_int(void *c, const char *name, int def)
-{
-    const kv *k = find(c, name);
-    return k ? (int)k->v[0] : def;
-}
-static int g_bool(void *c, const char *name, int def)
-{
-    return g_int(c, name, def);
-}
-static const char *g_string(void *c, const char *name, const char *def)
-{
-    const kv *k = find(c, name);
-    return k && k->str ? k->str : def;
-}
-static int g_floats(void *c, const char *name, double *out, int max)
-{
-    const kv *k = find(c, name);
-    if (!k || k->str)
-        return 0;
-    for (int i = 0; i < k->n && i < max; i++)
-        out[i] = k->v[i];
-    return k->n;
-}
 static int g_image(void *c, const char *path, int *w, int *h, float **px, char *err, size_t n)
 {
     (void)c, (void)w, (void)h, (void)px;
@@ -758,16 +713,17 @@ static void test_plenoptic_compound(double mla_scale, double *outside_fraction)
     const lf_camera_type *t = lf_camera_find("plenoptic");
     const double stop_mm = 8, focus_m = 2, p_um = 100;
     lf_lens lens;
-    char err[512] = "";
-    if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
+    char err[512] = ""; /* the camera plugins' message buffer */
+    lf_error lerr = {0};
+    if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, &lerr)) {
+        CHECK_MSG(0, "%s", lerr.msg);
         return;
     }
     char warn[600];
     lf_lens_set_stop_diameter(&lens, stop_mm, warn, sizeof warn);
     lf_lens_paraxial px;
     CHECK(lf_lens_paraxial_analyse(&lens, &px) == 0);
-    CHECK(lf_lens_focus_thick(&lens, focus_m * 1e3, &lens.film_distance_mm, err, sizeof err) == 0);
+    CHECK(lf_lens_focus_thick(&lens, focus_m * 1e3, &lens.film_distance_mm, &lerr) == 0);
     double Nw = lf_lens_working_fnumber(&lens, &px, focus_m * 1e3, lens.film_distance_mm);
     double Z = lens.film_distance_mm - px.exit_pupil_mm; /* mm, MLA -> exit pupil */
     double p = p_um * 1e-3, fm = p * Nw * mla_scale, Pimg = p * (Z + fm) / Z;

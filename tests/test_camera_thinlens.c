@@ -17,54 +17,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- a tiny parameter store standing in for the scene file ---- */
-typedef struct kv {
-    const char *name;
-    double v[4];
-    int n;
-    const char *s;
-} kv;
-typedef struct store {
-    kv items[12];
-    int n;
-    int image_kind; /* synthetic aperture images: 0 none, 1 ring, 2 all black */
-} store;
-
-static const kv *find(const store *s, const char *name)
-{
-    for (int i = 0; i < s->n; i++)
-        if (!strcmp(s->items[i].name, name))
-            return &s->items[i];
-    return NULL;
-}
-static double g_float(void *c, const char *name, double def)
-{
-    const kv *k = find(c, name);
-    return k && !k->s ? k->v[0] : def;
-}
-static int g_int(void *c, const char *name, int def)
-{
-    const kv *k = find(c, name);
-    return k && !k->s ? (int)k->v[0] : def;
-}
-static int g_bool(void *c, const char *name, int def)
-{
-    return g_int(c, name, def);
-}
-static const char *g_string(void *c, const char *name, const char *def)
-{
-    const kv *k = find(c, name);
-    return k && k->s ? k->s : def;
-}
-static int g_floats(void *c, const char *name, double *out, int max)
-{
-    const kv *k = find(c, name);
-    if (!k || k->s)
-        return 0;
-    for (int i = 0; i < k->n && i < max; i++)
-        out[i] = k->v[i];
-    return k->n;
-}
+#include "tests/camera_store.h"
 
 /* Ring image 64x64: transmission 1 for 0.4 < r < 0.9 (r in units of the
  * half-width), 0.5 in the inner disk r < 0.2, 0 elsewhere. */

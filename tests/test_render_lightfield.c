@@ -271,15 +271,16 @@ static void test_plenoptic_centre_view(int compound)
     double pin_z = 0, mag = 1;
     if (compound) {
         lf_lens lens;
-        char err[512], warn[512];
+        char warn[512];
+        lf_error lerr = {0};
         lf_lens_paraxial px;
-        if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, err, sizeof err)) {
-            CHECK_MSG(0, "%s", err);
+        if (lf_lens_load(LF_SOURCE_DIR "/scenes/lenses/dgauss.50mm.dat", &lens, &lerr)) {
+            CHECK_MSG(0, "%s", lerr.msg);
             return;
         }
         lf_lens_set_stop_diameter(&lens, 8.0, warn, sizeof warn);
         lf_lens_paraxial_analyse(&lens, &px);
-        lf_lens_focus_thick(&lens, zo, &lens.film_distance_mm, err, sizeof err);
+        lf_lens_focus_thick(&lens, zo, &lens.film_distance_mm, &lerr);
         zi = lens.film_distance_mm - px.exit_pupil_mm, D = px.exit_pupil_diameter_mm;
         mag = px.entrance_pupil_diameter_mm / px.exit_pupil_diameter_mm;
         pin_z = (px.front_principal_mm - px.entrance_pupil_mm) * 1e-3; /* camera origin at H */

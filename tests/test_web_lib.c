@@ -242,6 +242,8 @@ int main(void)
         CHECK(r5 && strstr(r5, "200 OK") && strstr(r5, "text/javascript") && strstr(r5, "\r\n\r\n")[4] == '\0');
         pthread_join(th, NULL);
         free(r1), free(r2), free(r3), free(r4), free(r5);
+        volatile sig_atomic_t stop = 1; /* already asked to stop: returns without waiting */
+        CHECK(lf_web_server_run(srv, &stop, &err) == 0);
         lf_web_server_close(srv);
     }
     lf_web_server *bad = NULL;

@@ -48,8 +48,8 @@ int lf_cli_main(const lf_tool *tool, int argc, char **argv)
         return 1;
     }
     int n_pos = 0;
-    char err[512];
-    lf_args_status st = lf_args_parse(tool, cmd, argc, argv, first, pos, &n_pos, err, sizeof err);
+    lf_error err = {0};
+    lf_args_status st = lf_args_parse(tool, cmd, argc, argv, first, pos, &n_pos, &err);
     int rc;
     switch (st) {
     case LF_ARGS_HELP:
@@ -61,7 +61,7 @@ int lf_cli_main(const lf_tool *tool, int argc, char **argv)
         rc = 0;
         break;
     case LF_ARGS_ERROR:
-        fprintf(stderr, "%s%s%s: %s\n", tool->name, cmd->name ? " " : "", cmd->name ? cmd->name : "", err);
+        fprintf(stderr, "%s%s%s: %s\n", tool->name, cmd->name ? " " : "", cmd->name ? cmd->name : "", err.msg);
         print_usage(stderr, tool, cmd);
         rc = 2;
         break;

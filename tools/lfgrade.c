@@ -10,8 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "cli.h"
 #include "grade/lf_grade.h"
@@ -23,37 +21,6 @@ static struct {
     int json, threads;
 } opt;
 
-static int is_dir(const char *p)
-{
-    struct stat st;
-    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-/* A folder, else assignments/NAME here, else next to the executable
- * (build/bin/../../assignments). */
-static int find_assignment(const char *a, char *out, size_t n)
-{
-    char rubric[PATH_MAX + 16];
-    snprintf(rubric, sizeof rubric, "%s/rubric.txt", a);
-    if (is_dir(a) && access(rubric, R_OK) == 0)
-        return snprintf(out, n, "%s", a), 0;
-    snprintf(out, n, "assignments/%s", a);
-    if (is_dir(out))
-        return 0;
-    char exe[PATH_MAX];
-    ssize_t l = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (l > 0) {
-        exe[l] = 0;
-        char *s = strrchr(exe, '/');
-        if (s) {
-            *s = 0;
-            if (snprintf(out, n, "%s/../../assignments/%s", exe, a) < (int)n && is_dir(out))
-                return 0;
-        }
-    }
-    return -1;
-}
-
 static int run_grade(int n, char **pos)
 {
     const char *assignment = pos[0];
@@ -64,13 +31,12 @@ static int run_grade(int n, char **pos)
         o.cache_dir = opt.cache;
     o.threads = opt.threads;
     char adir[PATH_MAX];
-    if (find_assignment(assignment, adir, sizeof adir)) {
-        fprintf(stderr, "lfgrade: %s: no such assignment (a folder with rubric.txt, or a name under assignments/)\n",
-                assignment);
+    lf_error err = {0};
+    if (lf_grade_find_assignment(assignment, adir, sizeof adir, &err)) {
+        fprintf(stderr, "lfgrade: %s\n", err.msg);
         return EXIT_USAGE;
     }
     o.report_dir = opt.report;
-    lf_error err = {0};
     lf_grade_ctx *g;
     if (lf_grade_ctx_new(adir, &o, &g, &err)) {
         fprintf(stderr, "lfgrade: %s\n", err.msg);
@@ -88,21 +54,19 @@ static int run_grade(int n, char **pos)
             continue;
         }
         const lf_grade_result *r = &res[graded++];
-        int lost = 0;
-        for (int k = 0; k < r->nchecks; k++)
-            lost += r->checks[k].status == LF_GRADE_FAIL;
+        int lost = lf_grade_failed_checks(r);
         fprintf(stderr, "[%d/%d] %s: %d/%d (%d check%s failed, %.2f s)\n", i + 1, nsubs, r->student, r->score,
                 r->max, lost, lost == 1 ? "" : "s", r->seconds);
         for (int k = 0; k < r->nchecks; k++)
             if (r->checks[k].status == LF_GRADE_FAIL)
                 fprintf(stderr, "    %s -%d: %s\n", r->checks[k].id, r->checks[k].points - r->checks[k].earned,
                         r->checks[k].reason);
-        if (opt.json) {
-            char *j = lf_grade_result_json(r);
-            if (j)
-                printf("%s\n", j);
-            free(j);
-        }
+        char *j = opt.json ? lf_grade_result_json(r) : NULL;
+        if (j)
+            printf("%s\n", j);
+        else if (opt.json)
+            fprintf(stderr, "lfgrade: %s: out of memory for the JSON result\n", r->student);
+        free(j);
     }
     if (opt.report && graded) {
         if (lf_grade_write_gradebook(opt.report, res, graded, &err)) {

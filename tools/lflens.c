@@ -43,7 +43,6 @@ static const lf_arg plot_args[] = {
 /* Loads the lens and analyses it for the flags' sensor and focus. */
 static int analyse(const char *path, lf_lens *L, lf_lens_report *r)
 {
-    char msg[1024];
     lf_error err = {0};
     double w, h;
     if (opt.sensor && opt.diagonal_mm > 0) {
@@ -58,8 +57,8 @@ static int analyse(const char *path, lf_lens *L, lf_lens_report *r)
         w = opt.diagonal_mm * 3.0 / sqrt(13.0), h = opt.diagonal_mm * 2.0 / sqrt(13.0);
     else if (!opt.sensor)
         lf_lens_sensor_size("fullframe", &w, &h);
-    if (lf_lens_load(path, L, msg, sizeof msg)) {
-        fprintf(stderr, "lflens: %s\n", msg);
+    if (lf_lens_load(path, L, &err)) {
+        fprintf(stderr, "lflens: %s\n", err.msg);
         return 1;
     }
     if (opt.aperture_mm > 0) {

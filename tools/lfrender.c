@@ -10,19 +10,17 @@
  * after writing a checkpoint that --resume continues from.  No output file is
  * written on failure, and outputs are replaced atomically.
  */
-#include <errno.h>
-#include <math.h>
 #include <signal.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "base/lf_file.h"
+#include "base/lf_file_write.h"
 #include "base/lf_keys.h"
+#include "base/lf_progress.h"
 #include "camera/lf_camera.h"
 #include "cli.h"
 #include "image/lf_image.h"
@@ -38,122 +36,13 @@ static struct {
     double checkpoint_every, exposure;
 } opt;
 
-typedef struct progress {
-    double t0, last;
-    int enabled;
-} progress;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static void on_progress(void *ctx, long done, long total)
 {
-    progress *p = ctx;
-    double t = now();
-    if (!p->enabled || (t - p->last < 0.2 && done < total))
-        return;
-    p->last = t;
-    double frac = (double)done / total, el = t - p->t0;
-    double eta = frac > 0 ? el * (1 - frac) / frac : 0;
-    int width = 40, fill = (int)(frac * width);
-    char bar[64];
-    for (int i = 0; i < width; i++)
-        bar[i] = i < fill ? '#' : '.';
-    bar[width] = '\0';
-    fprintf(stderr, "\r[%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs ", bar, 100 * frac, el, eta);
-    if (done == total)
-        fputc('\n', stderr);
-    fflush(stderr);
-}
-
-/* mkdir -p for the output's directory. */
-static int ensure_parent_dir(const char *path)
-{
-    char buf[PATH_MAX];
-    snprintf(buf, sizeof buf, "%s", path);
-    char *slash = strrchr(buf, '/');
-    if (!slash || slash == buf)
-        return 0;
-    *slash = '\0';
-    for (char *p = buf + 1; *p; p++)
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(buf, 0777) && errno != EEXIST)
-                return -1;
-            *p = '/';
-        }
-    if (mkdir(buf, 0777) && errno != EEXIST)
-        return -1;
-    return 0;
-}
-
-/* Checked before hours of rendering: can we create a file beside the output? */
-static int check_writable(const char *path, char *msg, size_t n)
-{
-    if (ensure_parent_dir(path)) {
-        snprintf(msg, n, "cannot create the directory of %s: %s", path, strerror(errno));
-        return -1;
+    char line[160];
+    if (lf_progress_line(ctx, done, total, line, sizeof line)) {
+        fputs(line, stderr);
+        fflush(stderr);
     }
-    char probe[PATH_MAX];
-    const char *slash = strrchr(path, '/');
-    if (slash)
-        snprintf(probe, sizeof probe, "%.*s/.lfrender-probe-%ld", (int)(slash - path), path, (long)getpid());
-    else
-        snprintf(probe, sizeof probe, ".lfrender-probe-%ld", (long)getpid());
-    FILE *f = fopen(probe, "wb");
-    if (!f) {
-        snprintf(msg, n, "cannot write %s: %s", path, strerror(errno));
-        return -1;
-    }
-    fclose(f);
-    remove(probe);
-    return 0;
-}
-
-/* --aov disparity: OUT.disparity.exr beside OUT.exr (1 channel, 32-bit
- * float, the render's lensfield:* attributes plus lensfield:aov); OUT's
- * header names it (lensfield:disparity_file) and gets the range. */
-static int write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, int quiet, lf_error *err)
-{
-    lf_image d;
-    int rc = lf_renderer_disparity(r, &d, err);
-    if (rc)
-        return rc;
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%.*s.disparity.exr", (int)(strlen(out) - 4), out);
-    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-    float range[2] = {INFINITY, -INFINITY};
-    for (size_t i = 0; i < (size_t)d.width * d.height; i++)
-        range[0] = d.data[i] < range[0] ? d.data[i] : range[0], range[1] = d.data[i] > range[1] ? d.data[i] : range[1];
-    lf_attrs_set_string(meta, LF_KEY_DISPARITY_FILE, base);
-    lf_attrs_set_floats(meta, LF_KEY_DISPARITY_RANGE, range, 2);
-    lf_attrs a = {0};
-    for (size_t k = 0; k < meta->count && !rc; k++) {
-        const lf_attr *at = &meta->items[k];
-        switch (at->type) {
-        case LF_ATTR_STRING: rc = lf_attrs_set_string(&a, at->name, at->s); break;
-        case LF_ATTR_INT: rc = lf_attrs_set_int(&a, at->name, at->i); break;
-        case LF_ATTR_FLOAT: rc = lf_attrs_set_float(&a, at->name, (float)at->d); break;
-        case LF_ATTR_DOUBLE: rc = lf_attrs_set_double(&a, at->name, at->d); break;
-        case LF_ATTR_FLOATS: rc = lf_attrs_set_floats(&a, at->name, at->v, at->n); break;
-        case LF_ATTR_M44D: rc = lf_attrs_set_m44d(&a, at->name, at->m); break;
-        }
-    }
-    if (!rc)
-        rc = lf_attrs_set_string(&a, LF_KEY_AOV, "disparity");
-    if (rc)
-        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the disparity AOV's attributes");
-    else
-        rc = lf_image_write(path, &d, &a, NULL, err);
-    if (!rc && !quiet)
-        fprintf(stderr, "lfrender: wrote %s (disparity %.6g .. %.6g px per view step)\n", path, range[0], range[1]);
-    lf_attrs_free(&a);
-    lf_image_free(&d);
-    return rc;
 }
 
 static volatile int stop_requested;
@@ -170,14 +59,9 @@ static int run_merge(int n, char **parts)
     lf_image img;
     lf_attrs meta = {0};
     int rc = lf_render_merge((const char **)parts, n, &img, &meta, &err);
-    if (!rc) {
-        /* write as the unsplit render would: Film "savefp16" travels in the parts */
-        lf_write_opts wo = {0};
+    if (!rc) { /* write as the unsplit render would: Film "savefp16" travels in the parts */
         const lf_attr *h = lf_attrs_get(&meta, LF_KEY_SAVEFP16);
-        wo.half = h && h->type == LF_ATTR_INT && h->i;
-        for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
-            if (img.data[k] > 65504.f)
-                wo.half = 0;
+        lf_write_opts wo = {.half = h && h->type == LF_ATTR_INT && h->i && lf_image_fits_half(&img)};
         rc = lf_image_write(opt.out, &img, &meta, &wo, &err);
         lf_image_free(&img);
     }
@@ -223,12 +107,6 @@ static int render_opts_from_flags(lf_render_opts *o)
     return 0;
 }
 
-static int has_ext(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    return n >= e && !strcasecmp(path + n - e, ext);
-}
-
 static int run_render(int n, char **pos)
 {
     (void)n;
@@ -238,7 +116,7 @@ static int run_render(int n, char **pos)
     if (rc)
         return rc;
     for (int i = 0; i < opt.n_plugins; i++) {
-        char msg[1024];
+        char msg[1024]; /* the camera plugin ABI's convention (camera/lf_camera.h) */
         if (lf_camera_load_plugin(opt.plugins[i], msg, sizeof msg)) {
             fprintf(stderr, "lfrender: %s\n", msg);
             return 1;
@@ -274,8 +152,8 @@ static int run_render(int n, char **pos)
         return 1;
     }
     o.scene_path = scene;
-    progress pr = {now(), 0, !opt.quiet && isatty(2)};
-    o.progress = on_progress;
+    lf_progress pr;
+    o.progress = !opt.quiet && isatty(2) ? on_progress : NULL;
     o.progress_ctx = &pr;
     lf_renderer *r;
     if (lf_renderer_create(&desc, &o, &r, &err)) {
@@ -288,22 +166,25 @@ static int run_render(int n, char **pos)
     rc = -1;
     if (opt.explain) {
         char *plan = lf_renderer_explain(r);
-        fputs(plan ? plan : "", stdout);
+        if (plan)
+            fputs(plan, stdout);
+        else
+            fprintf(stderr, "lfrender: out of memory for the effect plan\n");
         free(plan);
-        rc = 0;
+        rc = plan ? 0 : 1;
     }
     if (!out)
         out = lf_renderer_film_filename(r);
-    if (rc < 0 && o.part && !has_ext(out, ".exr")) {
+    if (rc < 0 && o.part && !lf_path_has_ext(out, ".exr")) {
         fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
         rc = 2;
     }
-    if (rc < 0 && opt.aov && (o.part || !has_ext(out, ".exr"))) {
+    if (rc < 0 && opt.aov && (o.part || !lf_path_has_ext(out, ".exr"))) {
         fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
                         "--spp-range)\n");
         rc = 2;
     }
-    char ckpath[4200], msg[1200];
+    char ckpath[4200];
     if (rc < 0 && (o.checkpoint_every > 0 || o.resume || checkpoint)) {
         if (!checkpoint) {
             snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
@@ -313,8 +194,8 @@ static int run_render(int n, char **pos)
         o.stop = &stop_requested;
         lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
     }
-    if (rc < 0 && check_writable(out, msg, sizeof msg)) {
-        fprintf(stderr, "lfrender: %s\n", msg);
+    if (rc < 0 && lf_file_check_writable(out, &err)) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
         rc = 1;
     }
     if (rc >= 0) {
@@ -324,29 +205,27 @@ static int run_render(int n, char **pos)
     }
     lf_image img;
     lf_attrs meta = {0};
-    pr.t0 = now();
+    lf_progress_start(&pr);
     rc = lf_renderer_render(r, &img, &meta, &err);
     if (!rc) {
         lf_render_stats st = lf_renderer_stats(r);
         if (st.nonfinite_samples)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
-        lf_write_opts wo = {0};
-        wo.exposure = (float)opt.exposure;
-        if (opt.tonemap)
-            lf_tonemap_parse(opt.tonemap, &wo.tonemap);
-        wo.half = o.part ? 0 : lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
-        for (size_t k = 0; wo.half && k < (size_t)img.width * img.height * img.channels; k++)
-            if (img.data[k] > 65504.f) { /* half floats top out at 65504: keep bright renders exact */
-                fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
-                                "writing 32-bit float channels\n");
-                wo.half = 0;
-            }
+        lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+        wo.half = !o.part && lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
+        if (wo.half && !lf_image_fits_half(&img)) { /* half floats top out at 65504: keep bright renders exact */
+            fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
+                            "writing 32-bit float channels\n");
+            wo.half = 0;
+        }
         if (!opt.quiet)
             fprintf(stderr, "lfrender: %lld camera paths in %.3f s: %.3f M paths/s, %.3f M rays/s\n",
                     st.camera_paths, st.seconds, st.camera_paths / st.seconds * 1e-6, st.rays / st.seconds * 1e-6);
-        if (opt.aov)
-            rc = write_disparity(r, out, &meta, opt.quiet, &err);
+        char aov[PATH_MAX];
+        float range[2];
+        if (opt.aov && !(rc = lf_render_write_disparity(r, out, &meta, aov, sizeof aov, range, &err)) && !opt.quiet)
+            fprintf(stderr, "lfrender: wrote %s (disparity %.6g .. %.6g px per view step)\n", aov, range[0], range[1]);
         if (!rc)
             rc = lf_image_write(out, &img, &meta, &wo, &err);
         if (!rc && !opt.quiet)

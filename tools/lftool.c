@@ -1,40 +1,24 @@
-/* lftool - decode, refocus and re-view light-field raws (docs/lftool.md).
- *
- *   lftool info RAW.exr
- *   lftool decode RAW.exr -o DIR [--format exr|png] [--white WHITE.exr] [--layout hci]
- *   lftool calibrate WHITE.exr -o LAYOUT.exr [--grid square|hex]
- *   lftool refocus RAW.exr (--alpha A | --depth M | --disparity PX) [--aperture R | --views u0 u1 v0 v1]
- *                  [--method shift|fourier] -o OUT
- *   lftool stack|allfocus RAW.exr --from D0 --to D1 [--steps N] -o OUT
- *   lftool depth RAW.exr [--from D0 --to D1] [--confidence C.exr] -o OUT.exr|.pfm
- *   lftool view RAW.exr --u U --v V [--geometry plane --disparity PX | --disparity-map D.exr] -o OUT
- *   lftool synth LF.exr OUT.exr [CS348B flags]
- *   lftool export-web RAW.exr -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]
- *   lftool serve DIR [--port P]
- *
- * RAW may also be a folder of views (HCI layout or PREFIX_RR_CC names).
+/* lftool - decode, refocus and re-view light fields (docs/lftool.md;
+ * `lftool --help`, `lftool COMMAND --help`).  IN is a light-field raw or a
+ * folder of views (HCI layout or PREFIX_RR_CC names).  The work is done by
+ * lightfield/ (lf_lightfield.h, lf_source.h, lf_depth.h) and web/
+ * (lf_web.h); this file holds the flag tables and prints.
  *
  * Exit codes: 0 ok, 1 bad input (the message names the file and what is
  * missing or wrong), 2 usage.
  */
-#include <errno.h>
-#include <math.h>
+#include <signal.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 #include <time.h>
 
-#include <limits.h>
-#include <signal.h>
-#include <unistd.h>
-
+#include "base/lf_file_write.h"
 #include "base/lf_keys.h"
 #include "cli.h"
 #include "image/lf_image.h"
 #include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
+#include "lightfield/lf_source.h"
 #include "web/lf_web.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
@@ -68,8 +52,7 @@ static struct {
     int cams[2], tile[2], lenses[2], outdim[2], spp;
     double griddim[4], fov, pitch, rotation, offset[2], mainlens[4], pos[3], rot[3], focal, outfov, lensradius;
     long long seed;
-    int g_kind, g_cams, g_griddim, g_fov, g_tile, g_grid, g_pitch, g_rot, g_offset, g_lenses, g_main, g_spp, g_rot3,
-        g_lensradius, g_seed;
+    int g_kind, g_cams, g_griddim, g_fov, g_tile, g_grid, g_pitch, g_rot, g_offset, g_lenses, g_main, g_spp, g_seed;
 } fl;
 
 static int usage(const char *fmt, const char *arg)
@@ -194,12 +177,10 @@ static const lf_arg synth_args[] = {
      .given = &opt.have_focal},
     {"--camerapos", NULL, LF_ARG_DOUBLE, fl.pos, "X Y Z", "virtual camera position", .count = 3,
      .given = &opt.have_pos},
-    {"--camerarot", NULL, LF_ARG_DOUBLE, fl.rot, "X Y Z", "virtual camera rotation (degrees)", .count = 3,
-     .given = &fl.g_rot3},
+    {"--camerarot", NULL, LF_ARG_DOUBLE, fl.rot, "X Y Z", "virtual camera rotation (degrees)", .count = 3},
     {"--outputfov", NULL, LF_ARG_DOUBLE, &fl.outfov, "DEG", "virtual camera field of view", .min = 0, .max = 180,
      .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &opt.have_outfov},
-    {"--lensradius", NULL, LF_ARG_DOUBLE, &fl.lensradius, "R", "virtual lens radius (0: pinhole)", R_MIN(0),
-     .given = &fl.g_lensradius},
+    {"--lensradius", NULL, LF_ARG_DOUBLE, &fl.lensradius, "R", "virtual lens radius (0: pinhole)", R_MIN(0)},
     {"--outputdim", NULL, LF_ARG_INT, fl.outdim, "W H", "output size in pixels", R_IN(1, 65536), .count = 2,
      .given = &opt.have_outdim},
     {"--coverage", NULL, LF_ARG_STRING, &opt.coverage, "COV.exr", "also write where rays left the captured aperture"},
@@ -225,338 +206,152 @@ static void apply_flags(void)
 {
     lf_lf_layout *f = &opt.flags;
     lf_lf_layout_init(f);
-    if (fl.g_kind)
-        f->kind = strcmp(fl.kind, "plenoptic") ? LF_LF_CAMERA_ARRAY : LF_LF_PLENOPTIC, f->have |= LF_LF_HAVE_KIND;
-    if (fl.g_cams)
-        f->cams_x = fl.cams[0], f->cams_y = fl.cams[1], f->kind = LF_LF_CAMERA_ARRAY,
-        f->have |= LF_LF_HAVE_CAMS | LF_LF_HAVE_KIND;
-    if (fl.g_griddim)
-        memcpy(f->grid_bounds, fl.griddim, sizeof f->grid_bounds), f->have |= LF_LF_HAVE_BOUNDS;
-    if (fl.g_fov)
-        f->fov_deg = fl.fov, f->have |= LF_LF_HAVE_FOV;
-    if (fl.g_tile)
-        f->tile_w = fl.tile[0], f->tile_h = fl.tile[1], f->have |= LF_LF_HAVE_TILE;
-    if (fl.g_grid)
-        f->grid = strcmp(fl.grid, "hex") ? LF_LF_GRID_SQUARE : LF_LF_GRID_HEX, f->have |= LF_LF_HAVE_GRID;
-    if (fl.g_pitch)
-        f->pitch_px = fl.pitch, f->have |= LF_LF_HAVE_PITCH;
-    if (fl.g_rot)
-        f->rotation_rad = fl.rotation, f->have |= LF_LF_HAVE_ROTATION;
-    if (fl.g_offset)
-        f->offset_px[0] = fl.offset[0], f->offset_px[1] = fl.offset[1], f->have |= LF_LF_HAVE_OFFSET;
-    if (fl.g_lenses)
-        f->lens_x = fl.lenses[0], f->lens_y = fl.lenses[1], f->have |= LF_LF_HAVE_LENS_COUNT;
-    if (fl.g_main)
-        f->main_focal_mm = fl.mainlens[0], f->main_fstop = fl.mainlens[1], f->mla_distance_mm = fl.mainlens[2],
-        f->pitch_um = fl.mainlens[3], f->have |= LF_LF_HAVE_MAIN_LENS;
+    const struct {
+        int given;
+        unsigned have;
+    } given[] = {{fl.g_kind, LF_LF_HAVE_KIND},   {fl.g_cams, LF_LF_HAVE_CAMS | LF_LF_HAVE_KIND},
+                 {fl.g_griddim, LF_LF_HAVE_BOUNDS}, {fl.g_fov, LF_LF_HAVE_FOV},
+                 {fl.g_tile, LF_LF_HAVE_TILE},    {fl.g_grid, LF_LF_HAVE_GRID},
+                 {fl.g_pitch, LF_LF_HAVE_PITCH},  {fl.g_rot, LF_LF_HAVE_ROTATION},
+                 {fl.g_offset, LF_LF_HAVE_OFFSET}, {fl.g_lenses, LF_LF_HAVE_LENS_COUNT},
+                 {fl.g_main, LF_LF_HAVE_MAIN_LENS}};
+    for (size_t i = 0; i < LF_ARRAY_LEN(given); i++)
+        if (given[i].given)
+            f->have |= given[i].have;
+    f->kind = fl.g_cams || (fl.g_kind && strcmp(fl.kind, "plenoptic")) ? LF_LF_CAMERA_ARRAY : LF_LF_PLENOPTIC;
+    f->grid = fl.g_grid && !strcmp(fl.grid, "hex") ? LF_LF_GRID_HEX : LF_LF_GRID_SQUARE;
+    f->cams_x = fl.cams[0], f->cams_y = fl.cams[1];
+    memcpy(f->grid_bounds, fl.griddim, sizeof f->grid_bounds);
+    f->fov_deg = fl.fov, f->pitch_px = fl.pitch, f->rotation_rad = fl.rotation;
+    f->tile_w = fl.tile[0], f->tile_h = fl.tile[1];
+    f->offset_px[0] = fl.offset[0], f->offset_px[1] = fl.offset[1];
+    f->lens_x = fl.lenses[0], f->lens_y = fl.lenses[1];
+    f->main_focal_mm = fl.mainlens[0], f->main_fstop = fl.mainlens[1];
+    f->mla_distance_mm = fl.mainlens[2], f->pitch_um = fl.mainlens[3];
     lf_lf_synth_opts *s = &opt.synth;
     *s = lf_lf_synth_defaults();
     s->threads = opt.threads;
     if (fl.g_spp)
         s->spp = fl.spp;
-    if (opt.have_focal)
-        s->focal_distance = fl.focal;
-    if (opt.have_pos)
-        memcpy(s->pos, fl.pos, sizeof s->pos);
-    if (fl.g_rot3)
-        memcpy(s->rot_deg, fl.rot, sizeof s->rot_deg);
-    if (opt.have_outfov)
-        s->fov_deg = fl.outfov;
-    if (fl.g_lensradius)
-        s->lens_radius = fl.lensradius;
-    if (opt.have_outdim)
-        s->width = fl.outdim[0], s->height = fl.outdim[1];
     if (fl.g_seed)
         s->seed = (uint32_t)fl.seed;
+    s->focal_distance = fl.focal, s->lens_radius = fl.lensradius, s->fov_deg = fl.outfov;
+    memcpy(s->pos, fl.pos, sizeof s->pos);
+    memcpy(s->rot_deg, fl.rot, sizeof s->rot_deg);
+    s->width = fl.outdim[0], s->height = fl.outdim[1];
 }
 
-/* ---------- loading ---------- */
+/* ---------- helpers ---------- */
 
-typedef struct loaded {
-    lf_image raw;
-    lf_attrs attrs;
-    lf_lf_layout layout;
-    lf_lightfield lf;
-    lf_lf_folder folder; /* when the input is a folder of views (folder.dir != NULL) */
-} loaded;
-
-static void unload(loaded *l)
+/* Every command starts here: its name, IN (and OUT) and the flags' values. */
+static const opts *begin(const char *cmd, int n, char **pos)
 {
-    lf_lf_free(&l->lf);
-    lf_image_free(&l->raw);
-    lf_attrs_free(&l->attrs);
-    lf_lf_folder_free(&l->folder);
+    opt.cmd = cmd;
+    opt.input = pos[0];
+    if (n > 1)
+        opt.output = pos[1];
+    apply_flags();
+    return &opt;
 }
 
-/* A folder of views (docs/lightfield-format.md): every view is read, even
- * for info, so a missing or unreadable view is reported at once. */
-static int load_folder(const opts *o, loaded *l)
+/* Prints a library error (after the input's name when given): exit 1. */
+static int fail(const lf_error *err, const char *name)
+{
+    if (name)
+        fprintf(stderr, "lftool: %s: %s\n", name, err->msg);
+    else
+        fprintf(stderr, "lftool: %s\n", err->msg);
+    return EXIT_INPUT;
+}
+
+/* Reads the raw (or folder of views) and resolves its layout (attributes +
+ * flags); decodes unless layout_only. */
+static int load(const opts *o, lf_lf_source *s, int layout_only)
 {
     lf_error err = {0};
-    if (o->white) {
-        fprintf(stderr, "lftool: %s: --white applies to raws, not to a folder of views\n", o->input);
-        return EXIT_INPUT;
-    }
-    if (lf_lf_folder_scan(o->input, &l->folder, &err) || lf_lf_folder_load(&l->folder, &o->flags, &l->lf, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    l->layout = l->lf.layout;
-    if (l->lf.nonfinite && !o->allow_nonfinite) {
-        fprintf(stderr,
-                "lftool: %s: %zu non-finite pixel values (NaN/Inf); pass --allow-nonfinite to treat them as "
-                "missing samples\n",
-                o->input, l->lf.nonfinite);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    return EXIT_OK;
-}
-
-/* Reads the raw (or folder of views), resolves its layout (attributes +
- * flags); decodes unless layout_only. Prints the error and returns
- * EXIT_INPUT on failure. */
-static int load(const opts *o, loaded *l, int layout_only)
-{
-    memset(l, 0, sizeof *l);
-    if (lf_lf_is_folder(o->input))
-        return load_folder(o, l);
-    lf_error err = {0};
-    if (lf_image_read(o->input, &l->raw, &l->attrs, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    lf_lf_layout file;
-    if (lf_lf_layout_from_attrs(&l->attrs, &file, &err) ||
-        lf_lf_layout_resolve(&file, &o->flags, l->raw.width, l->raw.height, &l->layout, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    size_t bad = lf_image_count_nonfinite(&l->raw);
-    if (bad && !o->allow_nonfinite && !layout_only) {
-        fprintf(stderr,
-                "lftool: %s: %zu non-finite pixel values (NaN/Inf); pass --allow-nonfinite to treat them as "
-                "missing samples\n",
-                o->input, bad);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    if (layout_only)
-        return EXIT_OK;
-    lf_image white = {0};
-    if (o->white && lf_image_read(o->white, &white, NULL, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    int rc = lf_lf_decode(&l->raw, &l->layout, o->white ? &white : NULL, &l->lf, &err);
-    lf_image_free(&white);
-    if (rc) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(l);
-        return EXIT_INPUT;
-    }
-    if (l->lf.nonfinite)
+    lf_lf_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only};
+    if (lf_lf_open(o->input, &oo, s, &err))
+        return fail(&err, NULL);
+    if (!s->folder.dir && s->lf.nonfinite)
         fprintf(stderr, "lftool: %s: warning: %zu non-finite pixel values excluded as missing samples\n", o->input,
-                l->lf.nonfinite);
+                s->lf.nonfinite);
     return EXIT_OK;
 }
 
 static int write_image(const char *path, const lf_image *img, const lf_attrs *a)
 {
     lf_error err = {0};
-    lf_write_opts wo = {0};
-    wo.exposure = (float)opt.exposure;
-    if (opt.tonemap)
-        lf_tonemap_parse(opt.tonemap, &wo.tonemap);
-    if (lf_image_write(path, img, a, &wo, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    return EXIT_OK;
-}
-
-static int need_output(const opts *o)
-{
-    if (!o->output)
-        return usage("%s needs -o OUTPUT", o->cmd);
-    return 0;
-}
-
-static int make_dir(const char *dir)
-{
-    if (mkdir(dir, 0777) && errno != EEXIST) {
-        fprintf(stderr, "lftool: cannot create directory %s: %s\n", dir, strerror(errno));
-        return EXIT_INPUT;
-    }
-    return EXIT_OK;
-}
-
-static lf_image view_image(const lf_lightfield *lf, int iu, int iv)
-{
-    lf_image v = {lf->ns, lf->nt, 3, lf_lf_view(lf, iu, iv)};
-    return v;
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
 }
 
 /* ---------- commands ---------- */
 
-static int cmd_info(const opts *o)
+static int cmd_info(int n, char **pos)
 {
-    loaded l;
-    int rc = load(o, &l, 1);
+    const opts *o = begin("info", n, pos);
+    lf_lf_source s;
+    int rc = load(o, &s, 1);
     if (rc)
         return rc;
-    char buf[2048];
-    lf_lf_layout_describe(&l.layout, buf, sizeof buf);
-    if (l.folder.dir) {
-        printf("%s: folder of %d x %d views (%s layout, %s)\n%s", o->input, l.lf.nu, l.lf.nv,
-               l.folder.kind == LF_LF_FOLDER_HCI ? "HCI" : "row/column", l.folder.pattern, buf);
-        if (l.lf.disp_per_inv_m > 0)
-            printf("disparity %.6g + %.6g / depth px per view step\n", l.lf.disp_at_inf, l.lf.disp_per_inv_m);
-        if (l.folder.gt_disparity)
-            printf("ground-truth disparity: %s\n", l.folder.gt_disparity);
-        if (l.lf.nonfinite)
-            printf("non-finite pixel values: %zu\n", l.lf.nonfinite);
-        unload(&l);
-        return EXIT_OK;
-    }
-    printf("%s: %d x %d raw, %d channels\n%s", o->input, l.raw.width, l.raw.height, l.raw.channels, buf);
-    size_t bad = lf_image_count_nonfinite(&l.raw);
-    if (bad)
-        printf("non-finite pixel values: %zu\n", bad);
-    unload(&l);
+    char buf[4096];
+    lf_lf_source_describe(&s, buf, sizeof buf);
+    fputs(buf, stdout);
+    lf_lf_close(&s);
     return EXIT_OK;
 }
 
-/* The centre view's ground-truth disparity (docs/lightfield-format.md,
- * "Disparity AOV"): from the render's disparity image named by the raw's
- * lensfield:disparity_file, decoded with the raw's layout, or a folder's
- * gt_disp_lowres.pfm.  *gt stays empty when there is none. */
-static int centre_disparity(const opts *o, const loaded *l, lf_image *gt)
+/* The HCI benchmark layout, with the centre view's ground truth when known. */
+static int decode_hci(const opts *o, const lf_lf_source *s)
 {
-    memset(gt, 0, sizeof *gt);
+    const lf_lightfield *lf = &s->lf;
+    lf_image gt;
     lf_error err = {0};
-    if (l->folder.dir) {
-        if (l->folder.gt_disparity && lf_image_read(l->folder.gt_disparity, gt, NULL, &err)) {
-            fprintf(stderr, "lftool: %s\n", err.msg);
-            return EXIT_INPUT;
-        }
-        return EXIT_OK;
-    }
-    const lf_attr *a = lf_attrs_get(&l->attrs, LF_KEY_DISPARITY_FILE);
-    if (!a || a->type != LF_ATTR_STRING || !a->s[0])
-        return EXIT_OK;
-    if (l->lf.nu % 2 == 0 || l->lf.nv % 2 == 0) {
+    int no_centre;
+    if (lf_lf_source_gt_disparity(s, &gt, &no_centre, &err))
+        return fail(&err, NULL);
+    if (no_centre)
         fprintf(stderr, "lftool: %s: note: %d x %d views have no centre view; gt_disp_lowres.pfm not written\n",
-                o->input, l->lf.nu, l->lf.nv);
-        return EXIT_OK;
-    }
-    char path[PATH_MAX];
-    const char *slash = strrchr(o->input, '/');
-    if (a->s[0] == '/' || !slash)
-        snprintf(path, sizeof path, "%s", a->s);
-    else
-        snprintf(path, sizeof path, "%.*s/%s", (int)(slash - o->input), o->input, a->s);
-    lf_image raw = {0};
-    lf_lightfield d = {0};
-    if (lf_image_read(path, &raw, NULL, &err) ||
-        (raw.width != l->raw.width || raw.height != l->raw.height
-             ? lf_error_set(&err, LF_ERR_PARAM, "%s is %d x %d, the raw %d x %d", path, raw.width, raw.height,
-                            l->raw.width, l->raw.height)
-             : 0) ||
-        lf_lf_decode(&raw, &l->layout, NULL, &d, &err) || lf_image_alloc(gt, d.ns, d.nt, 1, &err)) {
-        fprintf(stderr, "lftool: %s: disparity: %s\n", o->input, err.msg);
-        lf_image_free(&raw), lf_lf_free(&d), lf_image_free(gt);
-        return EXIT_INPUT;
-    }
-    const float *v = lf_lf_view(&d, d.nu / 2, d.nv / 2);
-    for (size_t i = 0; i < (size_t)d.ns * d.nt; i++)
-        gt->data[i] = v[i * 3];
-    lf_image_free(&raw), lf_lf_free(&d);
-    return EXIT_OK;
-}
-
-static int cmd_decode(const opts *o)
-{
-    int rc = need_output(o);
-    if (rc)
-        return rc;
-    loaded l;
-    if ((rc = load(o, &l, 0)))
-        return rc;
-    const lf_lightfield *lf = &l.lf;
-    if (o->hci) {
-        lf_image gt;
-        lf_error err = {0};
-        if (!(rc = centre_disparity(o, &l, &gt)) && lf_lf_write_hci(o->output, lf, gt.data ? &gt : NULL, &err)) {
-            fprintf(stderr, "lftool: %s\n", err.msg);
-            rc = EXIT_INPUT;
-        }
-        if (!rc)
-            printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu,
-                   lf->nv, lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
-        lf_image_free(&gt);
-        unload(&l);
-        return rc;
-    }
-    const char *ext = o->format ? o->format : "exr";
-    if ((rc = make_dir(o->output))) {
-        unload(&l);
-        return rc;
-    }
-    char path[4096];
-    for (int iv = 0; iv < lf->nv && !rc; iv++)
-        for (int iu = 0; iu < lf->nu && !rc; iu++) {
-            lf_image v = view_image(lf, iu, iv);
-            snprintf(path, sizeof path, "%s/view_%02d_%02d.%s", o->output, iv, iu, ext); /* row, column */
-            rc = write_image(path, &v, NULL);
-        }
-    /* mosaic: views tiled as the cameras sit (view (0,0) top-left) */
-    lf_image m;
-    lf_error err = {0};
-    if (!rc && !lf_image_alloc(&m, lf->ns * lf->nu, lf->nt * lf->nv, 3, &err)) {
-        for (int iv = 0; iv < lf->nv; iv++)
-            for (int iu = 0; iu < lf->nu; iu++)
-                for (int t = 0; t < lf->nt; t++)
-                    memcpy(lf_image_px(&m, iu * lf->ns, iv * lf->nt + t), lf_lf_view(lf, iu, iv) + (size_t)t * lf->ns * 3,
-                           sizeof(float) * 3 * lf->ns);
-        snprintf(path, sizeof path, "%s/mosaic.%s", o->output, ext);
-        rc = write_image(path, &m, NULL);
-        lf_image_free(&m);
-    }
+                o->input, lf->nu, lf->nv);
+    int rc = lf_lf_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : EXIT_OK;
     if (!rc)
-        printf("%s: %d x %d views of %d x %d -> %s (%zu missing samples)\n", o->input, lf->nu, lf->nv, lf->ns, lf->nt,
-               o->output, lf->missing);
-    unload(&l);
+        printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu, lf->nv,
+               lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
+    lf_image_free(&gt);
     return rc;
 }
 
-/* disparity from exactly one of --alpha, --depth, --disparity */
-static int focus_disparity(const opts *o, const lf_lightfield *lf, double *d, int required)
+static int cmd_decode(int n, char **pos)
 {
-    int n = o->have_alpha + o->have_depth + o->have_disp;
-    if (n > 1)
-        return usage("%s", "give one of --alpha, --depth, --disparity");
-    if (n == 0) {
-        if (required)
-            return usage("%s", "refocus needs --alpha A, --depth METRES or --disparity PX");
-        *d = 0;
-        return 0;
-    }
+    const opts *o = begin("decode", n, pos);
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
+    if (rc)
+        return rc;
+    const lf_lightfield *lf = &s.lf;
     lf_error err = {0};
-    int rc = 0;
-    if (o->have_alpha)
-        rc = lf_lf_alpha_to_disparity(lf, o->alpha, d, &err);
-    else if (o->have_depth)
-        rc = lf_lf_depth_to_disparity(lf, o->depth, d, &err);
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    if (o->hci)
+        rc = decode_hci(o, &s);
+    else if (lf_lf_write_views(lf, o->output, o->format ? o->format : "exr", &wo, &err))
+        rc = fail(&err, NULL);
     else
-        *d = o->disp;
-    if (rc) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        return EXIT_INPUT;
-    }
+        printf("%s: %d x %d views of %d x %d -> %s (%zu missing samples)\n", o->input, lf->nu, lf->nv, lf->ns, lf->nt,
+               o->output, lf->missing);
+    lf_lf_close(&s);
+    return rc;
+}
+
+/* disparity from at most one of --alpha, --depth, --disparity (0 if none) */
+static int focus_disparity(const opts *o, const lf_lightfield *lf, double *d)
+{
+    if (o->have_alpha + o->have_depth + o->have_disp > 1)
+        return usage("%s", "give one of --alpha, --depth, --disparity");
+    lf_error err = {0};
+    *d = o->have_disp ? o->disp : 0;
+    if ((o->have_alpha && lf_lf_alpha_to_disparity(lf, o->alpha, d, &err)) ||
+        (o->have_depth && lf_lf_depth_to_disparity(lf, o->depth, d, &err)))
+        return fail(&err, o->input);
     return 0;
 }
 
@@ -571,463 +366,298 @@ static lf_lf_refocus_opts aperture_opts(const opts *o)
     return r;
 }
 
-/* Ng 2005's range of exact refocusing of a plenoptic raw (docs/lightfield.md,
- * "Refocusable range"): |d| <= 1 px/view, i.e. |1 - 1/alpha| <= P p / D.
- * Outside it the sub-aperture views are themselves blurred: warn, go on. */
-static void refocus_range_warning(const opts *o, const lf_lightfield *lf, double d)
+static int cmd_refocus(int n, char **pos)
 {
-    if (lf->disp_per_alpha == 0 || !(fabs(d) > 1.0 + 1e-9))
-        return;
-    double k = lf->disp_per_inv_m, d_inf = lf->disp_at_inf, b = 1.0 / lf->disp_per_alpha;
-    char asked[96], far[32], amax[32];
-    if (o->have_depth)
-        snprintf(asked, sizeof asked, "depth %g m", o->depth);
-    else if (o->have_alpha)
-        snprintf(asked, sizeof asked, "alpha %g", o->alpha);
-    else
-        snprintf(asked, sizeof asked, "disparity %g px/view", d);
-    if (k > 0 && -1.0 - d_inf > 0)
-        snprintf(far, sizeof far, "%.4g m", k / (-1.0 - d_inf));
-    else
-        snprintf(far, sizeof far, "infinity");
-    if (b < 1.0)
-        snprintf(amax, sizeof amax, "%.5g", 1.0 / (1.0 - b));
-    else
-        snprintf(amax, sizeof amax, "infinity");
-    fprintf(stderr,
-            "lftool: warning: %s: %s (disparity %.3g px/view) is outside the refocusable range (Ng 2005: "
-            "|disparity| <= 1 px/view, alpha %.5g .. %s, depths %.4g m .. %s): the sub-aperture views are blurred "
-            "there, so the result is softer than a photograph focused at that depth\n",
-            o->input, asked, d, 1.0 / (1.0 + b), amax, k > 0 && 1.0 - d_inf > 0 ? k / (1.0 - d_inf) : INFINITY, far);
-}
-
-static int cmd_refocus(const opts *o)
-{
-    int rc = need_output(o);
-    if (rc)
-        return rc;
+    const opts *o = begin("refocus", n, pos);
     if (o->have_alpha + o->have_depth + o->have_disp != 1)
         return usage("%s", "refocus needs exactly one of --alpha A, --depth METRES, --disparity PX");
-    loaded l;
-    if ((rc = load(o, &l, 0)))
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
+    if (rc)
         return rc;
     lf_lf_refocus_opts ro = aperture_opts(o);
-    if ((rc = focus_disparity(o, &l.lf, &ro.disparity_px, 1))) {
-        unload(&l);
-        return rc;
-    }
-    refocus_range_warning(o, &l.lf, ro.disparity_px);
     lf_error err = {0};
     lf_image out = {0};
+    char range[256], asked[96];
+    if ((rc = focus_disparity(o, &s.lf, &ro.disparity_px)))
+        goto done;
+    if (lf_lf_refocus_outside(&s.lf, ro.disparity_px, range, sizeof range)) { /* done, with a warning */
+        if (o->have_depth)
+            snprintf(asked, sizeof asked, "depth %g m", o->depth);
+        else if (o->have_alpha)
+            snprintf(asked, sizeof asked, "alpha %g", o->alpha);
+        else
+            snprintf(asked, sizeof asked, "disparity %g px/view", ro.disparity_px);
+        fprintf(stderr,
+                "lftool: warning: %s: %s (disparity %.3g px/view) is outside the refocusable range (%s): the "
+                "sub-aperture views are blurred there, so the result is softer than a photograph focused at that "
+                "depth\n",
+                o->input, asked, ro.disparity_px, range);
+    }
     if (o->method && !strcmp(o->method, "fourier")) {
         lf_lf_fourier *f = NULL;
-        rc = lf_lf_fourier_new(&l.lf, &ro, o->oversample, &f, &err) ||
+        rc = lf_lf_fourier_new(&s.lf, &ro, o->oversample, &f, &err) ||
              lf_lf_fourier_refocus(f, ro.disparity_px, &out, &err);
         lf_lf_fourier_release(f);
     } else {
-        rc = lf_lf_refocus(&l.lf, &ro, &out, &err);
+        rc = lf_lf_refocus(&s.lf, &ro, &out, &err);
     }
     if (rc) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(&l);
-        return EXIT_INPUT;
+        rc = fail(&err, o->input);
+        goto done;
     }
-    lf_attrs a = {0};
-    lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
-    rc = write_image(o->output, &out, &a);
-    if (!rc)
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    if (lf_lf_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
+        rc = fail(&err, NULL);
+    else
         printf("%s: refocused at disparity %.6g px/view -> %s\n", o->input, ro.disparity_px, o->output);
-    lf_attrs_free(&a);
+done:
     lf_image_free(&out);
-    unload(&l);
+    lf_lf_close(&s);
     return rc;
 }
 
-static int stack_range(const opts *o, const lf_lightfield *lf, double *d0, double *d1)
+/* --from/--to, each defaulting to the disparities of the largest aperture,
+ * -1 and +1 px per view */
+static void stack_range(const opts *o, double *d0, double *d1)
 {
-    if (!o->have_from || !o->have_to) {
-        /* default: the disparities of the largest aperture, +-1 px per view */
-        (void)lf;
-        *d0 = o->have_from ? o->from : -1, *d1 = o->have_to ? o->to : 1;
-    } else {
-        *d0 = o->from, *d1 = o->to;
-    }
-    if (o->steps < 2)
-        return usage("%s", "--steps must be >= 2");
-    return 0;
+    *d0 = o->have_from ? o->from : -1, *d1 = o->have_to ? o->to : 1;
 }
 
-static int cmd_stack(const opts *o)
+static int cmd_stack(int n, char **pos)
 {
-    int rc = need_output(o);
+    const opts *o = begin("stack", n, pos);
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    loaded l;
-    if ((rc = load(o, &l, 0)))
-        return rc;
     double d0, d1;
-    if ((rc = stack_range(o, &l.lf, &d0, &d1)) || (rc = make_dir(o->output))) {
-        unload(&l);
-        return rc;
-    }
+    stack_range(o, &d0, &d1);
+    lf_error err = {0};
+    if (lf_dir_create(o->output, &err))
+        rc = fail(&err, NULL);
     lf_lf_refocus_opts ro = aperture_opts(o);
     for (int k = 0; k < o->steps && !rc; k++) {
         ro.disparity_px = d0 + (d1 - d0) * k / (o->steps - 1);
         lf_image out;
-        lf_error err = {0};
-        if (lf_lf_refocus(&l.lf, &ro, &out, &err)) {
-            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-            rc = EXIT_INPUT;
+        if (lf_lf_refocus(&s.lf, &ro, &out, &err)) {
+            rc = fail(&err, o->input);
             break;
         }
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
-        lf_attrs a = {0};
-        lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, ro.disparity_px);
-        rc = write_image(path, &out, &a);
-        lf_attrs_free(&a);
+        lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+        rc = lf_lf_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
         lf_image_free(&out);
     }
     if (!rc)
         printf("%s: %d slices, disparity %g .. %g -> %s\n", o->input, o->steps, d0, d1, o->output);
-    unload(&l);
+    lf_lf_close(&s);
     return rc;
 }
 
-static int cmd_allfocus_depth(const opts *o, int want_depth)
+static int allfocus_depth(const opts *o, int want_depth)
 {
-    int rc = need_output(o);
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    loaded l;
-    if ((rc = load(o, &l, 0)))
-        return rc;
     double d0, d1;
-    if ((rc = stack_range(o, &l.lf, &d0, &d1))) {
-        unload(&l);
-        return rc;
-    }
+    stack_range(o, &d0, &d1);
     lf_lf_refocus_opts ro = aperture_opts(o);
     lf_image af, dm;
     lf_error err = {0};
-    if (lf_lf_allfocus(&l.lf, &ro, d0, d1, o->steps, &af, &dm, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(&l);
-        return EXIT_INPUT;
+    if (lf_lf_allfocus(&s.lf, &ro, d0, d1, o->steps, &af, &dm, &err)) {
+        lf_lf_close(&s);
+        return fail(&err, o->input);
     }
     rc = write_image(o->output, want_depth ? &dm : &af, NULL);
     if (!rc)
-        printf("%s: %s from %d slices (disparity %g .. %g) -> %s\n", o->input, want_depth ? "disparity map" : "all-in-focus",
-               o->steps, d0, d1, o->output);
+        printf("%s: %s from %d slices (disparity %g .. %g) -> %s\n", o->input,
+               want_depth ? "disparity map" : "all-in-focus", o->steps, d0, d1, o->output);
     lf_image_free(&af), lf_image_free(&dm);
-    unload(&l);
+    lf_lf_close(&s);
     return rc;
 }
 
-static int cmd_allfocus(const opts *o) { return cmd_allfocus_depth(o, 0); }
-/* Disparity range for depth: --from/--to, else lensfield:disp_min/max of
- * the input (a benchmark folder's [meta] disp_min/disp_max), else 0 0
- * (estimated from the data).  Returns the source's name. */
-static const char *depth_range(const opts *o, const lf_attrs *attrs, const lf_lf_layout *lay, double *d0, double *d1)
+static int cmd_allfocus(int n, char **pos)
 {
-    *d0 = *d1 = 0;
-    if (o->have_from && o->have_to) {
-        *d0 = o->from, *d1 = o->to;
-        return "--from/--to";
-    }
-    if ((lay->have & LF_LF_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
-        *d0 = lay->disp_min, *d1 = lay->disp_max;
-        return "the folder's disp_min/disp_max";
-    }
-    const lf_attr *a = lf_attrs_get(attrs, LF_KEY_DISP_MIN), *b = lf_attrs_get(attrs, LF_KEY_DISP_MAX);
-    if (a && b) {
-        double x = a->type == LF_ATTR_INT ? a->i : a->d, y = b->type == LF_ATTR_INT ? b->i : b->d;
-        if (isfinite(x) && isfinite(y) && x < y) {
-            *d0 = x, *d1 = y;
-            return "lensfield:disp_min/max";
-        }
-    }
-    return "estimated";
+    return allfocus_depth(begin("allfocus", n, pos), 0);
 }
 
-static int cmd_depth(const opts *o)
+static int cmd_depth(int n, char **pos)
 {
+    const opts *o = begin("depth", n, pos);
     if (o->method && !strcmp(o->method, "stack"))
-        return cmd_allfocus_depth(o, 1);
-    int rc = need_output(o);
-    if (rc)
-        return rc;
+        return allfocus_depth(o, 1);
     if (o->have_from != o->have_to)
         return usage("%s", "depth: give both --from and --to, or neither (range from the file or the data)");
     if (o->have_from && !(o->from < o->to))
         return usage("%s", "depth: --from must be below --to");
-    loaded l;
-    if ((rc = load(o, &l, 0)))
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
+    if (rc)
         return rc;
     lf_lf_depth_opts d = lf_lf_depth_defaults();
     d.threads = o->threads;
-    const char *src = depth_range(o, &l.attrs, &l.lf.layout, &d.d0, &d.d1);
+    const char *src = "--from/--to";
+    if (o->have_from)
+        d.d0 = o->from, d.d1 = o->to;
+    else if (!(src = lf_lf_source_disparity_range(&s, &d.d0, &d.d1)))
+        src = "estimated";
     lf_error err = {0};
-    if (d.d0 >= d.d1 && lf_lf_depth_range(&l.lf, o->threads, &d.d0, &d.d1, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    if (o->have_steps) {
-        if (o->steps < 3) {
-            unload(&l);
-            return usage("%s", "--steps must be >= 3");
-        }
+    lf_image disp = {0}, conf = {0};
+    if (d.d0 >= d.d1 && lf_lf_depth_range(&s.lf, o->threads, &d.d0, &d.d1, &err))
+        goto failed;
+    if (o->have_steps)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
-    }
-    lf_image disp, conf;
     if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */
-        if (lf_lf_depth(&l.lf, &d, &disp, &conf, &err) ||
-            lf_lf_calibrate_views(&l.lf, &disp, &conf, o->threads, NULL, &err)) {
-            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-            unload(&l);
-            return EXIT_INPUT;
-        }
+        if (lf_lf_depth(&s.lf, &d, &disp, &conf, &err) ||
+            lf_lf_calibrate_views(&s.lf, &disp, &conf, o->threads, NULL, &err))
+            goto failed;
         lf_image_free(&disp), lf_image_free(&conf);
     }
-    if (lf_lf_depth(&l.lf, &d, &disp, o->confidence ? &conf : NULL, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    lf_attrs a = {0};
-    float range[2] = {(float)d.d0, (float)d.d1};
-    lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2);
-    lf_attrs_set_string(&a, LF_KEY_DISPARITY_CONVENTION,
-                        "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step");
-    const char *dot = strrchr(o->output, '.');
-    if (dot && (!strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg"))) {
-        /* a picture of the map: the colour map over the search range, with its legend */
-        lf_image pic;
-        if (lf_image_colormap(&disp, d.d0, d.d1, &pic, &err)) {
-            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-            rc = EXIT_INPUT;
-        } else {
-            rc = write_image(o->output, &pic, NULL);
-            lf_image_free(&pic);
-        }
-    } else {
-        rc = write_image(o->output, &disp, &a);
-    }
+    if (lf_lf_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
+        goto failed;
+    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    rc = lf_lf_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o->confidence, &conf, NULL);
     if (!rc)
         printf("%s: disparity map (range %.4g .. %.4g px/view, %s) -> %s%s%s\n", o->input, d.d0, d.d1, src, o->output,
                o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
-    if (rc) /* no half-written result: the disparity map goes with its confidence */
+    else /* no half-written result: the disparity map goes with its confidence */
         remove(o->output);
-    lf_attrs_free(&a);
-    lf_image_free(&disp);
-    if (o->confidence)
-        lf_image_free(&conf);
-    unload(&l);
+    goto done;
+failed:
+    rc = fail(&err, o->input);
+done:
+    lf_image_free(&disp), lf_image_free(&conf);
+    lf_lf_close(&s);
     return rc;
 }
 
-/* A 1-channel map of the views' size (first channel of a colour image). */
-static int read_map(const char *path, const lf_lightfield *lf, lf_image *m)
+/* --calibrate-views for view: fit the views to the given map, or to one
+ * estimated on the nominal grid. */
+static int calibrate_for_view(const opts *o, lf_lightfield *lf, const lf_image *dm, const lf_image *cm, lf_error *err)
 {
-    lf_image img;
-    lf_error err = {0};
-    if (lf_image_read(path, &img, NULL, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    if (img.width != lf->ns || img.height != lf->nt) {
-        fprintf(stderr, "lftool: %s: map is %dx%d, the views are %dx%d\n", path, img.width, img.height, lf->ns, lf->nt);
-        lf_image_free(&img);
-        return EXIT_INPUT;
-    }
-    if (lf_image_alloc(m, img.width, img.height, 1, &err)) {
-        lf_image_free(&img);
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
-    for (size_t i = 0; i < (size_t)img.width * img.height; i++)
-        m->data[i] = img.data[i * img.channels];
-    lf_image_free(&img);
-    if (lf_image_count_nonfinite(m)) {
-        fprintf(stderr, "lftool: %s: non-finite values in the map\n", path);
-        lf_image_free(m);
-        return EXIT_INPUT;
-    }
-    return EXIT_OK;
+    if (o->dispmap)
+        return lf_lf_calibrate_views(lf, dm, o->confidence ? cm : NULL, o->threads, NULL, err);
+    lf_image ed = {0}, ec = {0};
+    lf_lf_depth_opts dopt = lf_lf_depth_defaults();
+    dopt.threads = o->threads;
+    int rc = lf_lf_depth(lf, &dopt, &ed, &ec, err) || lf_lf_calibrate_views(lf, &ed, &ec, o->threads, NULL, err);
+    lf_image_free(&ed), lf_image_free(&ec);
+    return rc;
 }
 
-static int cmd_view(const opts *o)
+static int cmd_view(int n, char **pos)
 {
-    int rc = need_output(o);
-    if (rc)
-        return rc;
-    if (!o->have_u || !o->have_v)
-        return usage("%s", "view needs --u U --v V");
+    const opts *o = begin("view", n, pos);
     /* per-pixel geometry by default; the plane blend with --geometry plane
      * (or, as before, when a focus plane is given without --geometry) */
     int plane = o->geometry ? !strcmp(o->geometry, "plane") : (o->have_alpha + o->have_depth + o->have_disp) > 0;
     if (plane && o->dispmap)
         return usage("%s", "--disparity-map needs --geometry depth");
-    loaded l;
-    if ((rc = load(o, &l, 0)))
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
+    if (rc)
         return rc;
     double d = 0;
-    if ((rc = focus_disparity(o, &l.lf, &d, 0))) {
-        unload(&l);
-        return rc;
-    }
-    lf_image out, dm = {0}, cm = {0};
+    lf_image out = {0}, dm = {0}, cm = {0};
     lf_error err = {0};
+    if ((rc = focus_disparity(o, &s.lf, &d)))
+        goto done;
     if (!plane && o->dispmap &&
-        ((rc = read_map(o->dispmap, &l.lf, &dm)) || (o->confidence && (rc = read_map(o->confidence, &l.lf, &cm))))) {
-        lf_image_free(&dm);
-        unload(&l);
-        return rc;
+        (lf_lf_read_map(o->dispmap, &s.lf, &dm, &err) ||
+         (o->confidence && lf_lf_read_map(o->confidence, &s.lf, &cm, &err)))) {
+        rc = fail(&err, NULL);
+        goto done;
     }
-    if (!plane && o->calibrate_views) { /* from the given map, or one estimated on the nominal grid */
-        lf_image ed = {0}, ec = {0};
-        lf_lf_depth_opts dopt = lf_lf_depth_defaults();
-        dopt.threads = o->threads;
-        rc = o->dispmap ? lf_lf_calibrate_views(&l.lf, &dm, o->confidence ? &cm : NULL, o->threads, NULL, &err)
-                        : (lf_lf_depth(&l.lf, &dopt, &ed, &ec, &err) ||
-                           lf_lf_calibrate_views(&l.lf, &ed, &ec, o->threads, NULL, &err));
-        lf_image_free(&ed), lf_image_free(&ec);
-        if (rc) {
-            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-            lf_image_free(&dm), lf_image_free(&cm);
-            unload(&l);
-            return EXIT_INPUT;
-        }
-    }
-    if (plane)
-        rc = lf_lf_view_at(&l.lf, o->u, o->v, d, &out, &err);
+    if (!plane && o->calibrate_views && calibrate_for_view(o, &s.lf, &dm, &cm, &err))
+        rc = EXIT_INPUT;
+    else if (plane)
+        rc = lf_lf_view_at(&s.lf, o->u, o->v, d, &out, &err);
     else {
         lf_lf_view_opts vo = lf_lf_view_defaults();
         vo.threads = o->threads;
         vo.plane_disparity = d;
         vo.disparity = o->dispmap ? &dm : NULL;
         vo.confidence = o->dispmap && o->confidence ? &cm : NULL;
-        rc = lf_lf_view_depth(&l.lf, o->u, o->v, &vo, &out, &err);
+        rc = lf_lf_view_depth(&s.lf, o->u, o->v, &vo, &out, &err);
     }
-    lf_image_free(&dm), lf_image_free(&cm);
-    if (rc) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    rc = write_image(o->output, &out, NULL);
-    lf_image_free(&out);
-    unload(&l);
+    rc = rc ? fail(&err, o->input) : write_image(o->output, &out, NULL);
+done:
+    lf_image_free(&out), lf_image_free(&dm), lf_image_free(&cm);
+    lf_lf_close(&s);
     return rc;
 }
 
-static int cmd_synth(const opts *o)
+static int cmd_synth(int n, char **pos)
 {
-    int rc = need_output(o);
+    const opts *o = begin("synth", n, pos);
+    if (o->dispmap && !(o->geometry && !strcmp(o->geometry, "depth")))
+        return usage("%s", "--disparity-map needs --geometry depth");
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    loaded l;
-    if ((rc = load(o, &l, 0)))
-        return rc;
-    const lf_lf_layout *y = &l.lf.layout;
-    if (y->kind != LF_LF_CAMERA_ARRAY) {
-        fprintf(stderr, "lftool: %s: synth needs a camera-array light field (lensfield:kind camera-array)\n", o->input);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    char missing[256] = "";
-    if (!(y->have & LF_LF_HAVE_BOUNDS))
-        strcat(missing, " lensfield:camera_grid_bounds (--griddim minx maxx miny maxy)");
-    if (!(y->have & LF_LF_HAVE_FOV))
-        strcat(missing, " lensfield:fov_deg (--inputfov DEG)");
-    if (missing[0]) {
-        fprintf(stderr, "lftool: %s: synth needs:%s\n", o->input, missing);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    lf_lf_synth_opts s = o->synth;
-    if (!o->have_outfov)
-        s.fov_deg = y->fov_deg;
-    if (!o->have_outdim)
-        s.width = l.lf.ns, s.height = l.lf.nt;
-    if (!o->have_pos) {
-        s.pos[0] = 0.5 * (y->grid_bounds[0] + y->grid_bounds[1]);
-        s.pos[1] = 0.5 * (y->grid_bounds[2] + y->grid_bounds[3]);
-        s.pos[2] = 0;
-    }
-    if (!o->have_focal && (y->have & LF_LF_HAVE_CAM_LENS) && y->focal_distance > 0)
-        s.focal_distance = y->focal_distance;
-    lf_image out, cov, dm = {0};
+    lf_lf_synth_opts so = o->synth;
+    unsigned set = (o->have_outfov ? LF_LF_SYNTH_SET_FOV : 0) | (o->have_outdim ? LF_LF_SYNTH_SET_SIZE : 0) |
+                   (o->have_pos ? LF_LF_SYNTH_SET_POS : 0) | (o->have_focal ? LF_LF_SYNTH_SET_FOCAL : 0);
+    lf_image out = {0}, cov = {0}, dm = {0};
     size_t uncovered = 0;
     lf_error err = {0};
+    if (lf_lf_synth_prepare(&s.lf, set, &so, &err))
+        goto failed;
     if (o->geometry && !strcmp(o->geometry, "depth")) { /* per-pixel geometry (docs/depth.md) */
         lf_lf_depth_opts dop = lf_lf_depth_defaults();
         dop.threads = o->threads;
-        if (o->dispmap)
-            rc = read_map(o->dispmap, &l.lf, &dm);
-        else if (lf_lf_depth(&l.lf, &dop, &dm, NULL, &err)) {
-            fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-            rc = EXIT_INPUT;
+        if (o->dispmap && lf_lf_read_map(o->dispmap, &s.lf, &dm, &err)) {
+            rc = fail(&err, NULL);
+            goto done;
         }
-        if (rc) {
-            unload(&l);
-            return rc;
-        }
-        s.disparity = &dm;
-    } else if (o->dispmap) {
-        unload(&l);
-        return usage("%s", "--disparity-map needs --geometry depth");
+        if (!o->dispmap && lf_lf_depth(&s.lf, &dop, &dm, NULL, &err))
+            goto failed;
+        so.disparity = &dm;
     }
-    clock_t c0 = clock();
-    if (lf_lf_synth(&l.lf, &s, &out, &cov, &uncovered, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        lf_image_free(&dm);
-        unload(&l);
-        return EXIT_INPUT;
-    }
-    lf_image_free(&dm);
-    (void)c0;
+    if (lf_lf_synth(&s.lf, &so, &out, &cov, &uncovered, &err))
+        goto failed;
     rc = write_image(o->output, &out, NULL);
     if (!rc && o->coverage)
         rc = write_image(o->coverage, &cov, NULL);
-    if (!rc) {
-        printf("%s: %dx%d, %d spp -> %s\n", o->input, s.width, s.height, s.spp, o->output);
-        if (uncovered)
-            fprintf(stderr, "lftool: %s: %zu of %d pixels have no ray inside the captured aperture%s\n", o->input,
-                    uncovered, s.width * s.height, o->coverage ? " (see the coverage mask)" : "");
-    }
-    lf_image_free(&out), lf_image_free(&cov);
-    unload(&l);
+    if (!rc)
+        printf("%s: %dx%d, %d spp -> %s\n", o->input, so.width, so.height, so.spp, o->output);
+    if (!rc && uncovered)
+        fprintf(stderr, "lftool: %s: %zu of %d pixels have no ray inside the captured aperture%s\n", o->input,
+                uncovered, so.width * so.height, o->coverage ? " (see the coverage mask)" : "");
+    goto done;
+failed:
+    rc = fail(&err, o->input);
+done:
+    lf_image_free(&out), lf_image_free(&cov), lf_image_free(&dm);
+    lf_lf_close(&s);
     return rc;
 }
 
-static int cmd_calibrate(const opts *o)
+static int cmd_calibrate(int n, char **pos)
 {
-    int rc = need_output(o);
-    if (rc)
-        return rc;
+    const opts *o = begin("calibrate", n, pos);
     lf_image white;
     lf_attrs a = {0}; /* only the estimated layout: the input's own header is not carried over */
     lf_error err = {0};
-    if (lf_image_read(o->input, &white, NULL, &err)) {
-        fprintf(stderr, "lftool: %s\n", err.msg);
-        return EXIT_INPUT;
-    }
+    if (lf_image_read(o->input, &white, NULL, &err))
+        return fail(&err, NULL);
     lf_lf_layout lay;
     lf_lf_layout_init(&lay);
     if (o->flags.have & LF_LF_HAVE_GRID)
         lay.grid = o->flags.grid, lay.have |= LF_LF_HAVE_GRID;
-    if (lf_lf_calibrate(&white, &lay, &err) || lf_lf_layout_to_attrs(&lay, &a, &err)) {
-        fprintf(stderr, "lftool: %s: %s\n", o->input, err.msg);
-        lf_image_free(&white), lf_attrs_free(&a);
-        return EXIT_INPUT;
-    }
-    lf_attrs_set_int(&a, LF_KEY_WHITE, 1);
-    rc = write_image(o->output, &white, &a);
-    if (!rc) {
+    int rc = EXIT_INPUT;
+    if (lf_lf_calibrate(&white, &lay, &err) || lf_lf_layout_to_attrs(&lay, &a, &err))
+        fail(&err, o->input);
+    else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1))
+        fprintf(stderr, "lftool: out of memory\n");
+    else if (!(rc = write_image(o->output, &white, &a))) {
         char buf[1024];
         lf_lf_layout_describe(&lay, buf, sizeof buf);
         printf("%s: estimated layout -> %s\n%s", o->input, o->output, buf);
@@ -1041,11 +671,9 @@ static int cmd_calibrate(const opts *o)
 
 /* ---------- export-web and serve (web/lf_web.h, docs/web.md) ---------- */
 
-static int cmd_export_web(const opts *o)
+static int cmd_export_web(int n, char **pos)
 {
-    int rc = need_output(o);
-    if (rc)
-        return rc;
+    const opts *o = begin("export-web", n, pos);
     if (o->have_from != o->have_to)
         return usage("%s", "export-web: give both --from and --to, or neither");
     lf_web_export_opts wo = lf_web_export_defaults();
@@ -1054,22 +682,23 @@ static int cmd_export_web(const opts *o)
     wo.have_range = o->have_from, wo.focus_min = o->from, wo.focus_max = o->to;
     wo.threads = o->threads;
     wo.source = o->input;
-    loaded l;
-    if ((rc = load(o, &l, 0)))
+    lf_lf_source s;
+    int rc = load(o, &s, 0);
+    if (rc)
         return rc;
     clock_t c0 = clock();
     lf_web_export_info info;
     lf_error err = {0};
-    if (lf_web_export(&l.lf, o->output, &wo, &info, &err)) {
+    if (lf_web_export(&s.lf, o->output, &wo, &info, &err)) {
         fprintf(stderr, "lftool: export-web: %s: %s\n", o->input, err.msg);
-        unload(&l);
+        lf_lf_close(&s);
         return EXIT_INPUT;
     }
     printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
            "(%.1f KiB, %.2f s CPU)\n",
-           o->input, l.lf.nu, l.lf.nv, l.lf.ns, l.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
+           o->input, s.lf.nu, s.lf.nv, s.lf.ns, s.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
            info.page_bytes / 1024.0, (double)(clock() - c0) / CLOCKS_PER_SEC);
-    unload(&l);
+    lf_lf_close(&s);
     return EXIT_OK;
 }
 
@@ -1080,8 +709,9 @@ static void serve_on_signal(int sig)
     serve_stop = 1;
 }
 
-static int cmd_serve(const opts *o)
+static int cmd_serve(int n, char **pos)
 {
+    const opts *o = begin("serve", n, pos);
     lf_web_server *srv;
     lf_error err = {0};
     if (lf_web_server_open(o->input, o->port, &srv, &err)) {
@@ -1095,11 +725,9 @@ static int cmd_serve(const opts *o)
     sigaction(SIGTERM, &sa, NULL);
     printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", lf_web_server_root(srv), lf_web_server_port(srv));
     fflush(stdout);
-    int rc = LF_OK;
-    while (!serve_stop && (rc == LF_OK || rc == LF_ERR_INTERRUPTED))
-        rc = lf_web_server_serve_one(srv, &err);
+    int rc = lf_web_server_run(srv, &serve_stop, &err);
     lf_web_server_close(srv);
-    if (rc != LF_OK && rc != LF_ERR_INTERRUPTED) {
+    if (rc) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
         return EXIT_INPUT;
     }
@@ -1107,29 +735,7 @@ static int cmd_serve(const opts *o)
     return EXIT_OK;
 }
 
-#define RUNNER(name, fn)                  \
-    static int run_##fn(int n, char **pos) \
-    {                                     \
-        opt.cmd = name;                   \
-        opt.input = pos[0];               \
-        if (n > 1)                        \
-            opt.output = pos[1];          \
-        apply_flags();                    \
-        return fn(&opt);                  \
-    }
-RUNNER("info", cmd_info)
-RUNNER("decode", cmd_decode)
-RUNNER("calibrate", cmd_calibrate)
-RUNNER("refocus", cmd_refocus)
-RUNNER("stack", cmd_stack)
-RUNNER("allfocus", cmd_allfocus)
-RUNNER("depth", cmd_depth)
-RUNNER("view", cmd_view)
-RUNNER("synth", cmd_synth)
-RUNNER("export-web", cmd_export_web)
-RUNNER("serve", cmd_serve)
-
-#define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, run_##fn, desc}
+#define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, fn, desc}
 static const lf_command commands[] = {
     CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
     CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
@@ -1151,7 +757,7 @@ static const lf_command commands[] = {
     CMD("view", "IN --u U --v V -o OUT [--geometry depth|plane] [--disparity-map D.exr]",
         "synthesize a view from another viewpoint", view_args, cmd_view, NULL),
     {"synth", "LF OUT.exr [CS348B flags]", "the CS348B virtual camera between the data cameras", synth_args,
-     LF_ARRAY_LEN(synth_args), 2, 2, run_cmd_synth, NULL},
+     LF_ARRAY_LEN(synth_args), 2, 2, cmd_synth, NULL},
     CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
         "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
     CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),

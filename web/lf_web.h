@@ -19,6 +19,8 @@
 #ifndef LF_WEB_H
 #define LF_WEB_H
 
+#include <signal.h>
+
 #include <stddef.h>
 
 #include "../base/lf_error.h"
@@ -77,6 +79,10 @@ const char *lf_web_server_root(const lf_web_server *server);
  * signal interrupted the wait (the caller checks its stop flag); another
  * code when accepting failed. */
 int lf_web_server_serve_one(lf_web_server *server, lf_error *err);
+/* Serves requests one at a time until *stop becomes non-zero (set by the
+ * caller's signal handler; the wait for a connection returns on a signal).
+ * 0 when stopped, else the code of the failure to accept. */
+int lf_web_server_run(lf_web_server *server, const volatile sig_atomic_t *stop, lf_error *err);
 void lf_web_server_close(lf_web_server *server);
 
 /* The request path after %XX decoding, query and fragment cut; -1 for NUL,

@@ -208,3 +208,11 @@ int lf_web_server_serve_one(lf_web_server *s, lf_error *err)
     close(c);
     return LF_OK;
 }
+
+int lf_web_server_run(lf_web_server *s, const volatile sig_atomic_t *stop, lf_error *err)
+{
+    int rc = LF_OK;
+    while (!*stop && (rc == LF_OK || rc == LF_ERR_INTERRUPTED))
+        rc = lf_web_server_serve_one(s, err);
+    return rc == LF_ERR_INTERRUPTED ? LF_OK : rc;
+}

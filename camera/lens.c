@@ -712,30 +712,21 @@ static int passes(pupil_ctx *c, double x, double y)
 
 enum { BISECT = 16 };
 
-/* Edge between a passing x and a failing x on the line y. */
-static double bisect_x(pupil_ctx *c, double y, double x_pass, double x_fail)
+/* Edge between a passing and a failing coordinate along x (on the line y =
+ * other) or along y (on the line x = other). */
+static double bisect_edge(pupil_ctx *c, int along_y, double other, double pass, double fail)
 {
     for (int i = 0; i < BISECT; i++) {
-        double m = 0.5 * (x_pass + x_fail);
-        if (passes(c, m, y))
-            x_pass = m;
+        double m = 0.5 * (pass + fail);
+        if (along_y ? passes(c, other, m) : passes(c, m, other))
+            pass = m;
         else
-            x_fail = m;
+            fail = m;
     }
-    return x_pass;
+    return pass;
 }
-
-static double bisect_y(pupil_ctx *c, double x, double y_pass, double y_fail)
-{
-    for (int i = 0; i < BISECT; i++) {
-        double m = 0.5 * (y_pass + y_fail);
-        if (passes(c, x, m))
-            y_pass = m;
-        else
-            y_fail = m;
-    }
-    return y_pass;
-}
+static double bisect_x(pupil_ctx *c, double y, double x_pass, double x_fail) { return bisect_edge(c, 0, y, x_pass, x_fail); }
+static double bisect_y(pupil_ctx *c, double x, double y_pass, double y_fail) { return bisect_edge(c, 1, x, y_pass, y_fail); }
 
 /* Stack room for the chief-ray search; longer prescriptions skip it. */
 #define LF_LENS_MAX_SURFACES 64

@@ -72,16 +72,7 @@ static lf_vec3 sample_direct(const lf_scene *s, lf_light_sampler lsm, const lf_h
     }
     lf_sample_2d(st, &u0, &u1);
     double pmf;
-    int li;
-    if (lsm == LF_LIGHTS_UNIFORM) {
-        int k = (int)(ul * s->n_nee_lights);
-        li = s->nee_lights[k < s->n_nee_lights ? k : s->n_nee_lights - 1];
-        pmf = 1.0 / s->n_nee_lights;
-    } else {
-        double ur;
-        li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
-        (void)ur;
-    }
+    int li = lf_pick_light(s, lsm, ul, &pmf);
     if (!(pmf > 0))
         return lf_v3(0, 0, 0);
     return light_direct(s, h, bsdf, wo, li, pmf, u0, u1, rays);
@@ -90,21 +81,20 @@ static lf_vec3 sample_direct(const lf_scene *s, lf_light_sampler lsm, const lf_h
 lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, lf_sample_stream *st,
                    long long *rays)
 {
-    lf_vec3 L = lf_v3(0, 0, 0), beta = lf_v3(1, 1, 1);
-    int depth = 0, specular_bounce = 0;
+    lf_vec3 L = lf_v3(0, 0, 0);
+    lf_path_state ps = {lf_v3(1, 1, 1), 1.f, 0, 1.f, o};
+    int depth = 0;
     const lf_light_sampler lsm = lf_light_sampler_for(in, s);
-    float p_b = 1.f, eta_scale = 1.f;
-    lf_vec3 prev_p = o;
     int passes = 0;
     for (;;) {
         lf_hit h;
         (*rays)++;
         if (!lf_scene_intersect(s, o, d, INFINITY, tau, &h)) {
-            lf_add_escaped_light(&L, s, lsm, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
+            lf_add_escaped_light(&L, s, lsm, ps.beta, depth == 0 || ps.specular_bounce, ps.p_b, ps.prev_p, d);
             break;
         }
         lf_vec3 wo = lf_neg(d);
-        lf_add_hit_emission(&L, s, lsm, &h, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
+        lf_add_hit_emission(&L, s, lsm, &h, ps.beta, depth == 0 || ps.specular_bounce, ps.p_b, ps.prev_p, d);
         const lf_material *mat = lf_materials_get(s->materials, h.material);
         if (lf_material_is_interface(mat)) {
             /* No surface here (pbrt "interface"): continue the ray unchanged. */
@@ -119,30 +109,18 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
         float ul, uc;
         int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc);
         if (!specular && s->n_nee_lights > 0)
-            L = lf_add(L, lf_mul(beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
+            L = lf_add(L, lf_mul(ps.beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
         else
             lf_sample_skip(st);
-        float u0, u1;
-        lf_sample_2d(st, &u0, &u1);
-        struct lf_bsdf_sample bs;
-        if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
+        if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
             break;
-        float cosi = lf_absdot(bs.wi, bsdf.n);
-        beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
-        p_b = bs.pdf;
-        specular_bounce = bs.specular;
-        if (bs.transmission && bs.eta > 0)
-            eta_scale *= bs.eta * bs.eta;
-        prev_p = h.sc.p;
-        o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
-        d = bs.wi;
         /* Russian roulette (render_internal.h).  pbrt-v4's rule: p = max
          * component, after depth 1.  The default, "sqrt": p = sqrt(max
          * component) (Cycles' rule), and not before depth 2: ending paths
          * early kills the bright direct light their next vertices would have
          * gathered, which costs far more variance than the rays it saves
          * (docs/performance.md, issue 21). */
-        if (!lf_roulette(in, &beta, eta_scale, depth, st))
+        if (!lf_roulette(in, &ps.beta, ps.eta_scale, depth, st))
             break;
     }
     return L;

@@ -254,15 +254,7 @@ static lf_vec3 vol_sample_direct(const lf_scene *s, lf_light_sampler lsm, const 
     }
     lf_sample_2d(st, &u0, &u1);
     double pmf;
-    int li;
-    if (lsm == LF_LIGHTS_UNIFORM) {
-        int k = (int)(ul * s->n_nee_lights);
-        li = s->nee_lights[k < s->n_nee_lights ? k : s->n_nee_lights - 1];
-        pmf = 1.0 / s->n_nee_lights;
-    } else {
-        double ur;
-        li = lf_distrib1d_sample_discrete(&s->light_distrib, ul, &pmf, &ur);
-    }
+    int li = lf_pick_light(s, lsm, ul, &pmf);
     if (!(pmf > 0))
         return lf_v3(0, 0, 0);
     return vol_light_direct(s, v, li, pmf, u0, u1, tau, rays);
@@ -271,11 +263,10 @@ static lf_vec3 vol_sample_direct(const lf_scene *s, lf_light_sampler lsm, const 
 lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, int medium,
                       lf_sample_stream *st, long long *rays)
 {
-    lf_vec3 L = lf_v3(0, 0, 0), beta = lf_v3(1, 1, 1);
-    int depth = 0, specular_bounce = 0;
+    lf_vec3 L = lf_v3(0, 0, 0);
+    lf_path_state ps = {lf_v3(1, 1, 1), 1.f, 0, 1.f, o};
+    int depth = 0;
     const lf_light_sampler lsm = lf_light_sampler_for(in, s);
-    float p_b = 1.f, eta_scale = 1.f;
-    lf_vec3 prev_p = o;
     int passes = 0;
     for (;;) {
         lf_hit h;
@@ -290,12 +281,12 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                 e.x = m->sigma_t.x > 0 ? m->sigma_a.x * m->Le.x * (1 - T.x) / m->sigma_t.x : 0;
                 e.y = m->sigma_t.y > 0 ? m->sigma_a.y * m->Le.y * (1 - T.y) / m->sigma_t.y : 0;
                 e.z = m->sigma_t.z > 0 ? m->sigma_a.z * m->Le.z * (1 - T.z) / m->sigma_t.z : 0;
-                L = lf_add(L, lf_mul(beta, e));
+                L = lf_add(L, lf_mul(ps.beta, e));
             }
             float uc, ut;
             lf_sample_2d(st, &uc, &ut);
             if (!m->scatters) {
-                beta = lf_mul(beta, transmittance(m->sigma_t, t_s));
+                ps.beta = lf_mul(ps.beta, transmittance(m->sigma_t, t_s));
             } else {
                 int c = (int)(uc * 3.f);
                 float sc = c <= 0 ? m->sigma_t.x : c == 1 ? m->sigma_t.y : m->sigma_t.z;
@@ -306,8 +297,8 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                     float pdf = (m->sigma_t.x * T.x + m->sigma_t.y * T.y + m->sigma_t.z * T.z) / 3.f;
                     if (!(pdf > 0))
                         break;
-                    beta = lf_scale(lf_mul(beta, lf_mul(m->sigma_s, T)), 1.f / pdf);
-                    if (!(lf_maxc(beta) > 0) || depth++ == in->max_depth)
+                    ps.beta = lf_scale(lf_mul(ps.beta, lf_mul(m->sigma_s, T)), 1.f / pdf);
+                    if (!(lf_maxc(ps.beta) > 0) || depth++ == in->max_depth)
                         break;
                     lf_vec3 p = lf_madd(o, d, t), wo = lf_neg(d);
                     float ul = 0.5f, uunused;
@@ -318,18 +309,18 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                         lf_sample_skip(st);
                     if (s->n_nee_lights > 0) {
                         vertex v = {p, wo, NULL, NULL, m->g, medium};
-                        L = lf_add(L, lf_mul(beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
+                        L = lf_add(L, lf_mul(ps.beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
                     } else {
                         lf_sample_skip(st);
                     }
                     float u0, u1, ppdf;
                     lf_sample_2d(st, &u0, &u1);
                     d = hg_sample(m->g, wo, u0, u1, &ppdf);
-                    p_b = ppdf;
-                    specular_bounce = 0;
-                    prev_p = p;
+                    ps.p_b = ppdf;
+                    ps.specular_bounce = 0;
+                    ps.prev_p = p;
                     o = p;
-                    if (!lf_roulette(in, &beta, eta_scale, depth, st))
+                    if (!lf_roulette(in, &ps.beta, ps.eta_scale, depth, st))
                         break;
                     continue;
                 }
@@ -337,19 +328,19 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                 float pass = (T.x + T.y + T.z) / 3.f;
                 if (!(pass > 0))
                     break;
-                beta = lf_scale(lf_mul(beta, T), 1.f / pass);
+                ps.beta = lf_scale(lf_mul(ps.beta, T), 1.f / pass);
             }
-            if (!(lf_maxc(beta) > 0))
+            if (!(lf_maxc(ps.beta) > 0))
                 break;
         } else {
             lf_sample_skip(st);
         }
         if (!hit) {
-            lf_add_escaped_light(&L, s, lsm, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
+            lf_add_escaped_light(&L, s, lsm, ps.beta, depth == 0 || ps.specular_bounce, ps.p_b, ps.prev_p, d);
             break;
         }
         lf_vec3 wo = lf_neg(d);
-        lf_add_hit_emission(&L, s, lsm, &h, beta, depth == 0 || specular_bounce, p_b, prev_p, d);
+        lf_add_hit_emission(&L, s, lsm, &h, ps.beta, depth == 0 || ps.specular_bounce, ps.p_b, ps.prev_p, d);
         const lf_material *mat = lf_materials_get(s->materials, h.material);
         if (lf_material_is_interface(mat)) {
             /* A medium boundary without a surface: continue, maybe in another medium. */
@@ -366,26 +357,14 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
         int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc);
         if (!specular && s->n_nee_lights > 0) {
             vertex v = {h.sc.p, wo, &h, &bsdf, 0.f, medium};
-            L = lf_add(L, lf_mul(beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
+            L = lf_add(L, lf_mul(ps.beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
         } else {
             lf_sample_skip(st);
         }
-        float u0, u1;
-        lf_sample_2d(st, &u0, &u1);
-        struct lf_bsdf_sample bs;
-        if (!lf_bsdf_sample(&bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
+        if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
             break;
-        float cosi = lf_absdot(bs.wi, bsdf.n);
-        beta = lf_mul(beta, lf_scale(bs.f, cosi / bs.pdf));
-        p_b = bs.pdf;
-        specular_bounce = bs.specular;
-        if (bs.transmission && bs.eta > 0)
-            eta_scale *= bs.eta * bs.eta;
-        prev_p = h.sc.p;
-        medium = medium_after(&h, bs.wi, medium);
-        o = lf_offset_origin(h.sc.p, h.sc.ng, bs.wi);
-        d = bs.wi;
-        if (!lf_roulette(in, &beta, eta_scale, depth, st))
+        medium = medium_after(&h, d, medium);
+        if (!lf_roulette(in, &ps.beta, ps.eta_scale, depth, st))
             break;
     }
     return L;

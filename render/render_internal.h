@@ -86,10 +86,11 @@ static inline lf_vec3 lf_sphere_center_at(const lf_sphere *sp, float tau)
     return lf_add(lf_scale(sp->centers[k], 1.f - f), lf_scale(sp->centers[k + 1], f));
 }
 
-/* Vertex i of a mesh at Embree time tau (linear between keyframes, as Embree). */
-static inline lf_vec3 lf_mesh_vertex_at(const lf_mesh *m, int i, float tau)
+/* Per-vertex 3-vector i of keyframed mesh data (P or N, n_keys blocks) at
+ * Embree time tau: linear between keyframes, as Embree. */
+static inline lf_vec3 lf_mesh_attr_at(const lf_mesh *m, const float *data, int i, float tau)
 {
-    const float *p = m->P + 3 * (size_t)i;
+    const float *p = data + 3 * (size_t)i;
     if (m->n_keys <= 1)
         return lf_v3(p[0], p[1], p[2]);
     float f;
@@ -97,17 +98,8 @@ static inline lf_vec3 lf_mesh_vertex_at(const lf_mesh *m, int i, float tau)
     const float *a = p + (size_t)k * 3 * m->n_verts, *b = a + (size_t)3 * m->n_verts;
     return lf_v3(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]));
 }
-
-static inline lf_vec3 lf_mesh_normal_at(const lf_mesh *m, int i, float tau)
-{
-    const float *p = m->N + 3 * (size_t)i;
-    if (m->n_keys <= 1)
-        return lf_v3(p[0], p[1], p[2]);
-    float f;
-    int k = lf_key_segment(m->n_keys, tau, &f);
-    const float *a = p + (size_t)k * 3 * m->n_verts, *b = a + (size_t)3 * m->n_verts;
-    return lf_v3(a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]));
-}
+static inline lf_vec3 lf_mesh_vertex_at(const lf_mesh *m, int i, float tau) { return lf_mesh_attr_at(m, m->P, i, tau); }
+static inline lf_vec3 lf_mesh_normal_at(const lf_mesh *m, int i, float tau) { return lf_mesh_attr_at(m, m->N, i, tau); }
 
 /* A static Embree scene of meshes in their own space, placed in the world
  * by lf_instance geometries.  Its meshes are s->meshes[mesh_first ..
@@ -377,6 +369,51 @@ static inline void lf_add_escaped_light(lf_vec3 *L, const lf_scene *s, lf_light_
         if (!lf_is_black(Le))
             lf_add_bsdf_sampled_light(L, s, lsm, s->infinite_lights[k], Le, beta, unweighted, p_b, prev_p, d, NULL);
     }
+}
+
+/* The light one-sample NEE uses at a vertex (strategies UNIFORM and POWER),
+ * chosen with ul; *pmf its probability (0: none). */
+static inline int lf_pick_light(const lf_scene *s, lf_light_sampler lsm, float ul, double *pmf)
+{
+    if (lsm == LF_LIGHTS_UNIFORM) {
+        int k = (int)(ul * s->n_nee_lights);
+        *pmf = 1.0 / s->n_nee_lights;
+        return s->nee_lights[k < s->n_nee_lights ? k : s->n_nee_lights - 1];
+    }
+    double ur;
+    return lf_distrib1d_sample_discrete(&s->light_distrib, ul, pmf, &ur);
+}
+
+/* The path's state between vertices, as both integrators carry it. */
+typedef struct lf_path_state {
+    lf_vec3 beta;        /* throughput */
+    float p_b;           /* the last BSDF sample's pdf (MIS of emission hit next) */
+    int specular_bounce; /* the last bounce was a delta lobe */
+    float eta_scale;     /* product of eta^2 over transmissions (roulette) */
+    lf_vec3 prev_p;      /* the last vertex */
+} lf_path_state;
+
+/* Continues a path from surface hit h by sampling its BSDF (the vertex's
+ * direction pair is drawn here): updates the state and the ray (o, d).
+ * Returns 0 when the path ends (no valid sample). */
+static inline int lf_bsdf_continue(const lf_bsdf *bsdf, const lf_hit *h, lf_vec3 wo, float uc, lf_sample_stream *st,
+                                   lf_path_state *ps, lf_vec3 *o, lf_vec3 *d)
+{
+    float u0, u1;
+    lf_sample_2d(st, &u0, &u1);
+    struct lf_bsdf_sample bs;
+    if (!lf_bsdf_sample(bsdf, wo, uc, u0, u1, &bs) || !(bs.pdf > 0) || lf_is_black(bs.f))
+        return 0;
+    float cosi = lf_absdot(bs.wi, bsdf->n);
+    ps->beta = lf_mul(ps->beta, lf_scale(bs.f, cosi / bs.pdf));
+    ps->p_b = bs.pdf;
+    ps->specular_bounce = bs.specular;
+    if (bs.transmission && bs.eta > 0)
+        ps->eta_scale *= bs.eta * bs.eta;
+    ps->prev_p = h->sc.p;
+    *o = lf_offset_origin(h->sc.p, h->sc.ng, bs.wi);
+    *d = bs.wi;
+    return 1;
 }
 
 /* The BSDF at a surface vertex and the two sample values it may spend on

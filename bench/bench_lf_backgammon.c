@@ -221,6 +221,8 @@ int main(int argc, char **argv)
                 o.defocus_weight = atof(getenv("LFD_ALPHA"));
             if (getenv("LFD_OCC"))
                 o.occlusion = atoi(getenv("LFD_OCC"));
+            if (getenv("LFD_INTERP"))
+                o.interp = atoi(getenv("LFD_INTERP"));
             double s = now(), sc = cpu_now();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
@@ -322,6 +324,8 @@ int main(int argc, char **argv)
         {
             lf_lf_depth_opts o = lf_lf_depth_defaults();
             o.threads = threads;
+            if (getenv("LFD_INTERP"))
+                o.interp = atoi(getenv("LFD_INTERP"));
             double s = now();
             if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);

@@ -58,6 +58,7 @@ typedef struct cost_ctx {
     float scale;         /* colour scale: 1 / mean channel sum of the reference */
     float alpha;         /* defocus weight */
     int occlusion;
+    int cubic;           /* 1: views looked up by Keys cubic convolution, 0: bilinear */
     float *cost;         /* [label][pixel] */
     float *scratch;      /* per thread: NGROUPS * NFIELDS * ns + 5 * ns floats */
     size_t scratch_per_thread;
@@ -117,6 +118,48 @@ LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float
         sad[x] += ad < tau ? ad : tau;
         s0[x] += e0, s1[x] += e1, s2[x] += e2;
         n[x] += ok;
+    }
+}
+
+/* Keys cubic convolution (a = -1/2) weights of the taps at -1, 0, 1, 2 for
+ * a sample at phase f in [0, 1). */
+static void keys4(double f, float w[4])
+{
+    double t = 1 + f;
+    w[0] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
+    w[1] = (float)((1.5 * f - 2.5) * f * f + 1);
+    t = 1 - f;
+    w[2] = (float)((1.5 * t - 2.5) * t * t + 1);
+    t = 2 - f;
+    w[3] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
+}
+
+/* o[i] = sum of the 4 rows weighted by v (n floats): the vertical pass of
+ * the separable cubic lookup. */
+LF_HOT_LOOP static void vcomb(float *restrict o, const float *restrict r0, const float *restrict r1,
+                              const float *restrict r2, const float *restrict r3, float v0, float v1, float v2,
+                              float v3, int n)
+{
+    for (int i = 0; i < n; i++)
+        o[i] = v0 * r0[i] + v1 * r1[i] + v2 * r2[i] + v3 * r3[i];
+}
+
+/* view_row with the horizontal pass of the cubic lookup: t[3 x + ch] is the
+ * vertically combined row at column x + ix - 1. */
+LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float *restrict t, const float *restrict c,
+                                       float h0, float h1, float h2, float h3, float scale, float tau, int xa, int xb)
+{
+    float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
+                    *restrict n = acc + 4 * ns;
+    for (int x = xa; x <= xb; x++) {
+        int k = 3 * x;
+        float e0 = (h0 * t[k] + h1 * t[k + 3] + h2 * t[k + 6] + h3 * t[k + 9] - c[k]) * scale;
+        float e1 = (h0 * t[k + 1] + h1 * t[k + 4] + h2 * t[k + 7] + h3 * t[k + 10] - c[k + 1]) * scale;
+        float e2 = (h0 * t[k + 2] + h1 * t[k + 5] + h2 * t[k + 8] + h3 * t[k + 11] - c[k + 2]) * scale;
+        float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
+        sad[x] += ad < tau ? ad : tau;
+        s0[x] += e0, s1[x] += e1, s2[x] += e2;
+        n[x] += 1.f;
     }
 }
 
@@ -198,6 +241,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     size_t np = (size_t)ns * nt;
     float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
     float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
+    float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
         const float *cref = c->ref + (size_t)y * ns * 3;
@@ -213,6 +257,25 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                 int r0 = y + iy, r1 = fy > 0.f ? r0 + 1 : r0;
                 if (r0 < 0 || r1 > nt - 1)
                     continue;
+                if (c->cubic && !v->valid) {
+                    /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
+                    int xa = 1 - ix > 0 ? 1 - ix : 0, xb = ns - 3 - ix < ns - 1 ? ns - 3 - ix : ns - 1;
+                    if (xa > xb)
+                        continue;
+                    float wy[4], wx[4];
+                    keys4(sy - iy, wy);
+                    keys4(sx - ix, wx);
+                    const float *rr[4];
+                    for (int m = 0; m < 4; m++)
+                        rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
+                    size_t c0 = 3 * (size_t)(xa + ix - 1);
+                    int n = 3 * (xb - xa + 4);
+                    vcomb(vt + 3 * (size_t)xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, wy[0], wy[1], wy[2],
+                          wy[3], n);
+                    view_row_cubic(acc + (size_t)v->group * NFIELDS * ns, ns, vt, cref, wx[0], wx[1], wx[2], wx[3],
+                                   c->scale, c->tau, xa, xb);
+                    continue;
+                }
                 int xa = ix < 0 ? -ix : 0;
                 int xb = ns - 1 - (fx > 0.f ? ix + 1 : ix);
                 if (xb > ns - 1)
@@ -494,7 +557,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     const float *ref = lf_lf_view(lf, iu0, iv0);
     dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
     float *cost = malloc(sizeof(float) * np * (size_t)nl);
-    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 5) * ns;
+    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 8) * ns + 12;
     size_t gf_scratch = 10 * np;
     size_t per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch;
     float *scratch = malloc(sizeof(float) * per_thread * (size_t)threads);
@@ -530,7 +593,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 
     cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, o->interp != 1, cost, scratch, per_thread};
     if (lf->valid)
         cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
     lf_parallel_for(nt, threads, 4, cost_rows, &cc);

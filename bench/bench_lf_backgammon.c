@@ -223,6 +223,8 @@ int main(int argc, char **argv)
                 o.occlusion = atoi(getenv("LFD_OCC"));
             if (getenv("LFD_INTERP"))
                 o.interp = atoi(getenv("LFD_INTERP"));
+            if (getenv("LFD_REFINE"))
+                o.refine = atoi(getenv("LFD_REFINE"));
             double s = now(), sc = cpu_now();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
@@ -326,6 +328,8 @@ int main(int argc, char **argv)
             o.threads = threads;
             if (getenv("LFD_INTERP"))
                 o.interp = atoi(getenv("LFD_INTERP"));
+            if (getenv("LFD_REFINE"))
+                o.refine = atoi(getenv("LFD_REFINE"));
             double s = now();
             if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);

@@ -476,6 +476,118 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
         }
 }
 
+/* ---------- continuous refinement (Gauss-Newton on photo-consistency) ---------- */
+
+/* Derivatives of the Keys weights (keys4) with respect to the sample position. */
+static void keys4d(double f, float w[4])
+{
+    double t = 1 + f;
+    w[0] = (float)(-1.5 * t * t + 5 * t - 4);
+    w[1] = (float)(4.5 * f * f - 5 * f);
+    t = 1 - f;
+    w[2] = (float)(-(4.5 * t * t - 5 * t));
+    t = 2 - f;
+    w[3] = (float)(-(-1.5 * t * t + 5 * t - 4));
+}
+
+typedef struct gn_ctx {
+    int w, h;
+    const dview *v;
+    const float *img;  /* the view's data, RGB */
+    const float *ref, *disp; /* reference view; disparity */
+    float *A, *B;      /* per pixel: sums of rho J^2 and rho J r over the views */
+    float scale, c2;
+} gn_ctx;
+
+/* Per pixel, at its own disparity d: the residual r = I_k(x - d du + ox, ...) - I_ref
+ * of one view (cubic lookup) and its derivative J with respect to d, with a
+ * Cauchy weight rho = 1 / (1 + |r|^2 / c^2) that lets a view seeing an
+ * occluder drop out; added to A and B. */
+static void gn_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    gn_ctx *c = vctx;
+    const dview *v = c->v;
+    int w = c->w, h = c->h;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            double d = c->disp[i];
+            const float *p = c->ref + 3 * i;
+            double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
+            int ix = (int)floor(sx), iy = (int)floor(sy);
+            if (ix < 1 || iy < 1 || ix > w - 3 || iy > h - 3)
+                continue;
+            float wx[4], wy[4], gx[4], gy[4];
+            keys4(sx - ix, wx), keys4(sy - iy, wy), keys4d(sx - ix, gx), keys4d(sy - iy, gy);
+            float val[3] = {0, 0, 0}, dx[3] = {0, 0, 0}, dy[3] = {0, 0, 0};
+            for (int m = 0; m < 4; m++) {
+                const float *row = c->img + ((size_t)(iy - 1 + m) * w + ix - 1) * 3;
+                float hv[3] = {0, 0, 0}, hg[3] = {0, 0, 0};
+                for (int n = 0; n < 4; n++)
+                    for (int ch = 0; ch < 3; ch++)
+                        hv[ch] += wx[n] * row[3 * n + ch], hg[ch] += gx[n] * row[3 * n + ch];
+                for (int ch = 0; ch < 3; ch++)
+                    val[ch] += wy[m] * hv[ch], dx[ch] += wy[m] * hg[ch], dy[ch] += gy[m] * hv[ch];
+            }
+            double rr = 0, jj = 0, jr = 0;
+            for (int ch = 0; ch < 3; ch++) {
+                double r = (val[ch] - p[ch]) * c->scale, j = -(v->du * dx[ch] + v->dv * dy[ch]) * c->scale;
+                rr += r * r, jj += j * j, jr += j * r;
+            }
+            double rho = 1.0 / (1.0 + rr / c->c2);
+            c->A[i] += (float)(rho * jj), c->B[i] += (float)(rho * jr);
+        }
+}
+
+typedef struct gnagg_ctx {
+    int w, h, r;
+    const float *A, *B, *disp, *refs;
+    float *out;
+    float dmax, sigma2;
+} gnagg_ctx;
+
+/* d = sum_q w_q (A_q d_q - b_q) / sum_q w_q A_q over the window: the
+ * linearised costs of the neighbours on the same surface (disparity within
+ * dmax, colour weight as the median's) added up; the step is at most dmax. */
+static void gnagg_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    gnagg_ctx *c = vctx;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < c->w; x++) {
+            size_t i = (size_t)y * c->w + x;
+            float d = c->disp[i];
+            const float *p = c->refs + 3 * i;
+            double sa = 0, sb = 0;
+            for (int yy = y - c->r; yy <= y + c->r; yy++) {
+                if (yy < 0 || yy >= c->h)
+                    continue;
+                for (int xx = x - c->r; xx <= x + c->r; xx++) {
+                    if (xx < 0 || xx >= c->w)
+                        continue;
+                    size_t j = (size_t)yy * c->w + xx;
+                    if (fabsf(c->disp[j] - d) > c->dmax) /* near a depth edge: views are partly occluded */
+                        goto keep;
+                    const float *q = c->refs + 3 * j;
+                    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
+                    float wt = expf(-(e0 * e0 + e1 * e1 + e2 * e2) / c->sigma2);
+                    sa += wt * c->A[j], sb += wt * c->B[j];
+                }
+            }
+            float nd;
+            nd = d;
+            if (sa > 1e-9) {
+                double t = sb / sa;
+                nd = (float)(t < d - c->dmax ? d - c->dmax : (t > d + c->dmax ? d + c->dmax : t));
+            }
+            c->out[i] = nd;
+            continue;
+        keep:
+            c->out[i] = d;
+        }
+}
+
 /* ---------- weighted median (guided by the reference colour) ---------- */
 
 typedef struct wm_ctx {
@@ -668,6 +780,31 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     } else {
         memcpy(disparity->data, disp, sizeof(float) * np);
     }
+    if (o->refine >= 0) {
+        /* continuous sub-label refinement: Gauss-Newton steps on the views'
+         * photo-consistency around the labelled disparity (docs/depth.md) */
+        int iters = o->refine > 0 ? o->refine : 2;
+        float *A = cost, *B = cost + np, *tmpd = cost + 2 * np; /* the cost volume is no longer needed */
+        for (size_t i = 0; i < np; i++)
+            for (int ch = 0; ch < 3; ch++) {
+                float v = ref[3 * i + ch] * scale;
+                refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
+            }
+        for (int it = 0; it < iters; it++) {
+            memset(A, 0, sizeof(float) * 2 * np);
+            for (int k = 0; k < nv; k++) {
+                if (views[k].valid)
+                    continue;
+                gn_ctx gc2 = {ns, nt, &views[k], views[k].data, ref, disparity->data, A, B, scale, 0.003f * 0.003f};
+                lf_parallel_for(nt, threads, 8, gn_rows, &gc2);
+            }
+            for (size_t i = 0; i < np; i++)
+                B[i] = A[i] * disparity->data[i] - B[i];
+            gnagg_ctx ga = {ns, nt, 2, A, B, disparity->data, refs, tmpd, (float)(2 * step), 0.02f};
+            lf_parallel_for(nt, threads, 4, gnagg_rows, &ga);
+            memcpy(disparity->data, tmpd, sizeof(float) * np);
+        }
+    }
     if (confidence) {
         if (lf_image_alloc(confidence, ns, nt, 1, err)) {
             rc = err ? err->code : LF_ERR_NOMEM;
@@ -767,6 +904,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
+    o.refine = -1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
     double s0 = -lim / f, s1 = lim / f;

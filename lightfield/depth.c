@@ -783,7 +783,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     if (o->refine >= 0) {
         /* continuous sub-label refinement: Gauss-Newton steps on the views'
          * photo-consistency around the labelled disparity (docs/depth.md) */
-        int iters = o->refine > 0 ? o->refine : 2;
+        int iters = o->refine > 0 ? o->refine : 1;
         float *A = cost, *B = cost + np, *tmpd = cost + 2 * np; /* the cost volume is no longer needed */
         for (size_t i = 0; i < np; i++)
             for (int ch = 0; ch < 3; ch++) {
@@ -904,7 +904,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
-    o.refine = -1; /* the range needs no sub-label precision */
+    o.refine = -1, o.interp = 1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
     double s0 = -lim / f, s1 = lim / f;

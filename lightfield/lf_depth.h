@@ -39,7 +39,7 @@ typedef struct lf_lf_depth_opts {
     int occlusion;       /* 0: full aperture only; 1 (default): best of 8 half apertures too */
     double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
-    int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (2), < 0 off */
+    int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */
     int interp;          /* views' sub-pixel lookup in the cost volume: 0 (default) Keys cubic, 1 bilinear */
     int threads;         /* <= 0: 2 */
 } lf_lf_depth_opts;

@@ -4,11 +4,12 @@
  * Layout of the work: the cost volume cost[label][pixel] is built in bands
  * of rows (threads take bands), views read in place (RGB interleaved);
  * for one label every view is shifted by a constant sub-pixel offset, so
- * the bilinear weights are constant along a row and the inner loops are
- * plain multiply-adds over contiguous floats (vectorised, AVX2 clone).
- * Then each cost slice is filtered (guided filter, threads take slices),
- * then per pixel the minimum, parabola refinement and confidence, then the
- * weighted median. */
+ * the cubic (or bilinear) weights are constant along a row and the inner
+ * loops are plain multiply-adds over contiguous floats (vectorised, AVX2
+ * clone).  Then each cost slice is filtered (guided filter, threads take
+ * slices), then per pixel the minimum, parabola refinement and confidence,
+ * then the weighted median, then a Gauss-Newton refinement (views outer,
+ * rows in parallel). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>

@@ -202,6 +202,10 @@ int main(int argc, char **argv)
                 o.defocus_weight = atof(getenv("LFD_ALPHA"));
             if (getenv("LFD_OCC"))
                 o.occlusion = atoi(getenv("LFD_OCC"));
+            if (getenv("LFD_INTERP"))
+                o.interp = atoi(getenv("LFD_INTERP"));
+            if (getenv("LFD_REFINE"))
+                o.refine = atoi(getenv("LFD_REFINE"));
             double s = lf_seconds(), sc = bench_cpu_seconds();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
@@ -303,6 +307,10 @@ int main(int argc, char **argv)
         {
             lf_lf_depth_opts o = lf_lf_depth_defaults();
             o.threads = threads;
+            if (getenv("LFD_INTERP"))
+                o.interp = atoi(getenv("LFD_INTERP"));
+            if (getenv("LFD_REFINE"))
+                o.refine = atoi(getenv("LFD_REFINE"));
             double s = lf_seconds();
             if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);

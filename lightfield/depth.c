@@ -4,11 +4,12 @@
  * Layout of the work: the cost volume cost[label][pixel] is built in bands
  * of rows (threads take bands), views read in place (RGB interleaved);
  * for one label every view is shifted by a constant sub-pixel offset, so
- * the bilinear weights are constant along a row and the inner loops are
- * plain multiply-adds over contiguous floats (vectorised, AVX2 clone).
- * Then each cost slice is filtered (guided filter, threads take slices),
- * then per pixel the minimum, parabola refinement and confidence, then the
- * weighted median. */
+ * the cubic (or bilinear) weights are constant along a row and the inner
+ * loops are plain multiply-adds over contiguous floats (vectorised, AVX2
+ * clone).  Then each cost slice is filtered (guided filter, threads take
+ * slices), then per pixel the minimum, parabola refinement and confidence,
+ * then the weighted median, then a Gauss-Newton refinement (views outer,
+ * rows in parallel). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -58,6 +59,7 @@ typedef struct cost_ctx {
     float scale;         /* colour scale: 1 / mean channel sum of the reference */
     float alpha;         /* defocus weight */
     int occlusion;
+    int cubic;           /* 1: views looked up by Keys cubic convolution, 0: bilinear */
     float *cost;         /* [label][pixel] */
     float *scratch;      /* per thread: NGROUPS * NFIELDS * ns + 5 * ns floats */
     size_t scratch_per_thread;
@@ -117,6 +119,48 @@ LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float
         sad[x] += ad < tau ? ad : tau;
         s0[x] += e0, s1[x] += e1, s2[x] += e2;
         n[x] += ok;
+    }
+}
+
+/* Keys cubic convolution (a = -1/2) weights of the taps at -1, 0, 1, 2 for
+ * a sample at phase f in [0, 1). */
+static void keys4(double f, float w[4])
+{
+    double t = 1 + f;
+    w[0] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
+    w[1] = (float)((1.5 * f - 2.5) * f * f + 1);
+    t = 1 - f;
+    w[2] = (float)((1.5 * t - 2.5) * t * t + 1);
+    t = 2 - f;
+    w[3] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
+}
+
+/* o[i] = sum of the 4 rows weighted by v (n floats): the vertical pass of
+ * the separable cubic lookup. */
+LF_HOT_LOOP static void vcomb(float *restrict o, const float *restrict r0, const float *restrict r1,
+                              const float *restrict r2, const float *restrict r3, float v0, float v1, float v2,
+                              float v3, int n)
+{
+    for (int i = 0; i < n; i++)
+        o[i] = v0 * r0[i] + v1 * r1[i] + v2 * r2[i] + v3 * r3[i];
+}
+
+/* view_row with the horizontal pass of the cubic lookup: t[3 x + ch] is the
+ * vertically combined row at column x + ix - 1. */
+LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float *restrict t, const float *restrict c,
+                                       float h0, float h1, float h2, float h3, float scale, float tau, int xa, int xb)
+{
+    float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
+                    *restrict n = acc + 4 * ns;
+    for (int x = xa; x <= xb; x++) {
+        int k = 3 * x;
+        float e0 = (h0 * t[k] + h1 * t[k + 3] + h2 * t[k + 6] + h3 * t[k + 9] - c[k]) * scale;
+        float e1 = (h0 * t[k + 1] + h1 * t[k + 4] + h2 * t[k + 7] + h3 * t[k + 10] - c[k + 1]) * scale;
+        float e2 = (h0 * t[k + 2] + h1 * t[k + 5] + h2 * t[k + 8] + h3 * t[k + 11] - c[k + 2]) * scale;
+        float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
+        sad[x] += ad < tau ? ad : tau;
+        s0[x] += e0, s1[x] += e1, s2[x] += e2;
+        n[x] += 1.f;
     }
 }
 
@@ -198,6 +242,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     size_t np = (size_t)ns * nt;
     float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
     float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
+    float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
         const float *cref = c->ref + (size_t)y * ns * 3;
@@ -213,6 +258,25 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                 int r0 = y + iy, r1 = fy > 0.f ? r0 + 1 : r0;
                 if (r0 < 0 || r1 > nt - 1)
                     continue;
+                if (c->cubic && !v->valid) {
+                    /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
+                    int xa = 1 - ix > 0 ? 1 - ix : 0, xb = ns - 3 - ix < ns - 1 ? ns - 3 - ix : ns - 1;
+                    if (xa > xb)
+                        continue;
+                    float wy[4], wx[4];
+                    keys4(sy - iy, wy);
+                    keys4(sx - ix, wx);
+                    const float *rr[4];
+                    for (int m = 0; m < 4; m++)
+                        rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
+                    size_t c0 = 3 * (size_t)(xa + ix - 1);
+                    int n = 3 * (xb - xa + 4);
+                    vcomb(vt + 3 * (size_t)xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, wy[0], wy[1], wy[2],
+                          wy[3], n);
+                    view_row_cubic(acc + (size_t)v->group * NFIELDS * ns, ns, vt, cref, wx[0], wx[1], wx[2], wx[3],
+                                   c->scale, c->tau, xa, xb);
+                    continue;
+                }
                 int xa = ix < 0 ? -ix : 0;
                 int xb = ns - 1 - (fx > 0.f ? ix + 1 : ix);
                 if (xb > ns - 1)
@@ -413,6 +477,118 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
         }
 }
 
+/* ---------- continuous refinement (Gauss-Newton on photo-consistency) ---------- */
+
+/* Derivatives of the Keys weights (keys4) with respect to the sample position. */
+static void keys4d(double f, float w[4])
+{
+    double t = 1 + f;
+    w[0] = (float)(-1.5 * t * t + 5 * t - 4);
+    w[1] = (float)(4.5 * f * f - 5 * f);
+    t = 1 - f;
+    w[2] = (float)(-(4.5 * t * t - 5 * t));
+    t = 2 - f;
+    w[3] = (float)(-(-1.5 * t * t + 5 * t - 4));
+}
+
+typedef struct gn_ctx {
+    int w, h;
+    const dview *v;
+    const float *img;  /* the view's data, RGB */
+    const float *ref, *disp; /* reference view; disparity */
+    float *A, *B;      /* per pixel: sums of rho J^2 and rho J r over the views */
+    float scale, c2;
+} gn_ctx;
+
+/* Per pixel, at its own disparity d: the residual r = I_k(x - d du + ox, ...) - I_ref
+ * of one view (cubic lookup) and its derivative J with respect to d, with a
+ * Cauchy weight rho = 1 / (1 + |r|^2 / c^2) that lets a view seeing an
+ * occluder drop out; added to A and B. */
+static void gn_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    gn_ctx *c = vctx;
+    const dview *v = c->v;
+    int w = c->w, h = c->h;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            double d = c->disp[i];
+            const float *p = c->ref + 3 * i;
+            double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
+            int ix = (int)floor(sx), iy = (int)floor(sy);
+            if (ix < 1 || iy < 1 || ix > w - 3 || iy > h - 3)
+                continue;
+            float wx[4], wy[4], gx[4], gy[4];
+            keys4(sx - ix, wx), keys4(sy - iy, wy), keys4d(sx - ix, gx), keys4d(sy - iy, gy);
+            float val[3] = {0, 0, 0}, dx[3] = {0, 0, 0}, dy[3] = {0, 0, 0};
+            for (int m = 0; m < 4; m++) {
+                const float *row = c->img + ((size_t)(iy - 1 + m) * w + ix - 1) * 3;
+                float hv[3] = {0, 0, 0}, hg[3] = {0, 0, 0};
+                for (int n = 0; n < 4; n++)
+                    for (int ch = 0; ch < 3; ch++)
+                        hv[ch] += wx[n] * row[3 * n + ch], hg[ch] += gx[n] * row[3 * n + ch];
+                for (int ch = 0; ch < 3; ch++)
+                    val[ch] += wy[m] * hv[ch], dx[ch] += wy[m] * hg[ch], dy[ch] += gy[m] * hv[ch];
+            }
+            double rr = 0, jj = 0, jr = 0;
+            for (int ch = 0; ch < 3; ch++) {
+                double r = (val[ch] - p[ch]) * c->scale, j = -(v->du * dx[ch] + v->dv * dy[ch]) * c->scale;
+                rr += r * r, jj += j * j, jr += j * r;
+            }
+            double rho = 1.0 / (1.0 + rr / c->c2);
+            c->A[i] += (float)(rho * jj), c->B[i] += (float)(rho * jr);
+        }
+}
+
+typedef struct gnagg_ctx {
+    int w, h, r;
+    const float *A, *B, *disp, *refs;
+    float *out;
+    float dmax, sigma2;
+} gnagg_ctx;
+
+/* d = sum_q w_q (A_q d_q - b_q) / sum_q w_q A_q over the window: the
+ * linearised costs of the neighbours on the same surface (disparity within
+ * dmax, colour weight as the median's) added up; the step is at most dmax. */
+static void gnagg_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    gnagg_ctx *c = vctx;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < c->w; x++) {
+            size_t i = (size_t)y * c->w + x;
+            float d = c->disp[i];
+            const float *p = c->refs + 3 * i;
+            double sa = 0, sb = 0;
+            for (int yy = y - c->r; yy <= y + c->r; yy++) {
+                if (yy < 0 || yy >= c->h)
+                    continue;
+                for (int xx = x - c->r; xx <= x + c->r; xx++) {
+                    if (xx < 0 || xx >= c->w)
+                        continue;
+                    size_t j = (size_t)yy * c->w + xx;
+                    if (fabsf(c->disp[j] - d) > c->dmax) /* near a depth edge: views are partly occluded */
+                        goto keep;
+                    const float *q = c->refs + 3 * j;
+                    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
+                    float wt = expf(-(e0 * e0 + e1 * e1 + e2 * e2) / c->sigma2);
+                    sa += wt * c->A[j], sb += wt * c->B[j];
+                }
+            }
+            float nd;
+            nd = d;
+            if (sa > 1e-9) {
+                double t = sb / sa;
+                nd = (float)(t < d - c->dmax ? d - c->dmax : (t > d + c->dmax ? d + c->dmax : t));
+            }
+            c->out[i] = nd;
+            continue;
+        keep:
+            c->out[i] = d;
+        }
+}
+
 /* ---------- weighted median (guided by the reference colour) ---------- */
 
 typedef struct wm_ctx {
@@ -494,7 +670,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     const float *ref = lf_lf_view(lf, iu0, iv0);
     dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
     float *cost = malloc(sizeof(float) * np * (size_t)nl);
-    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 5) * ns;
+    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 8) * ns + 12;
     size_t gf_scratch = 10 * np;
     size_t per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch;
     float *scratch = malloc(sizeof(float) * per_thread * (size_t)threads);
@@ -530,7 +706,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 
     cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, cost, scratch, per_thread};
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, o->interp != 1, cost, scratch, per_thread};
     if (lf->valid)
         cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
     lf_parallel_for(nt, threads, 4, cost_rows, &cc);
@@ -604,6 +780,31 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         lf_parallel_for(nt, threads, 4, wm_rows, &wm);
     } else {
         memcpy(disparity->data, disp, sizeof(float) * np);
+    }
+    if (o->refine >= 0) {
+        /* continuous sub-label refinement: Gauss-Newton steps on the views'
+         * photo-consistency around the labelled disparity (docs/depth.md) */
+        int iters = o->refine > 0 ? o->refine : 1;
+        float *A = cost, *B = cost + np, *tmpd = cost + 2 * np; /* the cost volume is no longer needed */
+        for (size_t i = 0; i < np; i++)
+            for (int ch = 0; ch < 3; ch++) {
+                float v = ref[3 * i + ch] * scale;
+                refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
+            }
+        for (int it = 0; it < iters; it++) {
+            memset(A, 0, sizeof(float) * 2 * np);
+            for (int k = 0; k < nv; k++) {
+                if (views[k].valid)
+                    continue;
+                gn_ctx gc2 = {ns, nt, &views[k], views[k].data, ref, disparity->data, A, B, scale, 0.003f * 0.003f};
+                lf_parallel_for(nt, threads, 8, gn_rows, &gc2);
+            }
+            for (size_t i = 0; i < np; i++)
+                B[i] = A[i] * disparity->data[i] - B[i];
+            gnagg_ctx ga = {ns, nt, 2, A, B, disparity->data, refs, tmpd, (float)(2 * step), 0.02f};
+            lf_parallel_for(nt, threads, 4, gnagg_rows, &ga);
+            memcpy(disparity->data, tmpd, sizeof(float) * np);
+        }
     }
     if (confidence) {
         if (lf_image_alloc(confidence, ns, nt, 1, err)) {
@@ -704,6 +905,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
+    o.refine = -1, o.interp = 1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
     double s0 = -lim / f, s1 = lim / f;

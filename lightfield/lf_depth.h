@@ -9,7 +9,8 @@
  * division: the centre view of an odd grid) in pixels per view step, as in
  * lf_lightfield.h: I_ref(x, y) = I_(iu,iv)(x - d (iu - iu_ref),
  * y - d r (iv - iv_ref)), r = lf->disp_v_per_u.  The method (docs/depth.md):
- *   1. cost volume over disparity labels: per view a truncated absolute
+ *   1. cost volume over disparity labels (views looked up by Keys cubic
+ *      convolution): per view a truncated absolute
  *      colour difference to the reference pixel (correspondence) and the
  *      difference between the views' mean and the reference pixel
  *      (defocus cue); for occlusions the cost of a label is the smallest over
@@ -20,7 +21,10 @@
  *   3. winner-take-all, sub-label refinement by a parabola through the
  *      cost minimum and its neighbours;
  *   4. confidence from the aggregated cost curve, and a confidence- and
- *      colour-weighted median filter guided by the reference view.
+ *      colour-weighted median filter guided by the reference view;
+ *   5. a Gauss-Newton step on the views' photo-consistency (robust weights,
+ *      same-surface window) refines the disparity continuously, away from
+ *      depth edges.
  * No learned parts.  Runs on o.threads threads (bands of rows, cost slices). */
 #ifndef LF_DEPTH_H
 #define LF_DEPTH_H
@@ -39,6 +43,8 @@ typedef struct lf_lf_depth_opts {
     int occlusion;       /* 0: full aperture only; 1 (default): best of 8 half apertures too */
     double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
+    int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */
+    int interp;          /* views' sub-pixel lookup in the cost volume: 0 (default) Keys cubic, 1 bilinear */
     int threads;         /* <= 0: 2 */
 } lf_lf_depth_opts;
 lf_lf_depth_opts lf_lf_depth_defaults(void);

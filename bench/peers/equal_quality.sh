@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Equal-quality comparison, lensfield vs Blender Cycles (and pbrt-v4 when PBRT
 # names a binary): for each case every renderer renders its OWN converged
-# reference (REF_SPP samples, seed 1000), then a ladder of spp (seed 1)
-# timed, interleaved (lensfield, Cycles, pbrt-v4 at each rung, RUNS times;
-# median time); the error of each rung is the RMSE against that renderer's
-# reference divided by the reference's mean (so the renderers' different
-# units and exposures compare).  bench/peers/eq_report.py fits e^2 = a/spp
+# reference (REF_SPP samples, seed 1000), then a ladder of spp timed,
+# interleaved (lensfield, Cycles, pbrt-v4 at each rung, RUNS times, run i
+# with seed i; median time); the error of each rung is the RMSE against
+# that renderer's reference, over the RUNS seeds (root mean square), divided
+# by the reference's mean (so the renderers' different units and exposures
+# compare).  Several seeds matter where a few pixels carry the error (the
+# sky case's small bright emitter: its antialiased edge pixels).  bench/peers/eq_report.py fits e^2 = a/spp
 # and t = t0 + b spp and reports the time each renderer needs to reach a
 # common relative RMSE (TARGET), its efficiency 1/(RMSE^2 t) and the ratios.
 # The scenes are scenes/bench/plane-spheres[-CASE].pbrt, sky.pbrt and
@@ -46,7 +48,7 @@ tsv=$out/measurements.tsv
 : > "$tsv"
 machine_line
 peers_pbrt_note
-echo "equal quality: ${w}x${h}, references $ref_spp spp (seed 1000), ladder ${ladder[*]} spp (seed 1), $runs interleaved timing runs, $THREADS threads"
+echo "equal quality: ${w}x${h}, references $ref_spp spp (seed 1000), ladder ${ladder[*]} spp (seeds 1..$runs), $runs interleaved timing runs, $THREADS threads"
 
 # Mean of R, G, B over the image.
 img_mean() { oiiotool "$1" --ch R,G,B --printstats | sed -nE 's/.*Stats Avg: ([^(]*).*/\1/p' | awk '{printf "%.9g", ($1 + $2 + $3) / 3}'; }
@@ -83,10 +85,10 @@ for c in "${cases[@]}"; do
         echo "$c: $r reference, $ref_spp spp, $t s" >&2
     done
     declare -A tms=()
-    for i in $(seq "$runs"); do
+    for i in $(seq "$runs"); do # run i renders with seed i: the error is over all runs' seeds
         for n in "${ladder[@]}"; do
             for r in "${rs[@]}"; do
-                tms[$r.$n]+="$(render "$r" "$c" "$scene" "$n" 1 "$out/$c-$r-$n.exr") "
+                tms[$r.$n]+="$(render "$r" "$c" "$scene" "$n" "$i" "$out/$c-$r-$n-s$i.exr") "
             done
         done
     done
@@ -95,7 +97,10 @@ for c in "${cases[@]}"; do
         mean=$(img_mean "$ref")
         for n in "${ladder[@]}"; do
             t=$(tr ' ' '\n' <<< "${tms[$r.$n]}" | grep . | median)
-            printf 'rung\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$c" "$r" "$n" "$t" "$(img_rms "$out/$c-$r-$n.exr" "$ref")" "$mean" "$ref_spp" >> "$tsv"
+            # RMS over the seeds: the square root of the mean squared error
+            rms=$(for i in $(seq "$runs"); do img_rms "$out/$c-$r-$n-s$i.exr" "$ref"; echo; done |
+                awk 'NF { s += $1 * $1; k++ } END { printf "%.9g", sqrt(s / k) }')
+            printf 'rung\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$c" "$r" "$n" "$t" "$rms" "$mean" "$ref_spp" >> "$tsv"
         done
     done
     for r in "${rs[@]:1}"; do # the references side by side, each over its own mean
@@ -108,4 +113,4 @@ done
 echo
 python3 bench/peers/eq_report.py < "$tsv"
 echo
-echo "(relative RMSE = RMSE over pixels and R, G, B against the renderer's own $ref_spp-spp reference, over the reference's mean, corrected for the reference's noise by 1/sqrt(1 + spp/$ref_spp); times are each renderer's own render time, medians of $runs; images and measurements.tsv in $out)"
+echo "(relative RMSE = RMSE over pixels, R, G, B and the $runs seeds against the renderer's own $ref_spp-spp reference, over the reference's mean, corrected for the reference's noise by 1/sqrt(1 + spp/$ref_spp); times are each renderer's own render time, medians of $runs; images and measurements.tsv in $out)"

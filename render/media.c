@@ -247,14 +247,14 @@ static lf_vec3 vol_sample_direct(const lf_scene *s, lf_light_sampler lsm, const 
     if (lsm == LF_LIGHTS_ALL) {
         lf_vec3 L = lf_v3(0, 0, 0);
         for (int k = 0; k < s->n_nee_lights; k++) {
-            lf_sample_2d(st, &u0, &u1);
+            lf_light_pair(&s->lights[s->nee_lights[k]], st, &u0, &u1);
             L = lf_add(L, vol_light_direct(s, v, s->nee_lights[k], 1.0, u0, u1, tau, rays));
         }
         return L;
     }
-    lf_sample_2d(st, &u0, &u1);
     double pmf;
     int li = lf_pick_light(s, lsm, ul, &pmf);
+    lf_light_pair(&s->lights[li], st, &u0, &u1);
     if (!(pmf > 0))
         return lf_v3(0, 0, 0);
     return vol_light_direct(s, v, li, pmf, u0, u1, tau, rays);

@@ -371,6 +371,19 @@ static inline void lf_add_escaped_light(lf_vec3 *L, const lf_scene *s, lf_light_
     }
 }
 
+/* The sample pair of light l's position: point, spot and distant lights
+ * take none (their direction is fixed), so the pair is skipped without
+ * computing it; the dimensions consumed are the same either way. */
+static inline void lf_light_pair(const lf_light *l, lf_sample_stream *st, float *u0, float *u1)
+{
+    if (l->kind == LF_LIGHT_POINT || l->kind == LF_LIGHT_SPOT || l->kind == LF_LIGHT_DISTANT) {
+        lf_sample_skip(st);
+        *u0 = *u1 = 0.5f;
+    } else {
+        lf_sample_2d(st, u0, u1);
+    }
+}
+
 /* The light one-sample NEE uses at a vertex (strategies UNIFORM and POWER),
  * chosen with ul; *pmf its probability (0: none). */
 static inline int lf_pick_light(const lf_scene *s, lf_light_sampler lsm, float ul, double *pmf)

@@ -144,7 +144,7 @@ void lf_sample_start(lf_sample_stream *st, const lf_sampler *s, int px, int py, 
     lf_sample_start_pixel(st, s, lf_sample_pixel_hash(s, px, py), px, py, index);
 }
 
-static void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
+static inline __attribute__((always_inline)) void sample_pair(lf_sample_stream *st, uint32_t *a, uint32_t *b)
 {
     uint32_t pair = st->dim >> 1;
     st->dim += 2;

@@ -541,6 +541,14 @@ static void gn_rows(void *vctx, int y0, int y1, int tid)
         }
 }
 
+/* Edge-aware weight of a neighbour by its colour difference to the centre
+ * pixel (RGB in the working scale): exp(-|p - q|^2 / sigma2). */
+static inline float colour_affinity(const float *p, const float *q, float sigma2)
+{
+    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
+    return expf(-(e0 * e0 + e1 * e1 + e2 * e2) / sigma2);
+}
+
 typedef struct gnagg_ctx {
     int w, h, r;
     const float *A, *B, *disp, *refs;
@@ -570,9 +578,7 @@ static void gnagg_rows(void *vctx, int y0, int y1, int tid)
                     size_t j = (size_t)yy * c->w + xx;
                     if (fabsf(c->disp[j] - d) > c->dmax) /* near a depth edge: views are partly occluded */
                         goto keep;
-                    const float *q = c->refs + 3 * j;
-                    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
-                    float wt = expf(-(e0 * e0 + e1 * e1 + e2 * e2) / c->sigma2);
+                    float wt = colour_affinity(p, c->refs + 3 * j, c->sigma2);
                     sa += wt * c->A[j], sb += wt * c->B[j];
                 }
             }
@@ -622,9 +628,7 @@ static void wm_rows(void *vctx, int y0, int y1, int tid)
                     if (xx < 0 || xx >= c->w)
                         continue;
                     size_t j = (size_t)yy * c->w + xx;
-                    const float *q = c->ref + 3 * j;
-                    float e0 = p[0] - q[0], e1 = p[1] - q[1], e2 = p[2] - q[2];
-                    float wt = expf(-(e0 * e0 + e1 * e1 + e2 * e2) / c->sigma2) * (c->conf[j] + 1e-3f);
+                    float wt = colour_affinity(p, c->ref + 3 * j, c->sigma2) * (c->conf[j] + 1e-3f);
                     buf[n].d = c->disp[j], buf[n].w = wt;
                     wsum += wt, n++;
                 }

@@ -27,14 +27,19 @@
 #include "bench/bench_util.h"
 
 /* The views through the library's folder reader (lightfield/folder.c):
- * HCI layout, parameters.cfg, every view. */
+ * HCI layout, parameters.cfg, every view; then equalised as lf_lf_open
+ * does (LFD_NOEQ=1: not). */
 static int load_hci_views(const char *dir, lf_lightfield *lf)
 {
     lf_lf_folder f;
     lf_lf_layout flags;
     lf_error err = {0};
     lf_lf_layout_init(&flags);
-    int rc = lf_lf_folder_scan(dir, &f, &err) || lf_lf_folder_load(&f, &flags, lf, &err);
+    int rc = lf_lf_folder_scan(dir, &f, &err) || lf_lf_folder_load(&f, &flags, lf, &err) ||
+             (!getenv("LFD_NOEQ") && lf_lf_equalize(lf, &err));
+    if (!rc && (lf->views_rescaled || lf->views_dark))
+        printf("equalised: %d views rescaled (gains %.3f .. %.3f), %d dark views left out, %zu samples missing\n",
+               lf->views_rescaled, lf->gain_lo, lf->gain_hi, lf->views_dark, lf->missing);
     if (rc)
         fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
     lf_lf_folder_free(&f);
@@ -279,6 +284,15 @@ int main(int argc, char **argv)
             return 1;
         }
         sub.disp_v_per_u = 1.0;
+        if (!getenv("LFD_NOGAINW") && lf.view_gain && (sub.view_gain = malloc(sizeof(float) * n5 * n5)))
+            for (int j = 0; j < n5; j++)
+                for (int i = 0; i < n5; i++)
+                    sub.view_gain[j * n5 + i] = lf.view_gain[2 * j * lf.nu + 2 * i];
+        if (lf.valid && (sub.valid = malloc(sizeof(float) * n5 * n5 * (size_t)lf.ns * lf.nt)))
+            for (int j = 0; j < n5; j++)
+                for (int i = 0; i < n5; i++)
+                    memcpy(sub.valid + ((size_t)j * n5 + i) * lf.ns * lf.nt,
+                           lf.valid + ((size_t)2 * j * lf.nu + 2 * i) * lf.ns * lf.nt, sizeof(float) * lf.ns * lf.nt);
         for (int j = 0; j < n5; j++)
             for (int i = 0; i < n5; i++)
                 memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);

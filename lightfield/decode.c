@@ -33,6 +33,7 @@ void lf_lf_free(lf_lightfield *lf)
     free(lf->valid);
     free(lf->half);
     free(lf->view_shift);
+    free(lf->view_gain);
     memset(lf, 0, sizeof *lf);
 }
 

@@ -885,6 +885,23 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
             for (int i = 0; i < 4; i++)
                 small.view_shift[4 * k + i] = lf->view_shift[4 * k + i] / (i >= 2 ? f : 1);
     }
+    size_t snp = (size_t)small.ns * small.nt;
+    if (lf->valid) { /* a small sample is valid when all its f x f samples are */
+        if (!(small.valid = malloc(sizeof(float) * snp * (size_t)lf->nu * lf->nv))) {
+            lf_lf_free(&small);
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        }
+        for (int k = 0; k < lf->nu * lf->nv; k++)
+            for (int y = 0; y < small.nt; y++)
+                for (int x = 0; x < small.ns; x++) {
+                    float ok = 1.f;
+                    for (int j = 0; j < f; j++)
+                        for (int i = 0; i < f; i++)
+                            if (lf->valid[(size_t)k * lf->ns * lf->nt + (size_t)(y * f + j) * lf->ns + x * f + i] == 0.f)
+                                ok = 0.f;
+                    small.valid[(size_t)k * snp + (size_t)y * small.ns + x] = ok;
+                }
+    }
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
             const float *src = lf_lf_view(lf, iu, iv);

@@ -105,6 +105,10 @@ typedef struct lf_lightfield {
     float *valid; /* NULL when every sample is valid, else ns*nt per view, 1 or 0 */
     size_t missing;   /* samples marked invalid */
     size_t nonfinite; /* raw values that were NaN/Inf (their samples are invalid) */
+    int views_rescaled, views_dark; /* lf_lf_equalize: views divided by their gain field, dark views left out */
+    float gain_lo, gain_hi;         /* the rescaled views' brightness gains against the centre view */
+    float *view_gain; /* NULL: every view as bright as the centre; else per view its mean gain before
+                       * lf_lf_equalize divided it out (its noise grew by 1 / gain: view synthesis weighs it by gain^2) */
     /* geometry for parameter conversions (0 when unknown) */
     double disp_v_per_u;    /* d_v / d_u for one depth (camera arrays with unequal baselines) */
     double disp_per_inv_m;  /* d = disp_at_inf + disp_per_inv_m / Z */
@@ -121,6 +125,17 @@ static inline float *lf_lf_view(const lf_lightfield *lf, int iu, int iv)
 }
 
 int lf_lf_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err);
+
+/* Photometric equalisation against the centre view (vignetted captures, e.g.
+ * decoded Lytro sets): each view's gain is fitted per channel as a smooth
+ * field, exp(quadratic in x, y), robustly to the log-ratios of cell means on
+ * a 16 x 16 grid of the centre view's cells, each compared with the view's
+ * window at the whole-pixel parallax shift that makes the ratios most alike;
+ * a view whose field departs from 1 by more than 2 % on average (or 8 % at a
+ * cell) is divided by it.  Cells under a tenth of the centre's brightness are marked
+ * missing (lf->valid), a view dark everywhere is missing whole.  Sets
+ * views_rescaled, views_dark, gain_lo/hi; adds to missing. */
+int lf_lf_equalize(lf_lightfield *lf, lf_error *err);
 void lf_lf_free(lf_lightfield *lf); /* accepts a zeroed struct */
 
 /* Decodes a raw image (any channel count: 1 is grey, RGB(A) used as RGB).

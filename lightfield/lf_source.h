@@ -34,6 +34,7 @@ typedef struct lf_lf_open_opts {
     const char *white;         /* raws: divide by this white image (NULL: none) */
     int allow_nonfinite;       /* NaN/Inf samples become missing instead of failing */
     int layout_only;           /* raws: resolve the layout, do not decode (nor check values) */
+    int no_equalize;           /* folders: keep the views' brightness as read (no lf_lf_equalize) */
 } lf_lf_open_opts;
 
 /* Reads a raw or a folder of views (every view is read, even with

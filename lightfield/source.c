@@ -46,6 +46,9 @@ static int open_folder(const lf_lf_open_opts *o, const lf_lf_layout *flags, lf_l
     src->layout = src->lf.layout;
     if (src->lf.nonfinite && !o->allow_nonfinite)
         return nonfinite_error(src, src->lf.nonfinite, err);
+    lf_error e = {0};
+    if (!o->no_equalize && lf_lf_equalize(&src->lf, &e))
+        return fail_named(src, &e, err);
     return LF_OK;
 }
 
@@ -95,6 +98,14 @@ void lf_lf_source_describe(const lf_lf_source *src, char *buf, size_t n)
                                   lf->disp_per_inv_m);
         if (k < n && f->gt_disparity)
             k += (size_t)snprintf(buf + k, n - k, "ground-truth disparity: %s\n", f->gt_disparity);
+        if (k < n && lf->views_rescaled)
+            k += (size_t)snprintf(buf + k, n - k,
+                                  "vignetting: %d views rescaled to the centre view's brightness (gains %.2f .. %.2f)\n",
+                                  lf->views_rescaled, lf->gain_lo, lf->gain_hi);
+        if (k < n && lf->views_dark)
+            k += (size_t)snprintf(buf + k, n - k, "dark views left out: %d\n", lf->views_dark);
+        if (k < n && lf->missing > lf->nonfinite)
+            k += (size_t)snprintf(buf + k, n - k, "missing samples: %zu\n", lf->missing);
         if (k < n && lf->nonfinite)
             snprintf(buf + k, n - k, "non-finite pixel values: %zu\n", lf->nonfinite);
         return;

@@ -558,7 +558,10 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
             double wu = 1 - fabs(iu - fu) / R, wvv = 1 - fabs(iv - fv) / R;
             if (wu <= 1e-9 || wvv <= 1e-9)
                 continue;
-            c.iu[c.nsrc] = iu, c.iv[c.nsrc] = iv, c.wv[c.nsrc] = wu * wvv;
+            /* a view lf_lf_equalize brightened carries noise grown by 1 / gain: inverse-variance weight */
+            double g = lf->view_gain ? lf->view_gain[(size_t)iv * lf->nu + iu] : 1.0;
+            g = g < 1 ? g : 1;
+            c.iu[c.nsrc] = iu, c.iv[c.nsrc] = iv, c.wv[c.nsrc] = wu * wvv * g * g;
             double sk[4];
             lf_lf_view_shift(lf, iu, iv, sk);
             c.du[c.nsrc] = sk[0] - st[0], c.dv[c.nsrc] = sk[1] - st[1];

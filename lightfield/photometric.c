@@ -1,0 +1,366 @@
+/* Photometric equalisation of a folder's views against the centre view
+ * (lf_lf_equalize, docs/lightfield-format.md "Vignetted views").
+ *
+ * Decoded plenoptic captures (Lytro sets written as one PNG per view) keep
+ * the main lens's vignetting: the views near the rim of the aperture are
+ * dimmer than the centre, and the corner views are dark or black.  A
+ * correspondence cost or a view blend that takes those values as they are
+ * sees every surface change colour from view to view.  Vignetting is smooth
+ * across the image, so each view's gain against the centre view is modelled
+ * per colour channel as exp(quadratic in x, y), fitted robustly to the
+ * log-ratios of the two views' means over a grid of cells: parallax moves
+ * content across a cell's boundary and makes some ratios wrong, which the
+ * robust weights (Cauchy, scale 0.05) leave out.  Cells where a view keeps
+ * less than a tenth of the centre's brightness are dark: their samples are
+ * marked missing, and a view with no usable cell is missing whole. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lf_lightfield.h"
+
+enum { CELLS = 16, NPAR = 6 };
+#define DARK_RATIO 0.1
+/* a field is applied when it departs from 1 by more than 2 % on average over
+ * the cells, or by more than 8 % at some cell: parallax and noise leave a fitted
+ * field near 1 (HCI backgammon, 80 views: at most 0.4 % on average, 3.4 % at
+ * the worst cell) */
+#define APPLY_MEAN 0.02
+#define APPLY_MAX 0.08
+
+static void basis(double x, double y, double b[NPAR])
+{
+    b[0] = 1, b[1] = x, b[2] = y, b[3] = x * x, b[4] = x * y, b[5] = y * y;
+}
+
+/* Solves the normal equations a (NPAR x NPAR, symmetric) p = r by Gaussian
+ * elimination with partial pivoting; 0 on success. */
+static int solve(double a[NPAR][NPAR], double r[NPAR], double p[NPAR])
+{
+    for (int c = 0; c < NPAR; c++) {
+        int piv = c;
+        for (int i = c + 1; i < NPAR; i++)
+            if (fabs(a[i][c]) > fabs(a[piv][c]))
+                piv = i;
+        if (!(fabs(a[piv][c]) > 1e-12))
+            return 1;
+        if (piv != c) {
+            for (int j = 0; j < NPAR; j++) {
+                double t = a[c][j];
+                a[c][j] = a[piv][j], a[piv][j] = t;
+            }
+            double t = r[c];
+            r[c] = r[piv], r[piv] = t;
+        }
+        for (int i = c + 1; i < NPAR; i++) {
+            double f = a[i][c] / a[c][c];
+            for (int j = c; j < NPAR; j++)
+                a[i][j] -= f * a[c][j];
+            r[i] -= f * r[c];
+        }
+    }
+    for (int i = NPAR - 1; i >= 0; i--) {
+        double s = r[i];
+        for (int j = i + 1; j < NPAR; j++)
+            s -= a[i][j] * p[j];
+        p[i] = s / a[i][i];
+    }
+    return 0;
+}
+
+/* Robust fit of log-ratio samples y at cell centres (x, yy) in [-1, 1]:
+ * least squares, then iteratively reweighted with Cauchy weights.  A small
+ * ridge on the non-constant terms keeps a fit over few cells bounded. */
+static int fit_field(const double *cx, const double *cy, const double *y, const int *use, int n, double p[NPAR])
+{
+    double *w = malloc(sizeof(double) * (size_t)n);
+    if (!w)
+        return 1;
+    for (int i = 0; i < n; i++)
+        w[i] = use[i] ? 1.0 : 0.0;
+    int rc = 0;
+    for (int it = 0; it < 8 && !rc; it++) {
+        double a[NPAR][NPAR] = {{0}}, r[NPAR] = {0}, b[NPAR], wsum = 0;
+        for (int i = 0; i < n; i++) {
+            if (w[i] <= 0)
+                continue;
+            basis(cx[i], cy[i], b);
+            for (int j = 0; j < NPAR; j++) {
+                r[j] += w[i] * b[j] * y[i];
+                for (int k = 0; k < NPAR; k++)
+                    a[j][k] += w[i] * b[j] * b[k];
+            }
+            wsum += w[i];
+        }
+        for (int j = 1; j < NPAR; j++)
+            a[j][j] += 1e-3 * wsum;
+        if ((rc = solve(a, r, p)))
+            break;
+        const double c = 0.05; /* Cauchy scale in log gain: 5 % */
+        for (int i = 0; i < n; i++) {
+            if (!use[i])
+                continue;
+            basis(cx[i], cy[i], b);
+            double e = y[i];
+            for (int j = 0; j < NPAR; j++)
+                e -= p[j] * b[j];
+            w[i] = 1.0 / (1.0 + (e / c) * (e / c));
+        }
+    }
+    free(w);
+    return rc;
+}
+
+
+/* Integral image (ns + 1) x (nt + 1) of value x valid per channel, and of the
+ * valid count (4 doubles per entry). */
+static void integral(const float *img, const float *valid, int ns, int nt, double *I)
+{
+    size_t w1 = (size_t)ns + 1;
+    memset(I, 0, sizeof(double) * 4 * w1);
+    for (int y = 0; y < nt; y++) {
+        double row[4] = {0, 0, 0, 0};
+        double *cur = I + (size_t)(y + 1) * w1 * 4;
+        const double *up = cur - w1 * 4;
+        cur[0] = cur[1] = cur[2] = cur[3] = 0;
+        for (int x = 0; x < ns; x++) {
+            size_t p = (size_t)y * ns + x;
+            if (!valid || valid[p] != 0.f)
+                row[0] += img[p * 3], row[1] += img[p * 3 + 1], row[2] += img[p * 3 + 2], row[3] += 1;
+            for (int c = 0; c < 4; c++)
+                cur[(x + 1) * 4 + c] = up[(x + 1) * 4 + c] + row[c];
+        }
+    }
+}
+
+static void box_sum(const double *I, int ns, int x0, int y0, int x1, int y1, double out[4])
+{
+    size_t w1 = (size_t)ns + 1;
+    for (int c = 0; c < 4; c++)
+        out[c] = I[((size_t)y1 * w1 + x1) * 4 + c] - I[((size_t)y0 * w1 + x1) * 4 + c] -
+                 I[((size_t)y1 * w1 + x0) * 4 + c] + I[((size_t)y0 * w1 + x0) * 4 + c];
+}
+
+/* Per cell of the centre view, its sums (cm) and those of the view's window
+ * moved by (sx, sy) (vm), both clipped to the image; (cx, cy) the view
+ * window's centre in [-1, 1]. */
+static void cell_sums(const double *ir, const double *iv, int ns, int nt, int nc, int sx, int sy, double *cm,
+                      double *vm, double *cx, double *cy)
+{
+    for (int j = 0; j < nc; j++)
+        for (int i = 0; i < nc; i++) {
+            size_t c = (size_t)j * nc + i;
+            int x0 = i * ns / nc, x1 = (i + 1) * ns / nc, y0 = j * nt / nc, y1 = (j + 1) * nt / nc;
+            x0 = x0 > -sx ? x0 : -sx, x1 = x1 < ns - sx ? x1 : ns - sx;
+            y0 = y0 > -sy ? y0 : -sy, y1 = y1 < nt - sy ? y1 : nt - sy;
+            if (x1 <= x0 || y1 <= y0) {
+                memset(cm + 4 * c, 0, 4 * sizeof(double)), memset(vm + 4 * c, 0, 4 * sizeof(double));
+                cx[c] = cy[c] = 0;
+                continue;
+            }
+            box_sum(ir, ns, x0, y0, x1, y1, cm + 4 * c);
+            box_sum(iv, ns, x0 + sx, y0 + sy, x1 + sx, y1 + sy, vm + 4 * c);
+            cx[c] = (x0 + x1 + 2.0 * sx) / ns - 1, cy[c] = (y0 + y1 + 2.0 * sy) / nt - 1;
+        }
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* How far the cells' log luminance ratios spread (median absolute deviation
+ * from their median): least where the shift undoes the parallax, whatever
+ * the gain.  HUGE_VAL when fewer than half the cells can say. */
+static double ratio_spread(const double *cm, const double *vm, size_t ncell, double *tmp)
+{
+    size_t n = 0;
+    for (size_t c = 0; c < ncell; c++) {
+        const double *a = cm + 4 * c, *b = vm + 4 * c;
+        double la = a[0] + a[1] + a[2], lb = b[0] + b[1] + b[2];
+        if (a[3] >= 16 && b[3] >= 16 && la > 1e-3 * a[3] && lb > 1e-6 * b[3])
+            tmp[n++] = log((lb / b[3]) / (la / a[3]));
+    }
+    if (n < ncell / 2 || n == 0)
+        return HUGE_VAL;
+    qsort(tmp, n, sizeof(double), cmpd);
+    double med = tmp[n / 2];
+    for (size_t i = 0; i < n; i++)
+        tmp[i] = fabs(tmp[i] - med);
+    qsort(tmp, n, sizeof(double), cmpd);
+    return tmp[n / 2];
+}
+
+int lf_lf_equalize(lf_lightfield *lf, lf_error *err)
+{
+    lf->views_rescaled = lf->views_dark = 0;
+    lf->gain_lo = lf->gain_hi = 1;
+    if (!lf->data || lf->nu * lf->nv < 2)
+        return LF_OK;
+    int ns = lf->ns, nt = lf->nt, nc = CELLS;
+    if (ns < 2 * nc || nt < 2 * nc)
+        nc = (ns < nt ? ns : nt) / 2;
+    if (nc < 2)
+        return LF_OK;
+    size_t np = (size_t)ns * nt, ncell = (size_t)nc * nc;
+    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double *means = malloc(sizeof(double) * 4 * ncell * 2);
+    double *cx = malloc(sizeof(double) * ncell * 4);
+    int *use = malloc(sizeof(int) * ncell);
+    double *ir = malloc(sizeof(double) * 4 * ((size_t)ns + 1) * ((size_t)nt + 1));
+    double *iv_ = malloc(sizeof(double) * 4 * ((size_t)ns + 1) * ((size_t)nt + 1));
+    if (!means || !cx || !use || !ir || !iv_) {
+        free(means), free(cx), free(use), free(ir), free(iv_);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
+    }
+    double *cy = cx + ncell, *ly = cy + ncell, *tmp = ly + ncell;
+    double *cm = means, *vm = means + 4 * ncell; /* per cell: r g b sums and the valid count */
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    const float *refv = lf->valid ? lf->valid + ((size_t)iv0 * lf->nu + iu0) * np : NULL;
+    integral(lf_lf_view(lf, iu0, iv0), refv, ns, nt, ir);
+    int rc = LF_OK;
+    for (int k = 0; k < lf->nu * lf->nv && !rc; k++) {
+        int iu = k % lf->nu, iv = k / lf->nu;
+        if (iu == iu0 && iv == iv0)
+            continue;
+        float *view = lf_lf_view(lf, iu, iv);
+        integral(view, lf->valid ? lf->valid + (size_t)k * np : NULL, ns, nt, iv_);
+        /* the parallax first: the whole-pixel shift of one disparity d,
+         * (-d du, -d dv), that makes the cells' brightness ratios most alike,
+         * d searched so the shift moves a pixel at a time, up to an eighth of
+         * the view */
+        double du = iu - iu0, dv = (iv - iv0) * rv, m = fmax(fabs(du), fabs(dv));
+        int K = (ns < nt ? ns : nt) / 8, bsx = 0, bsy = 0;
+        double best = HUGE_VAL;
+        for (int q = 0; q <= 2 * K; q++) {
+            int kk = (q + 1) / 2 * (q % 2 ? 1 : -1); /* 0, 1, -1, 2, -2, ...: ties keep the smaller shift */
+            double d = kk / m;
+            int sx = (int)lround(-d * du), sy = (int)lround(-d * dv);
+            cell_sums(ir, iv_, ns, nt, nc, sx, sy, cm, vm, cx, cy);
+            double sp = ratio_spread(cm, vm, ncell, tmp);
+            if (sp < best)
+                best = sp, bsx = sx, bsy = sy;
+        }
+        cell_sums(ir, iv_, ns, nt, nc, bsx, bsy, cm, vm, cx, cy);
+        /* dark cells: the view keeps under a tenth of the centre's brightness */
+        int dark[CELLS * CELLS], ndark = 0, nuse = 0, ncells = 0;
+        for (size_t c = 0; c < ncell; c++) {
+            double rl = cm[4 * c] + cm[4 * c + 1] + cm[4 * c + 2], vl = vm[4 * c] + vm[4 * c + 1] + vm[4 * c + 2];
+            dark[c] = cm[4 * c + 3] > 0 && rl > 0 && (vm[4 * c + 3] == 0 || vl / vm[4 * c + 3] < DARK_RATIO * rl / cm[4 * c + 3]);
+            ndark += dark[c];
+            ncells += cm[4 * c + 3] > 0;
+        }
+        /* a few dark cells are the scene (a bright thing in the centre view,
+         * a dark one where parallax puts the view's cell): they stay, and the
+         * robust fit leaves them out; vignetting darkens a quarter of the
+         * view or more */
+        if (ndark < ncells / 4)
+            ndark = 0, memset(dark, 0, sizeof dark);
+        double par[3][NPAR];
+        int fitted = 1;
+        for (int ch = 0; ch < 3 && fitted; ch++) {
+            nuse = 0;
+            for (size_t c = 0; c < ncell; c++) {
+                /* a ratio of cell means needs both means well above the data's noise floor */
+                use[c] = !dark[c] && cm[4 * c + 3] >= 16 && vm[4 * c + 3] >= 16 &&
+                         cm[4 * c + ch] > 1e-3 * cm[4 * c + 3] && vm[4 * c + ch] > 1e-3 * vm[4 * c + 3];
+                ly[c] = use[c] ? log((vm[4 * c + ch] / vm[4 * c + 3]) / (cm[4 * c + ch] / cm[4 * c + 3])) : 0;
+                nuse += use[c];
+            }
+            if (nuse < NPAR * 2 || fit_field(cx, cy, ly, use, (int)ncell, par[ch]))
+                fitted = 0;
+        }
+        if (!fitted && ndark == 0)
+            continue; /* too little texture to say anything: leave the view */
+        if (!fitted && ndark < ncells / 2)
+            continue;
+        /* the field's largest deviation from 1 over the cells that are not dark */
+        double dev = 0, devsum = 0, glo = INFINITY, ghi = 0, gsum = 0;
+        int ngain = 0;
+        if (fitted)
+            for (size_t c = 0; c < ncell; c++) {
+                if (dark[c])
+                    continue;
+                double b[NPAR], lum = 0;
+                basis(cx[c], cy[c], b);
+                for (int ch = 0; ch < 3; ch++) {
+                    double e = 0;
+                    for (int j = 0; j < NPAR; j++)
+                        e += par[ch][j] * b[j];
+                    double g = exp(e);
+                    dev = fmax(dev, fabs(g - 1)), devsum += fabs(g - 1) / 3;
+                    lum += g / 3;
+                }
+                glo = fmin(glo, lum), ghi = fmax(ghi, lum);
+                gsum += lum, ngain++;
+            }
+        int whole_dark = !fitted || ndark == ncells;
+        int rescale = ngain > 0 && (devsum / ngain > APPLY_MEAN || dev > APPLY_MAX);
+        if (!whole_dark && !rescale && ndark == 0)
+            continue;
+        if ((ndark || whole_dark) && !lf->valid) {
+            if (!(lf->valid = malloc(sizeof(float) * np * (size_t)lf->nu * lf->nv))) {
+                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
+                break;
+            }
+            for (size_t i = 0; i < np * (size_t)lf->nu * lf->nv; i++)
+                lf->valid[i] = 1.f;
+            refv = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
+        }
+        float *valid = lf->valid ? lf->valid + (size_t)k * np : NULL;
+        if (whole_dark) {
+            for (size_t p = 0; p < np; p++) {
+                if (valid[p] != 0.f)
+                    lf->missing++;
+                valid[p] = 0.f;
+                view[p * 3] = view[p * 3 + 1] = view[p * 3 + 2] = 0.f;
+            }
+            lf->views_dark++;
+            continue;
+        }
+        for (int y = 0; y < nt; y++) {
+            double yy = (y + 0.5) / nt * 2 - 1;
+            int yc = y - bsy < 0 ? 0 : (y - bsy >= nt ? nt - 1 : y - bsy), cj = yc * nc / nt;
+            for (int x = 0; x < ns; x++) {
+                size_t p = (size_t)y * ns + x;
+                int xc = x - bsx < 0 ? 0 : (x - bsx >= ns ? ns - 1 : x - bsx); /* the centre's cell it shows */
+                if (ndark && dark[(size_t)cj * nc + (size_t)(xc * nc / ns)]) {
+                    if (valid[p] != 0.f)
+                        lf->missing++;
+                    valid[p] = 0.f;
+                    view[p * 3] = view[p * 3 + 1] = view[p * 3 + 2] = 0.f;
+                    continue;
+                }
+                if (!rescale)
+                    continue;
+                double xx = (x + 0.5) / ns * 2 - 1, b[NPAR];
+                basis(xx, yy, b);
+                for (int ch = 0; ch < 3; ch++) {
+                    double e = 0;
+                    for (int j = 0; j < NPAR; j++)
+                        e += par[ch][j] * b[j];
+                    view[p * 3 + ch] = (float)(view[p * 3 + ch] / exp(e));
+                }
+            }
+        }
+        if (!rescale)
+            continue;
+        if (!lf->view_gain) {
+            if (!(lf->view_gain = malloc(sizeof(float) * (size_t)lf->nu * lf->nv))) {
+                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
+                break;
+            }
+            for (int i = 0; i < lf->nu * lf->nv; i++)
+                lf->view_gain[i] = 1.f;
+        }
+        lf->view_gain[k] = (float)(gsum / ngain);
+        if (lf->views_rescaled == 0)
+            lf->gain_lo = (float)glo, lf->gain_hi = (float)ghi;
+        else
+            lf->gain_lo = fminf(lf->gain_lo, (float)glo), lf->gain_hi = fmaxf(lf->gain_hi, (float)ghi);
+        lf->views_rescaled++;
+    }
+    free(means), free(cx), free(use), free(ir), free(iv_);
+    return rc;
+}

@@ -861,6 +861,12 @@ int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *di
         return rc;
     double m = widest_view(lf);
     double step = o->step > 0 ? o->step : 0.2 / m;
+    /* a wide range on a big grid (a gantry's 17 x 17 views, disparities of
+     * several px per view) at the default spacing would pass the label
+     * limit: the labels spread out instead (the refinement and the
+     * sub-label fit keep the precision) */
+    if (o->step <= 0 && (d1 - d0) / step + 1 > MAX_LABELS)
+        step = (d1 - d0) / (MAX_LABELS - 1);
     return depth_core(lf, o, d0, d1, step, disparity, confidence, err);
 }
 

@@ -215,6 +215,22 @@ int main(void)
         lf_image_free(&db);
     }
 
+    {
+        /* a range wider than 512 labels at the default spacing (0.2 px at the
+         * outermost view: 0.067 px/view here, so -18 .. 18 would be 541
+         * labels) spreads the labels instead of failing; the plane is still
+         * found (labels 0.07 px/view apart, refined within them) */
+        lf_lf_depth_opts ow = lf_lf_depth_defaults();
+        ow.d0 = -18, ow.d1 = 18;
+        lf_image dw;
+        CHECK_MSG(lf_lf_depth(&lf, &ow, &dw, NULL, &err) == 0, "%s", err.msg);
+        scores sw = score(dw.data, gt, NULL);
+        printf("  range -18 .. 18 px/view: BadPix0.07 %.2f %%, MSE x 100 %.4f\n", sw.bad07, sw.mse100);
+        CHECK(sw.bad07 < 2.0);
+        CHECK(sw.mse100 < 1.6);
+        lf_image_free(&dw);
+    }
+
     /* missing samples (lf->valid, as decode marks them; their data are 0): a
      * 40 x 40 block missing in 36 of the 48 other views must not disturb the
      * map there (the mask is honoured; the minimum over view subsets would

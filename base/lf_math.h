@@ -188,6 +188,46 @@ static inline void lf_sincos_quarter(double x, double *s, double *c)
  * Written with selects instead of branches (same points as pbrt's form:
  * for |a| > |b| the angle is pi/4 b/a; otherwise pi/2 - pi/4 a/b, whose cos
  * and sin are the sin and cos of pi/4 a/b). */
+/* Solves the n x n system A X = B in place by Gaussian elimination with
+ * partial pivoting; A row-major n x n, B row-major n x nrhs, X left in B.
+ * Returns 0 when a pivot falls below 1e-12 (singular or nearly), else 1. */
+static inline int lf_solve(double *A, double *B, int n, int nrhs)
+{
+    for (int i = 0; i < n; i++) {
+        int p = i;
+        for (int r = i + 1; r < n; r++)
+            if (fabs(A[r * n + i]) > fabs(A[p * n + i]))
+                p = r;
+        if (fabs(A[p * n + i]) < 1e-12)
+            return 0;
+        if (p != i) {
+            for (int k = 0; k < n; k++) {
+                double t = A[i * n + k];
+                A[i * n + k] = A[p * n + k], A[p * n + k] = t;
+            }
+            for (int k = 0; k < nrhs; k++) {
+                double t = B[i * nrhs + k];
+                B[i * nrhs + k] = B[p * nrhs + k], B[p * nrhs + k] = t;
+            }
+        }
+        for (int r = i + 1; r < n; r++) {
+            double f = A[r * n + i] / A[i * n + i];
+            for (int k = i; k < n; k++)
+                A[r * n + k] -= f * A[i * n + k];
+            for (int k = 0; k < nrhs; k++)
+                B[r * nrhs + k] -= f * B[i * nrhs + k];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--)
+        for (int k = 0; k < nrhs; k++) {
+            double t = B[i * nrhs + k];
+            for (int j = i + 1; j < n; j++)
+                t -= A[i * n + j] * B[j * nrhs + k];
+            B[i * nrhs + k] = t / A[i * n + i];
+        }
+    return 1;
+}
+
 static inline void lf_concentric_disk(double u, double v, double *x, double *y)
 {
     double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;

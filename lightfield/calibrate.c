@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_math.h"
 #include "fft_internal.h"
 #include "lf_lightfield.h"
 
@@ -21,21 +22,12 @@ static double lum(const lf_image *im, int x, int y)
     return isfinite(v) ? v : 0.0;
 }
 
-/* Solve the 3x3 system M x = r (Cramer); returns 0 when singular. */
+/* Solves the 3x3 system M x = r; returns 0 when singular. */
 static int solve3(const double M[9], const double r[3], double x[3])
 {
-    double det = M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
-                 M[2] * (M[3] * M[7] - M[4] * M[6]);
-    if (fabs(det) < 1e-12)
-        return 0;
-    for (int k = 0; k < 3; k++) {
-        double A[9];
-        memcpy(A, M, sizeof A);
-        A[k] = r[0], A[3 + k] = r[1], A[6 + k] = r[2];
-        x[k] = (A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-                A[2] * (A[3] * A[7] - A[4] * A[6])) / det;
-    }
-    return 1;
+    double A[9];
+    memcpy(A, M, sizeof A), memcpy(x, r, 3 * sizeof(double));
+    return lf_solve(A, x, 3, 1);
 }
 
 int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err)

@@ -582,8 +582,7 @@ static void gnagg_rows(void *vctx, int y0, int y1, int tid)
                     sa += wt * c->A[j], sb += wt * c->B[j];
                 }
             }
-            float nd;
-            nd = d;
+            float nd = d;
             if (sa > 1e-9) {
                 double t = sb / sa;
                 nd = (float)(t < d - c->dmax ? d - c->dmax : (t > d + c->dmax ? d + c->dmax : t));
@@ -609,7 +608,6 @@ typedef struct wm_ctx {
 typedef struct dw {
     float d, w;
 } dw;
-
 
 static void wm_rows(void *vctx, int y0, int y1, int tid)
 {

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_math.h"
 #include "lf_lightfield.h"
 
 enum { CELLS = 16, NPAR = 6 };
@@ -31,41 +32,6 @@ enum { CELLS = 16, NPAR = 6 };
 static void basis(double x, double y, double b[NPAR])
 {
     b[0] = 1, b[1] = x, b[2] = y, b[3] = x * x, b[4] = x * y, b[5] = y * y;
-}
-
-/* Solves the normal equations a (NPAR x NPAR, symmetric) p = r by Gaussian
- * elimination with partial pivoting; 0 on success. */
-static int solve(double a[NPAR][NPAR], double r[NPAR], double p[NPAR])
-{
-    for (int c = 0; c < NPAR; c++) {
-        int piv = c;
-        for (int i = c + 1; i < NPAR; i++)
-            if (fabs(a[i][c]) > fabs(a[piv][c]))
-                piv = i;
-        if (!(fabs(a[piv][c]) > 1e-12))
-            return 1;
-        if (piv != c) {
-            for (int j = 0; j < NPAR; j++) {
-                double t = a[c][j];
-                a[c][j] = a[piv][j], a[piv][j] = t;
-            }
-            double t = r[c];
-            r[c] = r[piv], r[piv] = t;
-        }
-        for (int i = c + 1; i < NPAR; i++) {
-            double f = a[i][c] / a[c][c];
-            for (int j = c; j < NPAR; j++)
-                a[i][j] -= f * a[c][j];
-            r[i] -= f * r[c];
-        }
-    }
-    for (int i = NPAR - 1; i >= 0; i--) {
-        double s = r[i];
-        for (int j = i + 1; j < NPAR; j++)
-            s -= a[i][j] * p[j];
-        p[i] = s / a[i][i];
-    }
-    return 0;
 }
 
 /* Robust fit of log-ratio samples y at cell centres (x, yy) in [-1, 1]:
@@ -94,8 +60,11 @@ static int fit_field(const double *cx, const double *cy, const double *y, const 
         }
         for (int j = 1; j < NPAR; j++)
             a[j][j] += 1e-3 * wsum;
-        if ((rc = solve(a, r, p)))
+        if (!lf_solve(&a[0][0], r, NPAR, 1)) {
+            rc = 1;
             break;
+        }
+        memcpy(p, r, sizeof r);
         const double c = 0.05; /* Cauchy scale in log gain: 5 % */
         for (int i = 0; i < n; i++) {
             if (!use[i])

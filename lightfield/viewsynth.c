@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/lf_math.h"
 #include "lf_depth.h"
 #include "../base/lf_parallel.h"
 
@@ -159,44 +160,9 @@ typedef struct vs_ctx {
     double sigma;  /* Gaussian kernel of the fit, px */
 } vs_ctx;
 
-/* Solve the n x n system A x = b in place (Gaussian elimination, partial
- * pivoting), 4 right-hand sides.  Returns 0 when (nearly) singular. */
-static int solve4(double *A, double (*b)[4], int n)
-{
-    for (int i = 0; i < n; i++) {
-        int p = i;
-        for (int r = i + 1; r < n; r++)
-            if (fabs(A[r * n + i]) > fabs(A[p * n + i]))
-                p = r;
-        if (fabs(A[p * n + i]) < 1e-12)
-            return 0;
-        if (p != i) {
-            for (int k = 0; k < n; k++) {
-                double t = A[i * n + k];
-                A[i * n + k] = A[p * n + k], A[p * n + k] = t;
-            }
-            for (int ch = 0; ch < 4; ch++) {
-                double t = b[i][ch];
-                b[i][ch] = b[p][ch], b[p][ch] = t;
-            }
-        }
-        for (int r = i + 1; r < n; r++) {
-            double f = A[r * n + i] / A[i * n + i];
-            for (int k = i; k < n; k++)
-                A[r * n + k] -= f * A[i * n + k];
-            for (int ch = 0; ch < 4; ch++)
-                b[r][ch] -= f * b[i][ch];
-        }
-    }
-    for (int i = n - 1; i >= 0; i--)
-        for (int ch = 0; ch < 4; ch++) {
-            double t = b[i][ch];
-            for (int k = i + 1; k < n; k++)
-                t -= A[i * n + k] * b[k][ch];
-            b[i][ch] = t / A[i * n + i];
-        }
-    return 1;
-}
+/* The visibility test: a source whose warped disparity at the looked-up
+ * spot is nearer than d by more than this sees an occluder there. */
+static inline float occluder_tol(float d) { return d + 0.25f + 0.05f * fabsf(d); }
 
 /* Scattered-data fit at kernel width sigma: every pixel of every visible
  * source lands, via d, at an offset from the target pixel centre; a
@@ -214,7 +180,7 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
     double is2 = 1.0 / (2 * sigma * sigma);
     double r2max = 9 * sigma * sigma;
     int rad = (int)ceil(3 * sigma);
-    float dtol = d + 0.25f + 0.05f * fabsf(d);
+    float dtol = occluder_tol(d);
     for (int k = 0; k < c->nsrc; k++) {
         double sx = x - d * c->du[k] + c->ox[k], sy = y - d * c->dv[k] + c->oy[k];
         if (sx < -0.5 || sy < -0.5 || sx > w - 0.5 || sy > h - 0.5)
@@ -270,7 +236,7 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
         A[a * nb + a] += 1e-4 * wsum;
     for (int a = 0; a < nb; a++)
         b[a][3] = a == 0;
-    if (!solve4(A, b, nb)) {
+    if (!lf_solve(A, &b[0][0], nb, 4)) {
         for (int ch = 0; ch < 3; ch++)
             rgb[ch] = (float)(rhs[0][ch] / wsum);
         *res = 0;
@@ -331,7 +297,7 @@ static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], flo
         float col[3];
         sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
         float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
-        double vis = dk > d + 0.25f + 0.05f * fabsf(d) ? 0.0 : 1.0;
+        double vis = dk > occluder_tol(d) ? 0.0 : 1.0;
         double inside = (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1) ? 0.1 : 1.0;
         double wk = c->wv[k] * inside;
         if (c->phase0 > 0) {
@@ -376,7 +342,7 @@ static int bg_at(const vs_ctx *c, double xf, double yf, float db, float rgb[3])
 {
     int w = c->lf->ns, h = c->lf->nt;
     double acc[3] = {0, 0, 0}, wsum = 0;
-    float tol = db + 0.25f + 0.05f * fabsf(db);
+    float tol = occluder_tol(db);
     for (int k = 0; k < c->nsrc; k++) {
         double sx = xf - db * c->du[k] + c->ox[k], sy = yf - db * c->dv[k] + c->oy[k];
         if (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1)
@@ -412,7 +378,7 @@ static int two_layer(const vs_ctx *c, int x, int y, float df, float db, const fl
 {
     int w = c->lf->ns, h = c->lf->nt;
     double W = 0, sI[3] = {0, 0, 0}, sB[3] = {0, 0, 0}, sBI = 0, sBB = 0;
-    float tol = df + 0.25f + 0.05f * fabsf(df);
+    float tol = occluder_tol(df);
     int n = 0;
     for (int k = 0; k < c->nsrc; k++) {
         double sx = x - df * c->du[k] + c->ox[k], sy = y - df * c->dv[k] + c->oy[k];

@@ -15,9 +15,8 @@ command -v valgrind > /dev/null || { echo "valgrind is not installed (apt-get in
 res=${RES:-160x106}
 w=${res%x*}; h=${res#*x}
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || cases=(pinhole thinlens motion rolling fisheye sky room)
-cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$BUILD" --target lfrender > /dev/null
+[ ${#cases[@]} -gt 0 ] || cases=("${CASES_DEFAULT[@]}")
+peers_build_targets lfrender
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 

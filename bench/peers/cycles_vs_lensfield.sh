@@ -23,7 +23,7 @@ runs=${1:-3}
 shift || true
 cases=("$@")
 if [ ${#cases[@]} -eq 0 ]; then
-    cases=(pinhole thinlens motion rolling fisheye sky room)
+    cases=("${CASES_DEFAULT[@]}")
     [ -z "${PBRT:-}" ] || cases+=(realistic)
 fi
 spp=${SPP:-64}

@@ -37,7 +37,7 @@ target=${TARGET:-0.02}
 out=${OUT:-out/peers-eq}
 cases=("$@")
 if [ ${#cases[@]} -eq 0 ]; then
-    cases=(pinhole thinlens motion rolling fisheye sky room)
+    cases=("${CASES_DEFAULT[@]}")
     [ -z "${PBRT:-}" ] || cases+=(realistic)
 fi
 top=${ladder[-1]}

@@ -21,7 +21,7 @@ ladder=${LADDER:-16 64}
 seeds=${SEEDS:-3}
 out=${OUT:-out/peers-eps}
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || cases=(pinhole thinlens motion rolling fisheye sky room)
+[ ${#cases[@]} -gt 0 ] || cases=("${CASES_DEFAULT[@]}")
 peers_build
 cmake --build "$BUILD" --target bench_variance > /dev/null
 BV=$BUILD/bin/bench_variance

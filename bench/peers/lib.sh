@@ -15,11 +15,18 @@ BUILD=${BUILD:-build}
 THREADS=${THREADS:-2}
 LFRENDER=$BUILD/bin/lfrender
 CASES_ALL=(pinhole thinlens motion rolling fisheye fisheye-lens sky room realistic)
+# the cases a script runs when none is named
+CASES_DEFAULT=(pinhole thinlens motion rolling fisheye sky room)
+
+# Configures the Release build and builds the named targets (default lfrender).
+peers_build_targets() {
+    cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+    cmake --build "$BUILD" --target "${@:-lfrender}" > /dev/null
+}
 
 peers_build() {
     command -v blender > /dev/null || { echo "blender is not installed (apt-get install blender)" >&2; exit 1; }
-    cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-    cmake --build "$BUILD" --target lfrender > /dev/null
+    peers_build_targets lfrender
     if [ -n "${PBRT:-}" ]; then
         command -v "$PBRT" > /dev/null || { echo "PBRT=$PBRT is not an executable" >&2; exit 1; }
     fi

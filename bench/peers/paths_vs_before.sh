@@ -12,9 +12,8 @@ cd "$(dirname "$0")/../.."
 runs=${RUNS:-3}
 spp=${SPP:-16}
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || cases=(pinhole thinlens motion rolling fisheye sky room)
-cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$BUILD" --target lfrender > /dev/null
+[ ${#cases[@]} -gt 0 ] || cases=("${CASES_DEFAULT[@]}")
+peers_build_targets lfrender
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 rate() { # BIN SCENE: M paths/s, or - when BIN cannot render it

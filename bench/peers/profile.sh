@@ -9,8 +9,7 @@ cd "$(dirname "$0")/../.."
 . bench/peers/lib.sh
 c=${1:-pinhole}
 spp=${2:-16}
-cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$BUILD" --target lfrender > /dev/null
+peers_build_targets lfrender
 command -v perf > /dev/null || { echo "perf is not installed (linux-perf); valgrind --tool=callgrind is the fallback" >&2; exit 1; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

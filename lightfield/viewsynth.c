@@ -43,10 +43,15 @@ lf_lf_view_opts lf_lf_view_defaults(void)
 
 static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
+/* The visibility test: a source whose warped disparity at the looked-up
+ * spot is nearer than d by more than this sees an occluder there. */
+static inline float occluder_tol(float d) { return d + 0.25f + 0.05f * fabsf(d); }
+
 /* Splat the reference disparity (and confidence, may be NULL) to a
- * viewpoint offset (du, dv) view steps from the reference (dv scaled). */
-static void splat(const float *disp, const float *conf, int w, int h, double du, double dv, double ox, double oy,
-                  float *out, float *out_conf)
+ * viewpoint offset (du, dv) view steps from the reference (dv scaled).
+ * Returns 0 when out of memory. */
+static int splat(const float *disp, const float *conf, int w, int h, double du, double dv, double ox, double oy,
+                 float *out, float *out_conf)
 {
     size_t np = (size_t)w * h;
     for (size_t i = 0; i < np; i++)
@@ -74,36 +79,78 @@ static void splat(const float *disp, const float *conf, int w, int h, double du,
                     }
                 }
         }
-    /* holes: farthest valid neighbour, grown until none is left */
-    for (int pass = 0; pass < w + h; pass++) {
-        int left = 0;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                size_t i = (size_t)y * w + x;
-                if (out[i] > -FLT_MAX)
-                    continue;
-                float best = FLT_MAX, bc = 0;
-                for (int k = 0; k < 4; k++) {
-                    int xx = x + (k == 0) - (k == 1), yy = y + (k == 2) - (k == 3);
-                    if (xx < 0 || xx >= w || yy < 0 || yy >= h)
-                        continue;
-                    float v = out[(size_t)yy * w + xx];
-                    if (v > -FLT_MAX && v < best)
-                        best = v, bc = out_conf ? out_conf[(size_t)yy * w + xx] : 0;
+    /* holes (disocclusions): the background is what appears there.  The
+     * nearest seen pixels left, right, above and below a hole pixel are its
+     * candidates; the farthest surface among them (within the occluder
+     * tolerance of the smallest disparity) is the background, and of its
+     * candidates the nearest gives the disparity, with its confidence
+     * halved per pixel of distance.  (Growing the hole from its rim lets
+     * the nearer side fill a thin strip, or the fill run along the scan.) */
+    int *last = malloc(sizeof(int) * (size_t)(w > h ? w : h) * 2);
+    float *bd = malloc(sizeof(float) * np * 3);
+    if (!last || !bd) {
+        free(last), free(bd);
+        return 0;
+    }
+    float *bc = bd + np, *bdist = bd + 2 * np;
+    float dfar = FLT_MAX;
+    for (size_t i = 0; i < np; i++) {
+        bd[i] = FLT_MAX, bc[i] = 0, bdist[i] = FLT_MAX;
+        if (out[i] > -FLT_MAX && out[i] < dfar)
+            dfar = out[i];
+    }
+    /* stage 0: the smallest candidate disparity; stage 1: the nearest
+     * candidate on that surface */
+    float *dmin = malloc(sizeof(float) * np);
+    if (!dmin) {
+        free(last), free(bd);
+        return 0;
+    }
+    for (size_t i = 0; i < np; i++)
+        dmin[i] = FLT_MAX;
+    for (int stage = 0; stage < 2; stage++)
+        for (int pass = 0; pass < 2; pass++) {
+            int n = pass ? w : h, len = pass ? h : w; /* rows, then columns */
+            for (int a = 0; a < n; a++) {
+                int *prv = last, *nxt = last + len;
+                for (int b = 0, lv = -1; b < len; b++) {
+                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
+                    lv = out[i] > -FLT_MAX ? b : lv;
+                    prv[b] = lv;
                 }
-                if (best < FLT_MAX) {
-                    /* marked as filled in this pass by storing after the scan would be cleaner;
-                     * filling in place only lets the fill run further along the scan */
-                    out[i] = best;
-                    if (out_conf)
-                        out_conf[i] = 0.5f * bc;
-                } else {
-                    left++;
+                for (int b = len - 1, nv = -1; b >= 0; b--) {
+                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
+                    nv = out[i] > -FLT_MAX ? b : nv;
+                    nxt[b] = nv;
+                }
+                for (int b = 0; b < len; b++) {
+                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
+                    if (out[i] > -FLT_MAX)
+                        continue;
+                    for (int e = 0; e < 2; e++) {
+                        int q = e ? nxt[b] : prv[b];
+                        if (q < 0)
+                            continue;
+                        size_t iq = pass ? (size_t)q * w + a : (size_t)a * w + q;
+                        float dq = out[iq], dist = (float)abs(q - b);
+                        if (stage == 0) {
+                            dmin[i] = dq < dmin[i] ? dq : dmin[i];
+                        } else if (dq <= occluder_tol(dmin[i]) && dist < bdist[i]) {
+                            bd[i] = dq, bdist[i] = dist;
+                            bc[i] = (out_conf ? out_conf[iq] : 0) * powf(0.5f, dist);
+                        }
+                    }
                 }
             }
-        if (!left)
-            break;
-    }
+        }
+    for (size_t i = 0; i < np; i++)
+        if (out[i] == -FLT_MAX) {
+            out[i] = bd[i] < FLT_MAX ? bd[i] : (dfar < FLT_MAX ? dfar : 0.f);
+            if (out_conf)
+                out_conf[i] = bc[i];
+        }
+    free(last), free(bd), free(dmin);
+    return 1;
 }
 
 /* Cubic convolution weights (Keys 1981, a = -0.5) for fraction t in [0, 1). */
@@ -160,9 +207,6 @@ typedef struct vs_ctx {
     double sigma;  /* Gaussian kernel of the fit, px */
 } vs_ctx;
 
-/* The visibility test: a source whose warped disparity at the looked-up
- * spot is nearer than d by more than this sees an occluder there. */
-static inline float occluder_tol(float d) { return d + 0.25f + 0.05f * fabsf(d); }
 
 /* Scattered-data fit at kernel width sigma: every pixel of every visible
  * source lands, via d, at an offset from the target pixel centre; a
@@ -541,12 +585,12 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     float *dt = buf, *ct = buf + np;
-    splat(D, C, w, h, st[0], st[1], st[2], st[3], dt, ct);
-    for (int k = 0; k < c.nsrc; k++) {
+    int ok = splat(D, C, w, h, st[0], st[1], st[2], st[3], dt, ct);
+    for (int k = 0; k < c.nsrc && ok; k++) {
         float *dk = buf + (2 + (size_t)k) * np;
         double sk[4];
         lf_lf_view_shift(lf, c.iu[k], c.iv[k], sk);
-        splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
+        ok = splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
         c.ds[k] = dk;
         float *dxk = buf + (2 + (size_t)c.nsrc + k) * np;
         for (int y = 0; y < h; y++)
@@ -560,6 +604,10 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
                 dxk[(size_t)y * w + x] = m;
             }
         c.dx[k] = dxk;
+    }
+    if (!ok) {
+        free(buf), lf_image_free(&disp), lf_image_free(&conf);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     c.dt = dt, c.ct = ct;
     c.cmin = o->min_confidence < 0 ? 0.05f : (float)o->min_confidence;

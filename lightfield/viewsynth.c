@@ -86,70 +86,47 @@ static int splat(const float *disp, const float *conf, int w, int h, double du, 
      * candidates the nearest gives the disparity, with its confidence
      * halved per pixel of distance.  (Growing the hole from its rim lets
      * the nearer side fill a thin strip, or the fill run along the scan.) */
-    int *last = malloc(sizeof(int) * (size_t)(w > h ? w : h) * 2);
-    float *bd = malloc(sizeof(float) * np * 3);
-    if (!last || !bd) {
-        free(last), free(bd);
+    int *cand = malloc(sizeof(int) * np * 4); /* nearest seen pixel left, right, above, below (-1: none) */
+    if (!cand)
         return 0;
-    }
-    float *bc = bd + np, *bdist = bd + 2 * np;
+    for (int y = 0; y < h; y++)
+        for (int x = 0, l = -1, r = -1; x < w; x++) {
+            size_t i = (size_t)y * w + x, ir = (size_t)y * w + (w - 1 - x);
+            l = out[i] > -FLT_MAX ? (int)i : l;
+            r = out[ir] > -FLT_MAX ? (int)ir : r;
+            cand[4 * i] = l, cand[4 * ir + 1] = r;
+        }
+    for (int x = 0; x < w; x++)
+        for (int y = 0, u = -1, d = -1; y < h; y++) {
+            size_t i = (size_t)y * w + x, id = (size_t)(h - 1 - y) * w + x;
+            u = out[i] > -FLT_MAX ? (int)i : u;
+            d = out[id] > -FLT_MAX ? (int)id : d;
+            cand[4 * i + 2] = u, cand[4 * id + 3] = d;
+        }
     float dfar = FLT_MAX;
+    for (size_t i = 0; i < np; i++)
+        dfar = out[i] > -FLT_MAX && out[i] < dfar ? out[i] : dfar;
     for (size_t i = 0; i < np; i++) {
-        bd[i] = FLT_MAX, bc[i] = 0, bdist[i] = FLT_MAX;
-        if (out[i] > -FLT_MAX && out[i] < dfar)
-            dfar = out[i];
-    }
-    /* stage 0: the smallest candidate disparity; stage 1: the nearest
-     * candidate on that surface */
-    float *dmin = malloc(sizeof(float) * np);
-    if (!dmin) {
-        free(last), free(bd);
-        return 0;
-    }
-    for (size_t i = 0; i < np; i++)
-        dmin[i] = FLT_MAX;
-    for (int stage = 0; stage < 2; stage++)
-        for (int pass = 0; pass < 2; pass++) {
-            int n = pass ? w : h, len = pass ? h : w; /* rows, then columns */
-            for (int a = 0; a < n; a++) {
-                int *prv = last, *nxt = last + len;
-                for (int b = 0, lv = -1; b < len; b++) {
-                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
-                    lv = out[i] > -FLT_MAX ? b : lv;
-                    prv[b] = lv;
-                }
-                for (int b = len - 1, nv = -1; b >= 0; b--) {
-                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
-                    nv = out[i] > -FLT_MAX ? b : nv;
-                    nxt[b] = nv;
-                }
-                for (int b = 0; b < len; b++) {
-                    size_t i = pass ? (size_t)b * w + a : (size_t)a * w + b;
-                    if (out[i] > -FLT_MAX)
-                        continue;
-                    for (int e = 0; e < 2; e++) {
-                        int q = e ? nxt[b] : prv[b];
-                        if (q < 0)
-                            continue;
-                        size_t iq = pass ? (size_t)q * w + a : (size_t)a * w + q;
-                        float dq = out[iq], dist = (float)abs(q - b);
-                        if (stage == 0) {
-                            dmin[i] = dq < dmin[i] ? dq : dmin[i];
-                        } else if (dq <= occluder_tol(dmin[i]) && dist < bdist[i]) {
-                            bd[i] = dq, bdist[i] = dist;
-                            bc[i] = (out_conf ? out_conf[iq] : 0) * powf(0.5f, dist);
-                        }
-                    }
-                }
-            }
+        if (out[i] > -FLT_MAX)
+            continue;
+        const int *q = cand + 4 * i;
+        float dmin = FLT_MAX, dist = FLT_MAX, best = dfar < FLT_MAX ? dfar : 0.f, bc = 0;
+        for (int e = 0; e < 4; e++)
+            if (q[e] >= 0 && out[q[e]] < dmin)
+                dmin = out[q[e]];
+        for (int e = 0; e < 4; e++) {
+            if (q[e] < 0 || out[q[e]] > occluder_tol(dmin))
+                continue;
+            /* the candidate shares the row (e < 2) or the column */
+            float de = (float)(e < 2 ? abs(q[e] - (int)i) : abs(q[e] - (int)i) / w);
+            if (de < dist)
+                dist = de, best = out[q[e]], bc = (out_conf ? out_conf[q[e]] : 0) * powf(0.5f, de);
         }
-    for (size_t i = 0; i < np; i++)
-        if (out[i] == -FLT_MAX) {
-            out[i] = bd[i] < FLT_MAX ? bd[i] : (dfar < FLT_MAX ? dfar : 0.f);
-            if (out_conf)
-                out_conf[i] = bc[i];
-        }
-    free(last), free(bd), free(dmin);
+        out[i] = best;
+        if (out_conf)
+            out_conf[i] = bc;
+    }
+    free(cand);
     return 1;
 }
 

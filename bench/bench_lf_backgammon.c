@@ -14,7 +14,13 @@
  * methods (82-slice focal-stack depth, plane blending at disparity 0).
  * --calibrate: also self-calibrate the view positions (lf_lf_calibrate_views)
  * from the depth and score the depth again; the views from the 5x5 views
- * calibrated the same way. */
+ * calibrated the same way.
+ * Diagnostics (environment): LFD_VERBOSE=1 per-view and per-disparity
+ * breakdowns; LFD_GTVIEW=1 the views from the ground-truth map; LFD_THIN=-1
+ * without the thin-structure step (LFD_THIN_RATIO its ratio); LFD_DUMP=DIR
+ * writes the 5x5 map (disp5.f32, conf5.f32: 512 x 512 floats) and each
+ * synthesised view (syn_R_C.f32: RGB floats, linear) for offline analysis;
+ * LFD_DISPIN=FILE.f32 replaces the 5x5 map by such a file. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -64,6 +70,27 @@ static void write_pfm(const char *path, const lf_image *img)
     lf_error err = {0};
     if (lf_image_write(path, img, NULL, NULL, &err))
         fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
+}
+
+/* Raw native floats, for the diagnostics (LFD_DUMP, LFD_DISPIN). */
+static void write_raw(const char *path, const float *v, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(v, sizeof(float), n, f) != n)
+        fprintf(stderr, "bench_lf_backgammon: cannot write %s\n", path);
+    if (f)
+        fclose(f);
+}
+
+static int read_raw(const char *path, float *v, size_t n)
+{
+    FILE *f = fopen(path, "rb");
+    size_t got = f ? fread(v, sizeof(float), n, f) : 0;
+    if (f)
+        fclose(f);
+    if (got != n)
+        fprintf(stderr, "bench_lf_backgammon: %s: expected %zu floats\n", path, n);
+    return got == n;
 }
 
 static void score(const char *name, const lf_image *d, const lf_image *gt, double secs)
@@ -211,6 +238,10 @@ int main(int argc, char **argv)
                 o.interp = atoi(getenv("LFD_INTERP"));
             if (getenv("LFD_REFINE"))
                 o.refine = atoi(getenv("LFD_REFINE"));
+            if (getenv("LFD_THIN"))
+                o.thin = atoi(getenv("LFD_THIN"));
+            if (getenv("LFD_THIN_RATIO"))
+                o.thin_ratio = atof(getenv("LFD_THIN_RATIO"));
             double s = lf_seconds(), sc = bench_cpu_seconds();
             if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
@@ -325,6 +356,10 @@ int main(int argc, char **argv)
                 o.interp = atoi(getenv("LFD_INTERP"));
             if (getenv("LFD_REFINE"))
                 o.refine = atoi(getenv("LFD_REFINE"));
+            if (getenv("LFD_THIN"))
+                o.thin = atoi(getenv("LFD_THIN"));
+            if (getenv("LFD_THIN_RATIO"))
+                o.thin_ratio = atof(getenv("LFD_THIN_RATIO"));
             double s = lf_seconds();
             if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
@@ -357,6 +392,15 @@ int main(int argc, char **argv)
                     return 1;
                 }
                 printf("5x5 views calibrated, depth again: %.2f s\n", lf_seconds() - s);
+            }
+            if (getenv("LFD_DISPIN") && !read_raw(getenv("LFD_DISPIN"), sd.data, (size_t)sd.width * sd.height))
+                return 1;
+            if (getenv("LFD_DUMP")) {
+                char pp[4096];
+                snprintf(pp, sizeof pp, "%s/disp5.f32", getenv("LFD_DUMP"));
+                write_raw(pp, sd.data, (size_t)sd.width * sd.height);
+                snprintf(pp, sizeof pp, "%s/conf5.f32", getenv("LFD_DUMP"));
+                write_raw(pp, sc.data, (size_t)sc.width * sc.height);
             }
             if (getenv("LFD_GTVIEW")) { /* diagnostic: ground-truth geometry */
                 char gtp[4096];
@@ -393,6 +437,11 @@ int main(int argc, char **argv)
                         return 1;
                     }
                     double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
+                    if (getenv("LFD_DUMP")) {
+                        char pp[4096];
+                        snprintf(pp, sizeof pp, "%s/syn_%d_%d.f32", getenv("LFD_DUMP"), r, c);
+                        write_raw(pp, out.data, (size_t)3 * out.width * out.height);
+                    }
                     if (getenv("LFD_VERBOSE")) {
                         /* split: pixels within 4 px of a disparity edge of the 5x5 map, and the rest */
                         double se[2] = {0, 0}, sb[2][12] = {{0}}, sdist[2][6] = {{0}};

@@ -8,8 +8,9 @@
  * loops are plain multiply-adds over contiguous floats (vectorised, AVX2
  * clone).  Then each cost slice is filtered (guided filter, threads take
  * slices), then per pixel the minimum, parabola refinement and confidence,
- * then the weighted median, then a Gauss-Newton refinement (views outer,
- * rows in parallel). */
+ * then the weighted median, then the thin-structure step (the unaggregated
+ * full-aperture winner, tracked while the volume is built, tested per
+ * pixel), then a Gauss-Newton refinement (views outer, rows in parallel). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -61,7 +62,8 @@ typedef struct cost_ctx {
     int occlusion;
     int cubic;           /* 1: views looked up by Keys cubic convolution, 0: bilinear */
     float *cost;         /* [label][pixel] */
-    float *scratch;      /* per thread: NGROUPS * NFIELDS * ns + 5 * ns floats */
+    float *rawd;         /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
+    float *scratch;      /* per thread: (NGROUPS * NFIELDS + 13) * ns + 12 floats */
     size_t scratch_per_thread;
 } cost_ctx;
 
@@ -234,6 +236,34 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
     }
 }
 
+/* The full aperture's correspondence cost of label l (every view's
+ * truncated difference, no defocus term) and the running winner
+ * over the labels: best cost, its label, the costs of the labels either
+ * side (for the parabola), the previous label's cost; r: 5 * ns, w: 2 * ns
+ * scratch. */
+LF_HOT_LOOP static void track_full(const float *restrict acc, float *restrict w, float *restrict r, int ns, int l)
+{
+    float *restrict w0 = w, *restrict w4 = w + ns;
+    float *restrict bc = r, *restrict bl = r + ns, *restrict pc = r + 2 * ns, *restrict nc = r + 3 * ns,
+                    *restrict lc = r + 4 * ns;
+    for (int x = 0; x < ns; x++)
+        w0[x] = acc[x], w4[x] = acc[4 * ns + x];
+    for (int g = 1; g < NGROUPS; g++) {
+        const float *a = acc + (size_t)g * NFIELDS * ns;
+        for (int x = 0; x < ns; x++)
+            w0[x] += a[x], w4[x] += a[4 * ns + x];
+    }
+    for (int x = 0; x < ns; x++) {
+        float c = w4[x] > 0.f ? w0[x] / w4[x] : FLT_MAX;
+        if (l == 0 || c < bc[x]) {
+            bc[x] = c, bl[x] = (float)l, pc[x] = l > 0 ? lc[x] : FLT_MAX, nc[x] = FLT_MAX;
+        } else if ((float)(l - 1) == bl[x]) {
+            nc[x] = c;
+        }
+        lc[x] = c;
+    }
+}
+
 static void cost_rows(void *vctx, int y0, int y1, int tid)
 {
     cost_ctx *c = vctx;
@@ -243,6 +273,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
     float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
     float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
+    float *rt = vt + 3 * (size_t)ns + 12; /* 5 * ns: the full aperture's winner (track_full) */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
         const float *cref = c->ref + (size_t)y * ns * 3;
@@ -300,7 +331,18 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                 }
             }
             combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion);
+            if (c->rawd)
+                track_full(acc, w, rt, ns, l);
         }
+        if (c->rawd)
+            for (int x = 0; x < ns; x++) {
+                double off = 0, cm = rt[2 * ns + x], cp = rt[3 * ns + x], cb = rt[x];
+                if (cm < FLT_MAX && cp < FLT_MAX && cm - 2 * cb + cp > 1e-12) {
+                    off = 0.5 * (cm - cp) / (cm - 2 * cb + cp);
+                    off = off < -0.5 ? -0.5 : (off > 0.5 ? 0.5 : off);
+                }
+                c->rawd[(size_t)y * ns + x] = (float)(c->d0 + c->step * (rt[ns + x] + off));
+            }
     }
 }
 
@@ -474,6 +516,155 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
             conf = conf * 4.f;
             c->conf[i] = conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
+        }
+}
+
+/* ---------- thin structures ---------- */
+
+/* Photo-consistency of pixel (x, y) at disparity d over the full aperture:
+ * the mean over the views of the squared difference to the reference of
+ * the square-root encoded colour (closer to perceptual steps than linear).
+ * A thin structure is the nearest surface, so every view sees it. */
+static float pixel_cost(const cost_ctx *c, const float *map, float map_max, int x, int y, double d)
+{
+    const lf_lightfield *lf = c->lf;
+    int ns = lf->ns, nt = lf->nt;
+    const float *p = c->ref + ((size_t)y * ns + x) * 3;
+    if (c->ref_valid && c->ref_valid[(size_t)y * ns + x] <= 0.5f)
+        return 0.f;
+    float rp[3];
+    for (int ch = 0; ch < 3; ch++)
+        rp[ch] = sqrtf(p[ch] * c->scale > 0 ? p[ch] * c->scale : 0.f);
+    double sum = 0;
+    int n = 0;
+    for (int k = 0; k < c->nviews; k++) {
+        const dview *v = &c->views[k];
+        double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
+        int ix = (int)floor(sx), iy = (int)floor(sy);
+        float fx = (float)(sx - ix), fy = (float)(sy - iy);
+        if (ix < 1 || iy < 1 || ix > ns - 3 || iy > nt - 3)
+            continue;
+        if (map) {
+            /* occluded in view k when a nearer pixel q = p + t (du, dv) of
+             * the map lands on the sample: d_q >= d + t within half a pixel */
+            double L = fabs(v->du) > fabs(v->dv) ? fabs(v->du) : fabs(v->dv);
+            int J = L > 0 ? (int)ceil((map_max - d) * L + 0.5) : 0, occ = 0;
+            for (int j = 1; j <= J && !occ; j++) {
+                double t = j / L;
+                int qx = (int)lrint(x + t * v->du), qy = (int)lrint(y + t * v->dv);
+                if (qx < 0 || qy < 0 || qx >= ns || qy >= nt)
+                    break;
+                float dq = map[(size_t)qy * ns + qx];
+                occ = dq >= d + t - 0.5 / L && dq > d + c->step * 2;
+            }
+            if (occ)
+                continue;
+        }
+        float val[3] = {0, 0, 0};
+        if (c->cubic && !v->valid) {
+            float wy[4], wx[4];
+            keys4(fy, wy);
+            keys4(fx, wx);
+            for (int m = 0; m < 4; m++) {
+                const float *row = v->data + ((size_t)(iy - 1 + m) * ns + ix - 1) * 3;
+                for (int q = 0; q < 4; q++)
+                    for (int ch = 0; ch < 3; ch++)
+                        val[ch] += wy[m] * wx[q] * row[3 * q + ch];
+            }
+        } else {
+            float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+            size_t i00 = (size_t)iy * ns + ix, i10 = i00 + ns;
+            if (v->valid && w00 * v->valid[i00] + w01 * v->valid[i00 + 1] + w10 * v->valid[i10] +
+                                    w11 * v->valid[i10 + 1] < 0.999f)
+                continue;
+            for (int ch = 0; ch < 3; ch++)
+                val[ch] = w00 * v->data[3 * i00 + ch] + w01 * v->data[3 * i00 + 3 + ch] + w10 * v->data[3 * i10 + ch] +
+                          w11 * v->data[3 * i10 + 3 + ch];
+        }
+        for (int ch = 0; ch < 3; ch++) {
+            float e = sqrtf(val[ch] * c->scale > 0 ? val[ch] * c->scale : 0.f) - rp[ch];
+            sum += e * e;
+        }
+        n++;
+    }
+    return n ? (float)(sum / n) : FLT_MAX;
+}
+
+typedef struct thin_ctx {
+    const cost_ctx *cc;
+    int w, h;
+    const float *disp;  /* after the median */
+    const float *rawd;  /* per-pixel winner of the unaggregated costs */
+    unsigned char *cand;
+    float *out;
+    float tol_d, tol_s, ratio, map_max;
+} thin_ctx;
+
+/* Candidates: the unaggregated winner is more than tol_d away from the
+ * aggregated disparity and its cost is below ratio times the cost there. */
+static void thin_cand_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    thin_ctx *t = vctx;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < t->w; x++) {
+            size_t i = (size_t)y * t->w + x;
+            t->cand[i] = 0;
+            if (t->rawd[i] - t->disp[i] <= t->tol_d) /* nearer: a thin structure occludes what is behind */
+                continue;
+            /* the structure: every view sees it; at the map's disparity: the views the map says see it */
+            float cr = pixel_cost(t->cc, NULL, 0, x, y, t->rawd[i]);
+            float cd = pixel_cost(t->cc, t->disp, t->map_max, x, y, t->disp[i]);
+            t->cand[i] = cr < t->ratio * cd;
+        }
+}
+
+/* A candidate is taken when a neighbour carries its disparity: another
+ * candidate, or a pixel of the map (the structure continues there). */
+static void thin_take_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    thin_ctx *t = vctx;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < t->w; x++) {
+            size_t i = (size_t)y * t->w + x;
+            float d = t->disp[i];
+            if (t->cand[i]) {
+                float r = t->rawd[i];
+                /* not an edge grown by a pixel: a mixed pixel on a surface's
+                 * outline against a plain background is as consistent with
+                 * the surface as with the background, so a candidate with
+                 * the surface on one side (x or y) needs the structure to go
+                 * on at the other side too */
+                int grown = 0;
+                for (int ax = 0; ax < 2 && !grown; ax++) {
+                    int own[2], surf[2];
+                    for (int sgn = 0; sgn < 2; sgn++) {
+                        int xx = x + (ax == 0 ? (sgn ? 1 : -1) : 0), yy = y + (ax == 1 ? (sgn ? 1 : -1) : 0);
+                        own[sgn] = surf[sgn] = 0;
+                        if (xx < 0 || yy < 0 || xx >= t->w || yy >= t->h)
+                            continue;
+                        size_t q = (size_t)yy * t->w + xx;
+                        surf[sgn] = fabsf(t->disp[q] - r) < t->tol_s;
+                        own[sgn] = surf[sgn] || (t->cand[q] && fabsf(t->rawd[q] - r) < t->tol_s);
+                    }
+                    grown = (surf[0] && !own[1]) || (surf[1] && !own[0]);
+                }
+                if (grown)
+                    r = d;
+                for (int j = -1; j <= 1 && d != r; j++)
+                    for (int k = -1; k <= 1; k++) {
+                        int xx = x + k, yy = y + j;
+                        if ((!j && !k) || xx < 0 || yy < 0 || xx >= t->w || yy >= t->h)
+                            continue;
+                        size_t q = (size_t)yy * t->w + xx;
+                        if ((t->cand[q] && fabsf(t->rawd[q] - r) < t->tol_s) || fabsf(t->disp[q] - r) < t->tol_s) {
+                            d = r;
+                            break;
+                        }
+                    }
+            }
+            t->out[i] = d;
         }
 }
 
@@ -672,12 +863,13 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     const float *ref = lf_lf_view(lf, iu0, iv0);
     dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
     float *cost = malloc(sizeof(float) * np * (size_t)nl);
-    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 8) * ns + 12;
+    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12;
     size_t gf_scratch = 10 * np;
     size_t per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch;
     float *scratch = malloc(sizeof(float) * per_thread * (size_t)threads);
     float *guide = malloc(sizeof(float) * np * 14), *disp = malloc(sizeof(float) * np * 2);
     float *refs = malloc(sizeof(float) * np * 3);
+    float *rawd = NULL; /* per pixel: the unaggregated winner and its confidence (thin structures) */
     int rc = LF_OK;
     if (!views || !cost || !scratch || !guide || !disp || !refs) {
         rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %d-label cost volume of %dx%d", nl, ns, nt);
@@ -707,8 +899,13 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     msum /= (double)np;
     float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 
+    if (o->thin >= 0 && !(rawd = malloc(sizeof(float) * np))) {
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        goto done;
+    }
     cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, o->interp != 1, cost, scratch, per_thread};
+                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, o->interp != 1, cost, rawd,
+                   scratch, per_thread};
     if (lf->valid)
         cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
     lf_parallel_for(nt, threads, 4, cost_rows, &cc);
@@ -783,6 +980,34 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
     } else {
         memcpy(disparity->data, disp, sizeof(float) * np);
     }
+    if (rawd) {
+        /* thin structures (a wire, a wedge's tip) a pixel or two wide lose
+         * to the window of the aggregation; where the pixel's own costs are
+         * decisive (ratio) and a neighbour carries the same disparity, they
+         * come back (docs/depth.md) */
+        double m = 0;
+        for (int k = 0; k < nv; k++) {
+            double a = fabs(views[k].du) > fabs(views[k].dv) ? fabs(views[k].du) : fabs(views[k].dv);
+            m = a > m ? a : m;
+        }
+        m = m > 0 ? m : 1;
+        unsigned char *cand = malloc(np);
+        if (!cand) {
+            rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+            lf_image_free(disparity);
+            goto done;
+        }
+        float *tout = cost; /* the cost volume is no longer needed */
+        thin_ctx tc = {&cc, ns, nt, disparity->data, rawd, cand, tout, (float)(0.6 / m), (float)(0.3 / m),
+                       o->thin_ratio > 0 ? (float)o->thin_ratio : 0.2f, -FLT_MAX};
+        for (size_t i = 0; i < np; i++)
+            tc.map_max = disparity->data[i] > tc.map_max ? disparity->data[i] : tc.map_max;
+        lf_parallel_for(nt, threads, 8, thin_cand_rows, &tc);
+        lf_parallel_for(nt, threads, 8, thin_take_rows, &tc);
+        for (size_t i = 0; i < np; i++)
+            disparity->data[i] = tout[i];
+        free(cand);
+    }
     if (o->refine >= 0) {
         /* continuous sub-label refinement: Gauss-Newton steps on the views'
          * photo-consistency around the labelled disparity (docs/depth.md) */
@@ -817,7 +1042,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         memcpy(confidence->data, conf, sizeof(float) * np);
     }
 done:
-    free(views), free(cost), free(scratch), free(guide), free(disp), free(refs);
+    free(views), free(cost), free(scratch), free(guide), free(disp), free(refs), free(rawd);
     return rc;
 }
 
@@ -930,7 +1155,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
-    o.refine = -1, o.interp = 1; /* the range needs no sub-label precision */
+    o.refine = -1, o.interp = 1, o.thin = -1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
     double s0 = -lim / f, s1 = lim / f;

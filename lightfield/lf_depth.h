@@ -22,6 +22,9 @@
  *      cost minimum and its neighbours;
  *   4. confidence from the aggregated cost curve, and a confidence- and
  *      colour-weighted median filter guided by the reference view;
+ *   4b. thin structures the aggregation erased (a wire, a wedge's tip: a
+ *      pixel or two wide) come back where the pixel's own cost curve is
+ *      decisive and a neighbour carries the same disparity;
  *   5. a Gauss-Newton step on the views' photo-consistency (robust weights,
  *      same-surface window) refines the disparity continuously, away from
  *      depth edges.
@@ -45,6 +48,9 @@ typedef struct lf_lf_depth_opts {
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
     int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */
     int interp;          /* views' sub-pixel lookup in the cost volume: 0 (default) Keys cubic, 1 bilinear */
+    int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
+    double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
+                          * the aggregated disparity; <= 0: 0.2 */
     int threads;         /* <= 0: 2 */
 } lf_lf_depth_opts;
 lf_lf_depth_opts lf_lf_depth_defaults(void);

@@ -846,6 +846,16 @@ static void wm_rows(void *vctx, int y0, int y1, int tid)
 
 /* ---------- driver ---------- */
 
+/* The largest view offset from the reference, in view steps (v scaled). */
+static double widest_view(const lf_lightfield *lf)
+{
+    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    double m = iu0 > lf->nu - 1 - iu0 ? iu0 : lf->nu - 1 - iu0;
+    double mv = (iv0 > lf->nv - 1 - iv0 ? iv0 : lf->nv - 1 - iv0) * rv;
+    return m > mv ? m : mv;
+}
+
 static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double d0, double d1, double step,
                       lf_image *disparity, lf_image *confidence, lf_error *err)
 {
@@ -985,11 +995,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
          * to the window of the aggregation; where the pixel's own costs are
          * decisive (ratio) and a neighbour carries the same disparity, they
          * come back (docs/depth.md) */
-        double m = 0;
-        for (int k = 0; k < nv; k++) {
-            double a = fabs(views[k].du) > fabs(views[k].dv) ? fabs(views[k].du) : fabs(views[k].dv);
-            m = a > m ? a : m;
-        }
+        double m = widest_view(lf);
         m = m > 0 ? m : 1;
         unsigned char *cand = malloc(np);
         if (!cand) {
@@ -1050,15 +1056,6 @@ static int cmpf(const void *a, const void *b)
 {
     float x = *(const float *)a, y = *(const float *)b;
     return (x > y) - (x < y);
-}
-
-static double widest_view(const lf_lightfield *lf)
-{
-    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
-    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
-    double m = iu0 > lf->nu - 1 - iu0 ? iu0 : lf->nu - 1 - iu0;
-    double mv = (iv0 > lf->nv - 1 - iv0 ? iv0 : lf->nv - 1 - iv0) * rv;
-    return m > mv ? m : mv;
 }
 
 static int check_lf(const lf_lightfield *lf, lf_error *err)

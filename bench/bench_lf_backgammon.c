@@ -4,7 +4,7 @@
  *   bench_lf_backgammon DIR [--threads N] [--runs N] [--depth-only | --views-only]
  *                       [--save-disp FILE.pfm] [--baseline] [--calibrate]
  *
- * Depth: lf_lf_depth on the 9x9 views with no range given (estimated from
+ * Depth: lf_lightfield_depth on the 9x9 views with no range given (estimated from
  * the data), median wall time of --runs (3) runs; scored as the benchmark
  * toolkit does against gt_disp_lowres.pfm: 15-px border excluded,
  * BadPix(t) = % of pixels with |d - gt| > t for t = 0.07, 0.03, 0.01 and
@@ -12,7 +12,7 @@
  * with both indices odd, synthesised with per-pixel geometry; mean PSNR in
  * 8-bit sRGB, 15-px border excluded.  --baseline also scores the previous
  * methods (82-slice focal-stack depth, plane blending at disparity 0).
- * --calibrate: also self-calibrate the view positions (lf_lf_calibrate_views)
+ * --calibrate: also self-calibrate the view positions (lf_lightfield_calibrate_views)
  * from the depth and score the depth again; the views from the 5x5 views
  * calibrated the same way.
  * Diagnostics (environment): LFD_VERBOSE=1 per-view and per-disparity
@@ -33,22 +33,22 @@
 #include "bench/bench_util.h"
 
 /* The views through the library's folder reader (lightfield/folder.c):
- * HCI layout, parameters.cfg, every view; then equalised as lf_lf_open
+ * HCI layout, parameters.cfg, every view; then equalised as lf_lightfield_open
  * does (LFD_NOEQ=1: not). */
 static int load_hci_views(const char *dir, lf_lightfield *lf)
 {
-    lf_lf_folder f;
-    lf_lf_layout flags;
+    lf_lightfield_folder f;
+    lf_lightfield_layout flags;
     lf_error err = {0};
-    lf_lf_layout_init(&flags);
-    int rc = lf_lf_folder_scan(dir, &f, &err) || lf_lf_folder_load(&f, &flags, lf, &err) ||
-             (!getenv("LFD_NOEQ") && lf_lf_equalize(lf, &err));
+    lf_lightfield_layout_init(&flags);
+    int rc = lf_lightfield_folder_scan(dir, &f, &err) || lf_lightfield_folder_load(&f, &flags, lf, &err) ||
+             (!getenv("LFD_NOEQ") && lf_lightfield_equalize(lf, &err));
     if (!rc && (lf->views_rescaled || lf->views_dark))
         printf("equalised: %d views rescaled (gains %.3f .. %.3f), %d dark views left out, %zu samples missing\n",
                lf->views_rescaled, lf->gain_lo, lf->gain_hi, lf->views_dark, lf->missing);
     if (rc)
         fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
-    lf_lf_folder_free(&f);
+    lf_lightfield_folder_free(&f);
     return rc;
 }
 
@@ -198,10 +198,10 @@ int main(int argc, char **argv)
         }
         if (baseline) {
             lf_image af, dm;
-            lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+            lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
             ro.threads = threads;
             double s = lf_seconds();
-            if (lf_lf_allfocus(&lf, &ro, -1.7, 0.7, 82, &af, &dm, &err)) {
+            if (lf_lightfield_allfocus(&lf, &ro, -1.7, 0.7, 82, &af, &dm, &err)) {
                 fprintf(stderr, "%s\n", err.msg);
                 return 1;
             }
@@ -214,11 +214,11 @@ int main(int argc, char **argv)
         lf_image disp = {0}, conf = {0};
         double r0 = 0, r1 = 0;
         if (!getenv("LFD_RANGE"))
-            lf_lf_depth_range(&lf, threads, &r0, &r1, &err);
+            lf_lightfield_depth_range(&lf, threads, &r0, &r1, &err);
         printf("estimated disparity range %.3f .. %.3f px/view\n", r0, r1);
         for (int r = 0; r < runs; r++) {
             lf_image_free(&disp), lf_image_free(&conf);
-            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
             o.threads = threads;
             if (getenv("LFD_RANGE"))
                 sscanf(getenv("LFD_RANGE"), "%lf %lf", &o.d0, &o.d1);
@@ -243,7 +243,7 @@ int main(int argc, char **argv)
             if (getenv("LFD_THIN_RATIO"))
                 o.thin_ratio = atof(getenv("LFD_THIN_RATIO"));
             double s = lf_seconds(), sc = bench_cpu_seconds();
-            if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
+            if (lf_lightfield_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
@@ -251,13 +251,13 @@ int main(int argc, char **argv)
         }
         qsort(times, (size_t)runs, sizeof(double), bench_cmp_double);
         qsort(cpus, (size_t)runs, sizeof(double), bench_cmp_double);
-        score("lf_lf_depth (range auto)", &disp, &gt, times[runs / 2]);
+        score("lf_lightfield_depth (range auto)", &disp, &gt, times[runs / 2]);
         printf("  depth: median of %d runs: wall %.2f s, CPU %.2f s (all threads)\n", runs, times[runs / 2],
                cpus[runs / 2]);
         if (calibrate) { /* self-calibrated view positions, depth again */
             double *rep = malloc(sizeof(double) * 6 * lf.nu * lf.nv);
             double s = lf_seconds();
-            if (!rep || lf_lf_calibrate_views(&lf, &disp, &conf, threads, rep, &err)) {
+            if (!rep || lf_lightfield_calibrate_views(&lf, &disp, &conf, threads, rep, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", rep ? err.msg : "out of memory");
                 return 1;
             }
@@ -273,14 +273,14 @@ int main(int argc, char **argv)
             printf("  calibrated view positions in %.2f s: largest departure from the grid %.4f view steps\n", tc, worst);
             free(rep);
             lf_image_free(&disp), lf_image_free(&conf);
-            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
             o.threads = threads;
             s = lf_seconds();
-            if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) {
+            if (lf_lightfield_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
-            score("lf_lf_depth (calibrated)", &disp, &gt, lf_seconds() - s);
+            score("lf_lightfield_depth (calibrated)", &disp, &gt, lf_seconds() - s);
             free(lf.view_shift);
             lf.view_shift = NULL;
         }
@@ -310,7 +310,7 @@ int main(int argc, char **argv)
         /* 5x5 light field of the views with even indices */
         int n5 = (lf.nu + 1) / 2;
         lf_lightfield sub = {0};
-        if (lf_lf_alloc(&sub, n5, n5, lf.ns, lf.nt, &err)) {
+        if (lf_lightfield_alloc(&sub, n5, n5, lf.ns, lf.nt, &err)) {
             fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
@@ -326,7 +326,7 @@ int main(int argc, char **argv)
                            lf.valid + ((size_t)2 * j * lf.nu + 2 * i) * lf.ns * lf.nt, sizeof(float) * lf.ns * lf.nt);
         for (int j = 0; j < n5; j++)
             for (int i = 0; i < n5; i++)
-                memcpy(lf_lf_view(&sub, i, j), lf_lf_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
+                memcpy(lf_lightfield_view(&sub, i, j), lf_lightfield_view(&lf, 2 * i, 2 * j), sizeof(float) * 3 * lf.ns * lf.nt);
         if (getenv("LFD_NOISE")) {
             /* robustness diagnostic: Gaussian noise of LFD_NOISE 8-bit sRGB levels on the source views
              * (added in sRGB, fixed seed), scored against the clean held-out views */
@@ -350,7 +350,7 @@ int main(int argc, char **argv)
         }
         lf_image sd = {0}, sc = {0};
         {
-            lf_lf_depth_opts o = lf_lf_depth_defaults();
+            lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
             o.threads = threads;
             if (getenv("LFD_INTERP"))
                 o.interp = atoi(getenv("LFD_INTERP"));
@@ -361,7 +361,7 @@ int main(int argc, char **argv)
             if (getenv("LFD_THIN_RATIO"))
                 o.thin_ratio = atof(getenv("LFD_THIN_RATIO"));
             double s = lf_seconds();
-            if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
+            if (lf_lightfield_depth(&sub, &o, &sd, &sc, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                 return 1;
             }
@@ -382,12 +382,12 @@ int main(int argc, char **argv)
             }
             if (calibrate) {
                 s = lf_seconds();
-                if (lf_lf_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
+                if (lf_lightfield_calibrate_views(&sub, &sd, &sc, threads, NULL, &err)) {
                     fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                     return 1;
                 }
                 lf_image_free(&sd), lf_image_free(&sc);
-                if (lf_lf_depth(&sub, &o, &sd, &sc, &err)) {
+                if (lf_lightfield_depth(&sub, &o, &sd, &sc, &err)) {
                     fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                     return 1;
                 }
@@ -423,20 +423,20 @@ int main(int argc, char **argv)
                     double s = lf_seconds();
                     int rc;
                     if (method == 0) {
-                        rc = lf_lf_view_at(&sub, u, v, 0.0, &out, &err);
+                        rc = lf_lightfield_view_at(&sub, u, v, 0.0, &out, &err);
                     } else {
-                        lf_lf_view_opts vo = lf_lf_view_defaults();
+                        lf_lightfield_view_opts vo = lf_lightfield_view_defaults();
                         vo.threads = threads;
                         vo.disparity = &sd, vo.confidence = &sc;
                         vo.blend = getenv("LFD_BLEND") && *getenv("LFD_BLEND") == '1'; /* diagnostic: the bicubic blend */
-                        rc = lf_lf_view_depth(&sub, u, v, &vo, &out, &err);
+                        rc = lf_lightfield_view_depth(&sub, u, v, &vo, &out, &err);
                     }
                     secs += lf_seconds() - s;
                     if (rc) {
                         fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);
                         return 1;
                     }
-                    double p = psnr8(&out, lf_lf_view(&lf, c, r), 15);
+                    double p = psnr8(&out, lf_lightfield_view(&lf, c, r), 15);
                     if (getenv("LFD_DUMP")) {
                         char pp[4096];
                         snprintf(pp, sizeof pp, "%s/syn_%d_%d.f32", getenv("LFD_DUMP"), r, c);
@@ -447,7 +447,7 @@ int main(int argc, char **argv)
                         double se[2] = {0, 0}, sb[2][12] = {{0}}, sdist[2][6] = {{0}};
                         size_t ndist[2][6] = {{0}};
                         size_t nn[2] = {0, 0}, nb[2][12] = {{0}};
-                        const float *tv = lf_lf_view(&lf, c, r);
+                        const float *tv = lf_lightfield_view(&lf, c, r);
                         for (int y = 15; y < out.height - 15; y++)
                             for (int x = 15; x < out.width - 15; x++) {
                                 float g = sd.data[(size_t)y * out.width + x];
@@ -491,7 +491,7 @@ int main(int argc, char **argv)
                     if (getenv("LFD_VERBOSE") && r == 3 && c == 3) {
                         lf_image_write("/tmp/lfd_v33.png", &out, NULL, NULL, &err);
                         for (size_t i = 0; i < (size_t)out.width * out.height * 3; i++)
-                            out.data[i] = 0.5f + 4 * (out.data[i] - lf_lf_view(&lf, c, r)[i]);
+                            out.data[i] = 0.5f + 4 * (out.data[i] - lf_lightfield_view(&lf, c, r)[i]);
                         lf_image_write("/tmp/lfd_v33_err.png", &out, NULL, NULL, &err);
                     }
                     sum += p, count++;
@@ -502,9 +502,9 @@ int main(int argc, char **argv)
                    method == 0 ? "views: plane d=0 (4 nearest)" : "views: per-pixel depth", sum / count, worst, count,
                    secs / count);
         }
-        lf_lf_free(&sub);
+        lf_lightfield_free(&sub);
         lf_image_free(&sd), lf_image_free(&sc);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     return 0;
 }

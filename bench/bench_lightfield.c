@@ -54,12 +54,12 @@ int main(int argc, char **argv)
     /* refocus */
     {
         lf_lightfield lf;
-        if (lf_lf_alloc(&lf, 9, 9, 512, 512, &err)) {
+        if (lf_lightfield_alloc(&lf, 9, 9, 512, 512, &err)) {
             fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         fill(&lf);
-        lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+        lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
         o.threads = 2;
         double t[64];
         lf_image img;
@@ -68,7 +68,7 @@ int main(int argc, char **argv)
             for (int k = 0; k < reps; k++) {
                 o.disparity_px = pass ? 0.0 : 0.37 + 0.113 * k;
                 double t0 = lf_seconds(), c0 = bench_cpu_seconds();
-                lf_lf_refocus(&lf, &o, &img, &err);
+                lf_lightfield_refocus(&lf, &o, &img, &err);
                 t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
                 lf_image_free(&img);
             }
@@ -79,13 +79,13 @@ int main(int argc, char **argv)
                    bench_median(cpu, reps) * 1e3, reps);
         }
         /* half-float storage */
-        if (lf_lf_make_half(&lf, &err) == 0) {
+        if (lf_lightfield_make_half(&lf, &err) == 0) {
             o.use_half = 1;
             double cpu[64];
             for (int k = 0; k < reps; k++) {
                 o.disparity_px = 0.37 + 0.113 * k;
                 double t0 = lf_seconds(), c0 = bench_cpu_seconds();
-                lf_lf_refocus(&lf, &o, &img, &err);
+                lf_lightfield_refocus(&lf, &o, &img, &err);
                 t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
                 lf_image_free(&img);
             }
@@ -94,44 +94,44 @@ int main(int argc, char **argv)
                    "%.1f ms CPU (%d frames)\n",
                    m * 1e3, 1 / m, bench_median(cpu, reps) * 1e3, reps);
         }
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
 
     /* Fourier slice */
     {
         lf_lightfield lf;
-        lf_lf_alloc(&lf, 9, 9, 256, 256, &err);
+        lf_lightfield_alloc(&lf, 9, 9, 256, 256, &err);
         fill(&lf);
-        lf_lf_fourier *fs = NULL;
+        lf_lightfield_fourier *fs = NULL;
         double t0 = lf_seconds();
-        if (lf_lf_fourier_new(&lf, NULL, 2.0, &fs, &err)) {
+        if (lf_lightfield_fourier_new(&lf, NULL, 2.0, &fs, &err)) {
             fprintf(stderr, "%s\n", err.msg);
         } else {
             double pre = lf_seconds() - t0, t[64];
             for (int k = 0; k < reps; k++) {
                 lf_image img;
                 double t1 = lf_seconds();
-                lf_lf_fourier_refocus(fs, 0.37 + 0.113 * k, &img, &err);
+                lf_lightfield_fourier_refocus(fs, 0.37 + 0.113 * k, &img, &err);
                 t[k] = lf_seconds() - t1;
                 lf_image_free(&img);
             }
             double m = bench_median(t, reps);
-            lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+            lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
             double ts[64];
             for (int k = 0; k < reps; k++) {
                 lf_image img;
                 o.disparity_px = 0.37 + 0.113 * k;
                 double t1 = lf_seconds();
-                lf_lf_refocus(&lf, &o, &img, &err);
+                lf_lightfield_refocus(&lf, &o, &img, &err);
                 ts[k] = lf_seconds() - t1;
                 lf_image_free(&img);
             }
             printf("fourier slice 9x9x256x256 (u,v padded to 18x18): precompute %.2f s, per frame median %.1f ms "
                    "(shift-and-add on the same field: %.1f ms)\n",
                    pre, m * 1e3, bench_median(ts, reps) * 1e3);
-            lf_lf_fourier_release(fs);
+            lf_lightfield_fourier_release(fs);
         }
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
 
     /* decode */
@@ -143,41 +143,41 @@ int main(int argc, char **argv)
         }
         for (size_t i = 0; i < (size_t)4096 * 4096 * 3; i++)
             raw.data[i] = (float)((i * 2654435761u) >> 8 & 0xffff) / 65536.0f;
-        lf_lf_layout lay, none, r;
-        lf_lf_layout_init(&lay);
-        lf_lf_layout_init(&none);
-        lay.kind = LF_LF_PLENOPTIC, lay.pitch_px = 10.3, lay.rotation_rad = 0.01;
+        lf_lightfield_layout lay, none, r;
+        lf_lightfield_layout_init(&lay);
+        lf_lightfield_layout_init(&none);
+        lay.kind = LF_LIGHTFIELD_PLENOPTIC, lay.pitch_px = 10.3, lay.rotation_rad = 0.01;
         lay.offset_px[0] = lay.offset_px[1] = 5.2;
-        lay.have = LF_LF_HAVE_KIND | LF_LF_HAVE_PITCH | LF_LF_HAVE_ROTATION | LF_LF_HAVE_OFFSET;
-        lf_lf_layout_resolve(&lay, &none, 4096, 4096, &r, &err);
+        lay.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_ROTATION | LF_LIGHTFIELD_HAVE_OFFSET;
+        lf_lightfield_layout_resolve(&lay, &none, 4096, 4096, &r, &err);
         int n = quick ? 1 : 3;
         double t[8];
         lf_lightfield lf = {0};
         for (int k = 0; k < n; k++) {
             double t0 = lf_seconds();
-            lf_lf_decode(&raw, &r, NULL, &lf, &err);
+            lf_lightfield_decode(&raw, &r, NULL, &lf, &err);
             t[k] = lf_seconds() - t0;
             if (k + 1 < n)
-                lf_lf_free(&lf);
+                lf_lightfield_free(&lf);
         }
         printf("decode 4096x4096 plenoptic raw (pitch 10.3 px, %d x %d lenses -> %d x %d views of %d x %d): median %.0f ms "
                "(%d runs, 1 thread)\n",
                r.lens_x, r.lens_y, lf.nu, lf.nv, lf.ns, lf.nt, bench_median(t, n) * 1e3, n);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
         lf_image_free(&raw);
     }
 
     /* synth */
     {
         lf_lightfield lf;
-        lf_lf_alloc(&lf, 16, 16, 128, 128, &err);
+        lf_lightfield_alloc(&lf, 16, 16, 128, 128, &err);
         fill(&lf);
-        lf_lf_layout *l = &lf.layout;
-        l->kind = LF_LF_CAMERA_ARRAY, l->cams_x = l->cams_y = 16;
+        lf_lightfield_layout *l = &lf.layout;
+        l->kind = LF_LIGHTFIELD_CAMERA_ARRAY, l->cams_x = l->cams_y = 16;
         l->grid_bounds[0] = l->grid_bounds[2] = -0.5, l->grid_bounds[1] = l->grid_bounds[3] = 0.5;
         l->fov_deg = 40, l->tile_w = l->tile_h = 128;
-        l->have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_BOUNDS | LF_LF_HAVE_FOV | LF_LF_HAVE_TILE;
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        l->have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_BOUNDS | LF_LIGHTFIELD_HAVE_FOV | LF_LIGHTFIELD_HAVE_TILE;
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = o.height = 600, o.fov_deg = 35, o.spp = 64, o.lens_radius = 0.05, o.focal_distance = 3;
         o.pos[2] = -0.2, o.threads = 2;
         int n = quick ? 1 : 3;
@@ -185,7 +185,7 @@ int main(int argc, char **argv)
         for (int k = 0; k < n; k++) {
             lf_image img;
             double t0 = lf_seconds(), c0 = bench_cpu_seconds();
-            lf_lf_synth(&lf, &o, &img, NULL, NULL, &err);
+            lf_lightfield_synth(&lf, &o, &img, NULL, NULL, &err);
             t[k] = lf_seconds() - t0, cpu[k] = bench_cpu_seconds() - c0;
             lf_image_free(&img);
         }
@@ -193,7 +193,7 @@ int main(int argc, char **argv)
         printf("synth 600x600, 64 spp, lens radius 0.05, 16x16 cameras of 128x128, 2 threads: median %.2f s wall, "
                "%.2f s CPU = %.0f ns CPU per sample (%d runs; target: under 2 s on 2 cores)\n",
                bench_median(t, n), mc, mc * 1e9 / (600.0 * 600 * 64), n);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
     return 0;
 }

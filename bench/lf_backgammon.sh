@@ -4,7 +4,7 @@
 #
 #   bash bench/lf_backgammon.sh [DIR]        default DIR: ../shared/lfdata/hci/backgammon
 #
-# Depth (lf_lf_depth, no range given: estimated from the data) on the 9 x 9
+# Depth (lf_lightfield_depth, no range given: estimated from the data) on the 9 x 9
 # views, 2 threads, median of 3 runs (wall and process CPU time); BadPix
 # 0.07 / 0.03 / 0.01 and MSE x 100 against gt_disp_lowres.pfm with a 15-px
 # border, as the benchmark's toolkit scores.  Views: from the 5 x 5 views

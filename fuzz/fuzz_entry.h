@@ -17,11 +17,11 @@
  *   lens_file     lf_lens_parse (camera/lens.h); on success also the paraxial
  *                 analysis and the thick-lens focus, which read every surface.
  *   lf_attributes lensfield:* attributes decoded from the bytes (a small
- *                 type/name/value encoding, below) -> lf_lf_layout_from_attrs
- *                 -> lf_lf_layout_resolve for a raw size taken from the bytes
- *                 -> lf_lf_decode of a small raw image.
+ *                 type/name/value encoding, below) -> lf_lightfield_layout_from_attrs
+ *                 -> lf_lightfield_layout_resolve for a raw size taken from the bytes
+ *                 -> lf_lightfield_decode of a small raw image.
  *   image_exr     lf_image_read (with attributes) of the bytes written to a
- *                 temporary file, then lf_lf_layout_from_attrs on what it read.
+ *                 temporary file, then lf_lightfield_layout_from_attrs on what it read.
  */
 #ifndef LF_FUZZ_ENTRY_H
 #define LF_FUZZ_ENTRY_H
@@ -225,21 +225,21 @@ static int lf_fuzz_lf_attributes(const uint8_t *data, size_t size)
             lf_attrs_set_floats(&attrs, name, v, cnt);
         }
     }
-    lf_lf_layout file, flags, lay;
+    lf_lightfield_layout file, flags, lay;
     lf_error err = {0};
     int result = 0;
-    if (lf_lf_layout_from_attrs(&attrs, &file, &err)) {
+    if (lf_lightfield_layout_from_attrs(&attrs, &file, &err)) {
         result = lf_fuzz_refused(err.msg);
         goto done;
     }
     char desc[1024];
-    lf_lf_layout_describe(&file, desc, sizeof desc);
-    lf_lf_layout_init(&flags);
-    if (lf_lf_layout_resolve(&file, &flags, raw_w, raw_h, &lay, &err)) {
+    lf_lightfield_layout_describe(&file, desc, sizeof desc);
+    lf_lightfield_layout_init(&flags);
+    if (lf_lightfield_layout_resolve(&file, &flags, raw_w, raw_h, &lay, &err)) {
         result = lf_fuzz_refused(err.msg);
         goto done;
     }
-    lf_lf_layout_describe(&lay, desc, sizeof desc);
+    lf_lightfield_layout_describe(&lay, desc, sizeof desc);
     lf_image raw = {0};
     if (lf_image_alloc(&raw, raw_w, raw_h, 3, &err) == 0) {
         for (size_t i = 0; i < (size_t)raw_w * raw_h * 3; i++)
@@ -247,8 +247,8 @@ static int lf_fuzz_lf_attributes(const uint8_t *data, size_t size)
         lf_lightfield lf;
         memset(&lf, 0, sizeof lf);
         lf_error derr = {0};
-        if (lf_lf_decode(&raw, &lay, NULL, &lf, &derr) == 0)
-            lf_lf_free(&lf);
+        if (lf_lightfield_decode(&raw, &lay, NULL, &lf, &derr) == 0)
+            lf_lightfield_free(&lf);
         else
             result = lf_fuzz_refused(derr.msg);
         lf_image_free(&raw);
@@ -272,10 +272,10 @@ static int lf_fuzz_image_exr(const uint8_t *data, size_t size)
         lf_attrs_free(&attrs);
         return lf_fuzz_refused(err.msg);
     }
-    lf_lf_layout lay;
+    lf_lightfield_layout lay;
     lf_error lerr = {0};
     int result = 0;
-    if (lf_lf_layout_from_attrs(&attrs, &lay, &lerr))
+    if (lf_lightfield_layout_from_attrs(&attrs, &lay, &lerr))
         result = lf_fuzz_refused(lerr.msg);
     lf_image_free(&img);
     lf_attrs_free(&attrs);

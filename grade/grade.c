@@ -502,7 +502,7 @@ static int parse_num(const char *s, double *v)
 typedef struct declared {
     int ok;
     char why[512];
-    lf_lf_synth_opts synth;
+    lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal;
     char flags_seen[512]; /* " lensradius focaldistance ..." */
     double values[32];
@@ -535,7 +535,7 @@ static int declared_value(const declared *d, const char *name, double *v)
 static void parse_declared(const char *md, const char *word, declared *d)
 {
     memset(d, 0, sizeof *d);
-    d->synth = lf_lf_synth_defaults();
+    d->synth = lf_lightfield_synth_defaults();
     char line[2048];
     if (!md) {
         snprintf(d->why, sizeof d->why, "no Submission.md to read the lftool %s command from", word);
@@ -659,20 +659,20 @@ static int lightfield_product(const lf_image *raw, const lf_attrs *meta, const d
                               lf_image *out, char *why, size_t wn)
 {
     lf_error err = {0};
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&flags);
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&flags);
     lf_lightfield lf;
     memset(&lf, 0, sizeof lf);
-    if (lf_lf_layout_from_attrs(meta, &file, &err) ||
-        lf_lf_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &err) ||
-        lf_lf_decode(raw, &lay, NULL, &lf, &err)) {
+    if (lf_lightfield_layout_from_attrs(meta, &file, &err) ||
+        lf_lightfield_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &err) ||
+        lf_lightfield_decode(raw, &lay, NULL, &lf, &err)) {
         snprintf(why, wn, "grader: reference light field: %s", err.msg);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
         return -1;
     }
     int rc;
     if (!refocus) {
-        lf_lf_synth_opts s = d->synth;
+        lf_lightfield_synth_opts s = d->synth;
         s.threads = threads > 0 ? threads : 2;
         if (!d->have_outfov)
             s.fov_deg = lay.fov_deg;
@@ -683,26 +683,26 @@ static int lightfield_product(const lf_image *raw, const lf_attrs *meta, const d
             s.pos[1] = 0.5 * (lay.grid_bounds[2] + lay.grid_bounds[3]);
             s.pos[2] = 0;
         }
-        if (!d->have_focal && (lay.have & LF_LF_HAVE_CAM_LENS) && lay.focal_distance > 0)
+        if (!d->have_focal && (lay.have & LF_LIGHTFIELD_HAVE_CAM_LENS) && lay.focal_distance > 0)
             s.focal_distance = lay.focal_distance;
-        rc = lf_lf_synth(&lf, &s, out, NULL, NULL, &err);
+        rc = lf_lightfield_synth(&lf, &s, out, NULL, NULL, &err);
     } else {
-        lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+        lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
         if (d->have_aperture)
             ro.aperture_radius = d->aperture;
         double disp = 0;
         rc = 0;
         if (d->focus_kind == 1)
-            rc = lf_lf_depth_to_disparity(&lf, d->focus, &disp, &err);
+            rc = lf_lightfield_depth_to_disparity(&lf, d->focus, &disp, &err);
         else if (d->focus_kind == 3)
-            rc = lf_lf_alpha_to_disparity(&lf, d->focus, &disp, &err);
+            rc = lf_lightfield_alpha_to_disparity(&lf, d->focus, &disp, &err);
         else if (d->focus_kind == 2)
             disp = d->focus;
         ro.disparity_px = disp;
         if (!rc)
-            rc = lf_lf_refocus(&lf, &ro, out, &err);
+            rc = lf_lightfield_refocus(&lf, &ro, out, &err);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     if (rc)
         snprintf(why, wn, "the declared command cannot be reproduced: %s", err.msg);
     return rc ? -1 : 0;
@@ -1188,19 +1188,19 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     const lf_attrs *meta;
     if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
         return lf_error_set(err, err->code, "check %s: reference light field: %s", c->id, err->msg);
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&flags);
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&flags);
     lf_lightfield lf;
     memset(&lf, 0, sizeof lf);
     lf_error e = {0};
-    if (lf_lf_layout_from_attrs(meta, &file, &e) ||
-        lf_lf_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) || lf_lf_decode(raw, &lay, NULL, &lf, &e)) {
-        lf_lf_free(&lf);
+    if (lf_lightfield_layout_from_attrs(meta, &file, &e) ||
+        lf_lightfield_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) || lf_lightfield_decode(raw, &lay, NULL, &lf, &e)) {
+        lf_lightfield_free(&lf);
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: reference light field: %s", c->id, e.msg);
     }
     double d_want = 0;
-    if (lf_lf_depth_to_disparity(&lf, want, &d_want, &e)) {
-        lf_lf_free(&lf);
+    if (lf_lightfield_depth_to_disparity(&lf, want, &d_want, &e)) {
+        lf_lightfield_free(&lf);
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: depth=%g: %s", c->id, want, e.msg);
     }
     int target = 0;
@@ -1210,7 +1210,7 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     sub_image *im = get_image(s, lf_grade_check_get(c, "image", c->id), lf.ns, lf.nt, why, sizeof why);
     if (!im) {
         fail(r, "%s", why);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
         return 0;
     }
     int eight_bit = !strcmp(im->format, "png");
@@ -1218,7 +1218,7 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     double dmin = d_want, dmax = d_want;
     for (int k = 0; k < ns; k++) {
         double d;
-        if (!lf_lf_depth_to_disparity(&lf, sj[k].depth, &d, &e))
+        if (!lf_lightfield_depth_to_disparity(&lf, sj[k].depth, &d, &e))
             dmin = fmin(dmin, d), dmax = fmax(dmax, d);
     }
     dmin -= 0.5, dmax += 0.5;
@@ -1226,15 +1226,15 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0}, errs[NSWEEP + 1];
     int best_q = -1;
     lf_image ref = {0};
-    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
     ro.threads = g->threads > 0 ? g->threads : 2;
     ro.disparity_px = d_want;
-    int rc = lf_lf_refocus(&lf, &ro, &ref, &e);
+    int rc = lf_lightfield_refocus(&lf, &ro, &ref, &e);
     for (int q = 0; !rc && q <= NSWEEP; q++) {
         lf_image sw = {0};
         /* the sweep, plus exactly zero (the unrefocused image) as the last step */
         ro.disparity_px = q < NSWEEP ? dmin + (dmax - dmin) * q / (NSWEEP - 1) : 0.0;
-        if ((rc = lf_lf_refocus(&lf, &ro, &sw, &e)))
+        if ((rc = lf_lightfield_refocus(&lf, &ro, &sw, &e)))
             break;
         if (eight_bit)
             lf_grade_quantize8(&sw);
@@ -1251,7 +1251,7 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
         lf_image_free(&sw);
     }
     if (rc) {
-        lf_image_free(&ref), lf_lf_free(&lf);
+        lf_image_free(&ref), lf_lightfield_free(&lf);
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
     }
     /* between sweep steps: the vertex of the parabola through the best and its neighbours */
@@ -1315,7 +1315,7 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
         fail(r, "%s: brightness %.2fx the reference (pass within %.2fx); %s", im->file, bright, max_bright, meas);
     }
     snprintf(r->measurements, sizeof r->measurements, "%s; %s", meas, looks);
-    lf_image_free(&ref), lf_lf_free(&lf);
+    lf_image_free(&ref), lf_lightfield_free(&lf);
     return 0;
 }
 

@@ -30,7 +30,7 @@ static int solve3(const double M[9], const double r[3], double x[3])
     return lf_solve(A, x, 3, 1);
 }
 
-int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err)
+int lf_lightfield_calibrate(const lf_image *white, lf_lightfield_layout *lay, lf_error *err)
 {
     int W = white->width, H = white->height;
     int N = 1;
@@ -57,7 +57,7 @@ int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err)
             double w = (0.5 - 0.5 * cos(2 * M_PI * (x + 0.5) / N)) * (0.5 - 0.5 * cos(2 * M_PI * (y + 0.5) / N));
             F[2 * ((size_t)y * N + x)] = (float)((lum(white, x0 + x, y0 + y) - mean) * w);
         }
-    lf_lf_fft2d(F, N, N, -1);
+    lf_lightfield_fft2d(F, N, N, -1);
 #define MAG(kx, ky) hypot(F[2 * ((size_t)(((ky) + N) % N) * N + (((kx) + N) % N))], \
                           F[2 * ((size_t)(((ky) + N) % N) * N + (((kx) + N) % N)) + 1])
     /* 1. strongest peak with pitch between 2.5 px and N/4 */
@@ -97,7 +97,7 @@ int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err)
             m60 = fmax(m60, MAG((int)lround(kr * cos(a60)) + dx, (int)lround(kr * sin(a60)) + dy));
             m90 = fmax(m90, MAG((int)lround(kr * cos(a90)) + dx, (int)lround(kr * sin(a90)) + dy));
         }
-    int hex = (lay->have & LF_LF_HAVE_GRID) ? lay->grid == LF_LF_GRID_HEX : m60 > m90;
+    int hex = (lay->have & LF_LIGHTFIELD_HAVE_GRID) ? lay->grid == LF_LIGHTFIELD_GRID_HEX : m60 > m90;
     double pitch = hex ? 2.0 * N / (sqrt(3.0) * kr) : N / kr;
     /* square: reciprocal vectors along the rows; hex: 90 degrees from them (mod 60) */
     double period = hex ? M_PI / 3 : M_PI / 2;
@@ -208,13 +208,13 @@ int lf_lf_calibrate(const lf_image *white, lf_lf_layout *lay, lf_error *err)
     int i0 = (int)ceil(lx - 0.5);
     o[0] += i0 * a[0] + j0 * rowf * b[0];
     o[1] += i0 * a[1] + j0 * rowf * b[1];
-    lay->kind = LF_LF_PLENOPTIC;
-    lay->grid = hex ? LF_LF_GRID_HEX : LF_LF_GRID_SQUARE;
+    lay->kind = LF_LIGHTFIELD_PLENOPTIC;
+    lay->grid = hex ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
     lay->pitch_px = pitch, lay->rotation_rad = rot;
     lay->offset_px[0] = o[0], lay->offset_px[1] = o[1];
     lay->lens_x = (int)floor((W - o[0]) / pitch) + 1;
     lay->lens_y = (int)floor((H - o[1]) / (pitch * rowf)) + 1;
-    lay->have |= LF_LF_HAVE_KIND | LF_LF_HAVE_GRID | LF_LF_HAVE_PITCH | LF_LF_HAVE_ROTATION | LF_LF_HAVE_OFFSET |
-                 LF_LF_HAVE_LENS_COUNT;
+    lay->have |= LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_GRID | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_ROTATION | LF_LIGHTFIELD_HAVE_OFFSET |
+                 LF_LIGHTFIELD_HAVE_LENS_COUNT;
     return LF_OK;
 }

@@ -6,7 +6,7 @@
 
 #include "lf_lightfield.h"
 
-int lf_lf_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err)
+int lf_lightfield_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err)
 {
     memset(lf, 0, sizeof *lf);
     if (nu < 1 || nv < 1 || ns < 1 || nt < 1)
@@ -25,7 +25,7 @@ int lf_lf_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_error *err
     return LF_OK;
 }
 
-void lf_lf_free(lf_lightfield *lf)
+void lf_lightfield_free(lf_lightfield *lf)
 {
     if (!lf)
         return;
@@ -99,13 +99,13 @@ static int raw_bilinear(const lf_image *raw, double px, double py, float out[3])
     return 1;
 }
 
-static int decode_camera_array(const lf_image *raw, const lf_lf_layout *l, lf_lightfield *lf, lf_error *err)
+static int decode_camera_array(const lf_image *raw, const lf_lightfield_layout *l, lf_lightfield *lf, lf_error *err)
 {
-    if (lf_lf_alloc(lf, l->cams_x, l->cams_y, l->tile_w, l->tile_h, err))
+    if (lf_lightfield_alloc(lf, l->cams_x, l->cams_y, l->tile_w, l->tile_h, err))
         return err ? err->code : LF_ERR_NOMEM;
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
-            float *v = lf_lf_view(lf, iu, iv);
+            float *v = lf_lightfield_view(lf, iu, iv);
             for (int t = 0; t < lf->nt; t++)
                 for (int s = 0; s < lf->ns; s++) {
                     float c[3];
@@ -125,14 +125,14 @@ static int decode_camera_array(const lf_image *raw, const lf_lf_layout *l, lf_li
     return LF_OK;
 }
 
-int lf_lf_plenoptic_views(const lf_lf_layout *l)
+int lf_lightfield_plenoptic_views(const lf_lightfield_layout *l)
 {
     return 2 * (int)floor((l->pitch_px - 1) / 2) + 1;
 }
 
 /* Samples every microlens (i, j) at centre - (u, v) for each view: the result
  * is indexed by lens (lens_x x lens_y), one validity flag per sample. */
-static int decode_lenses(const lf_image *raw, const lf_lf_layout *l, lf_lightfield *lf, lf_error *err)
+static int decode_lenses(const lf_image *raw, const lf_lightfield_layout *l, lf_lightfield *lf, lf_error *err)
 {
     /* A layout must fit its raw: the views of a lens come from its own
      * pixels, so views x lenses cannot much exceed the raw's pixel count. */
@@ -142,11 +142,11 @@ static int decode_lenses(const lf_image *raw, const lf_lf_layout *l, lf_lightfie
         return lf_error_set(err, LF_ERR_PARAM,
                             "microlens layout (%d x %d lenses of pitch %g px) does not fit the %d x %d raw",
                             l->lens_x, l->lens_y, l->pitch_px, raw->width, raw->height);
-    int n = lf_lf_plenoptic_views(l), half = n / 2;
-    if (lf_lf_alloc(lf, n, n, l->lens_x, l->lens_y, err) || ensure_valid(lf, err))
+    int n = lf_lightfield_plenoptic_views(l), half = n / 2;
+    if (lf_lightfield_alloc(lf, n, n, l->lens_x, l->lens_y, err) || ensure_valid(lf, err))
         return err ? err->code : LF_ERR_NOMEM;
     double c = cos(l->rotation_rad), s = sin(l->rotation_rad);
-    int hex = l->grid == LF_LF_GRID_HEX;
+    int hex = l->grid == LF_LIGHTFIELD_GRID_HEX;
     double row = l->pitch_px * (hex ? sqrt(3.0) / 2 : 1.0);
     for (int j = 0; j < l->lens_y; j++)
         for (int i = 0; i < l->lens_x; i++) {
@@ -176,7 +176,7 @@ static int decode_lenses(const lf_image *raw, const lf_lf_layout *l, lf_lightfie
 static int hex_to_rect(const lf_lightfield *h, lf_lightfield *r, lf_error *err)
 {
     int nt = (int)floor((h->nt - 1) * sqrt(3.0) / 2 + 1e-9) + 1;
-    if (lf_lf_alloc(r, h->nu, h->nv, h->ns, nt, err) || ensure_valid(r, err))
+    if (lf_lightfield_alloc(r, h->nu, h->nv, h->ns, nt, err) || ensure_valid(r, err))
         return err ? err->code : LF_ERR_NOMEM;
     const double row = sqrt(3.0) / 2;
     for (int view = 0; view < h->nu * h->nv; view++) {
@@ -230,24 +230,24 @@ static int hex_to_rect(const lf_lightfield *h, lf_lightfield *r, lf_error *err)
     return LF_OK;
 }
 
-void lf_lf_set_geometry(lf_lightfield *lf, const lf_lf_layout *l)
+void lf_lightfield_set_geometry(lf_lightfield *lf, const lf_lightfield_layout *l)
 {
     lf->layout = *l;
     lf->disp_v_per_u = 1.0;
-    if (l->kind == LF_LF_CAMERA_ARRAY) {
+    if (l->kind == LF_LIGHTFIELD_CAMERA_ARRAY) {
         double bx = l->cams_x > 1 ? (l->grid_bounds[1] - l->grid_bounds[0]) / (l->cams_x - 1) : 0;
         double by = l->cams_y > 1 ? (l->grid_bounds[3] - l->grid_bounds[2]) / (l->cams_y - 1) : 0;
-        if ((l->have & LF_LF_HAVE_BOUNDS) && (l->have & LF_LF_HAVE_FOV)) {
+        if ((l->have & LF_LIGHTFIELD_HAVE_BOUNDS) && (l->have & LF_LIGHTFIELD_HAVE_FOV)) {
             double fpx = 0.5 * (l->tile_w < l->tile_h ? l->tile_w : l->tile_h) / tan(l->fov_deg * M_PI / 360);
             double b = bx > 0 ? bx : by;
             lf->disp_per_inv_m = fpx * b;
             if (bx > 0 && by > 0)
                 lf->disp_v_per_u = by / bx;
             /* sensors shifted so that disparity vanishes at the convergence depth (HCI) */
-            if ((l->have & LF_LF_HAVE_CONVERGENCE) && l->convergence_m > 0)
+            if ((l->have & LF_LIGHTFIELD_HAVE_CONVERGENCE) && l->convergence_m > 0)
                 lf->disp_at_inf = -lf->disp_per_inv_m / l->convergence_m;
         }
-    } else if (l->have & LF_LF_HAVE_MAIN_LENS) {
+    } else if (l->have & LF_LIGHTFIELD_HAVE_MAIN_LENS) {
         double f = l->main_focal_mm * 1e-3, F = l->mla_distance_mm * 1e-3;
         double du = f / (2 * l->main_fstop) * 2 / l->pitch_px; /* lens metres per one-pixel view step */
         double k = du / (l->pitch_um * 1e-6);
@@ -276,12 +276,12 @@ static size_t count_missing(const lf_lightfield *lf)
     return m;
 }
 
-static int decode_plenoptic(const lf_image *raw, const lf_lf_layout *l, lf_lightfield *lf, lf_error *err)
+static int decode_plenoptic(const lf_image *raw, const lf_lightfield_layout *l, lf_lightfield *lf, lf_error *err)
 {
     return decode_lenses(raw, l, lf, err);
 }
 
-int lf_lf_decode(const lf_image *raw, const lf_lf_layout *l, const lf_image *white, lf_lightfield *lf,
+int lf_lightfield_decode(const lf_image *raw, const lf_lightfield_layout *l, const lf_image *white, lf_lightfield *lf,
                  lf_error *err)
 {
     memset(lf, 0, sizeof *lf);
@@ -293,11 +293,11 @@ int lf_lf_decode(const lf_image *raw, const lf_lf_layout *l, const lf_image *whi
     size_t nonfinite = lf_image_count_nonfinite(raw);
     int rc;
     lf_lightfield a = {0}, w = {0};
-    if (l->kind == LF_LF_CAMERA_ARRAY) {
+    if (l->kind == LF_LIGHTFIELD_CAMERA_ARRAY) {
         rc = decode_camera_array(raw, l, &a, err);
         if (!rc && white)
             rc = decode_camera_array(white, l, &w, err);
-    } else if (l->kind == LF_LF_PLENOPTIC) {
+    } else if (l->kind == LF_LIGHTFIELD_PLENOPTIC) {
         rc = decode_plenoptic(raw, l, &a, err);
         if (!rc && white)
             rc = decode_plenoptic(white, l, &w, err);
@@ -328,25 +328,25 @@ int lf_lf_decode(const lf_image *raw, const lf_lf_layout *l, const lf_image *whi
                 p[c] = q[c] > 1e-6f * (float)maxw ? p[c] / q[c] : (float)(p[c] / m);
         }
     }
-    lf_lf_free(&w);
-    if (!rc && l->kind == LF_LF_PLENOPTIC && l->grid == LF_LF_GRID_HEX) {
+    lf_lightfield_free(&w);
+    if (!rc && l->kind == LF_LIGHTFIELD_PLENOPTIC && l->grid == LF_LIGHTFIELD_GRID_HEX) {
         lf_lightfield r = {0};
         rc = hex_to_rect(&a, &r, err);
-        lf_lf_free(&a);
+        lf_lightfield_free(&a);
         a = r;
     }
     if (rc) {
-        lf_lf_free(&a);
+        lf_lightfield_free(&a);
         return rc;
     }
     *lf = a;
     lf->missing = count_missing(lf);
     lf->nonfinite = nonfinite;
-    lf_lf_set_geometry(lf, l);
+    lf_lightfield_set_geometry(lf, l);
     return LF_OK;
 }
 
-int lf_lf_alpha_to_disparity(const lf_lightfield *lf, double alpha, double *disp, lf_error *err)
+int lf_lightfield_alpha_to_disparity(const lf_lightfield *lf, double alpha, double *disp, lf_error *err)
 {
     if (lf->disp_per_alpha == 0)
         return lf_error_set(err, LF_ERR_PARAM,
@@ -358,7 +358,7 @@ int lf_lf_alpha_to_disparity(const lf_lightfield *lf, double alpha, double *disp
     return LF_OK;
 }
 
-int lf_lf_depth_to_disparity(const lf_lightfield *lf, double z, double *disp, lf_error *err)
+int lf_lightfield_depth_to_disparity(const lf_lightfield *lf, double z, double *disp, lf_error *err)
 {
     if (lf->disp_per_inv_m == 0)
         return lf_error_set(err, LF_ERR_PARAM,

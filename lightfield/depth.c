@@ -27,9 +27,9 @@
 
 enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
 
-lf_lf_depth_opts lf_lf_depth_defaults(void)
+lf_lightfield_depth_opts lf_lightfield_depth_defaults(void)
 {
-    lf_lf_depth_opts o;
+    lf_lightfield_depth_opts o;
     memset(&o, 0, sizeof o);
     o.occlusion = 2;
     o.defocus_weight = -1;
@@ -856,7 +856,7 @@ static double widest_view(const lf_lightfield *lf)
     return m > mv ? m : mv;
 }
 
-static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double d0, double d1, double step,
+static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double d0, double d1, double step,
                       lf_image *disparity, lf_image *confidence, lf_error *err)
 {
     int ns = lf->ns, nt = lf->nt, threads = o->threads > 0 ? o->threads : 2;
@@ -870,7 +870,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
         return lf_error_set(err, LF_ERR_PARAM, "disparity range %g .. %g in steps of %g gives %d labels (at most %d)",
                             d0, d1, step, nl, MAX_LABELS);
     step = (d1 - d0) / (nl - 1);
-    const float *ref = lf_lf_view(lf, iu0, iv0);
+    const float *ref = lf_lightfield_view(lf, iu0, iv0);
     dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
     float *cost = malloc(sizeof(float) * np * (size_t)nl);
     size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12;
@@ -891,7 +891,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lf_depth_opts *o, double
             if (iu == iu0 && iv == iv0)
                 continue;
             dview *v = &views[nv++];
-            v->data = lf_lf_view(lf, iu, iv);
+            v->data = lf_lightfield_view(lf, iu, iv);
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
             v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
             /* the angular group from the grid: calibrated positions a little
@@ -1065,10 +1065,10 @@ static int check_lf(const lf_lightfield *lf, lf_error *err)
     return LF_OK;
 }
 
-int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *disparity, lf_image *confidence,
+int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, lf_image *disparity, lf_image *confidence,
                 lf_error *err)
 {
-    lf_lf_depth_opts def = lf_lf_depth_defaults();
+    lf_lightfield_depth_opts def = lf_lightfield_depth_defaults();
     if (!o)
         o = &def;
     int rc = check_lf(lf, err);
@@ -1077,7 +1077,7 @@ int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *di
     double d0 = o->d0, d1 = o->d1;
     if (!isfinite(d0) || !isfinite(d1))
         return lf_error_set(err, LF_ERR_PARAM, "disparity range must be finite");
-    if (d0 >= d1 && (rc = lf_lf_depth_range(lf, o->threads, &d0, &d1, err)))
+    if (d0 >= d1 && (rc = lf_lightfield_depth_range(lf, o->threads, &d0, &d1, err)))
         return rc;
     double m = widest_view(lf);
     double step = o->step > 0 ? o->step : 0.2 / m;
@@ -1090,7 +1090,7 @@ int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *di
     return depth_core(lf, o, d0, d1, step, disparity, confidence, err);
 }
 
-int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err)
+int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err)
 {
     int rc = check_lf(lf, err);
     if (rc)
@@ -1098,13 +1098,13 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     /* quarter resolution by 4x4 box averaging: disparities shrink by 4 */
     int f = (lf->ns >= 64 && lf->nt >= 64) ? 4 : 1;
     lf_lightfield small = {0};
-    if ((rc = lf_lf_alloc(&small, lf->nu, lf->nv, lf->ns / f, lf->nt / f, err)))
+    if ((rc = lf_lightfield_alloc(&small, lf->nu, lf->nv, lf->ns / f, lf->nt / f, err)))
         return rc;
     small.disp_v_per_u = lf->disp_v_per_u;
     if (lf->view_shift) { /* calibrated views: offsets in the smaller pixels */
         small.view_shift = malloc(sizeof(double) * 4 * (size_t)lf->nu * lf->nv);
         if (!small.view_shift) {
-            lf_lf_free(&small);
+            lf_lightfield_free(&small);
             return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
         }
         for (int k = 0; k < lf->nu * lf->nv; k++)
@@ -1114,7 +1114,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     size_t snp = (size_t)small.ns * small.nt;
     if (lf->valid) { /* a small sample is valid when all its f x f samples are */
         if (!(small.valid = malloc(sizeof(float) * snp * (size_t)lf->nu * lf->nv))) {
-            lf_lf_free(&small);
+            lf_lightfield_free(&small);
             return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
         }
         for (int k = 0; k < lf->nu * lf->nv; k++)
@@ -1130,8 +1130,8 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     }
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
-            const float *src = lf_lf_view(lf, iu, iv);
-            float *dst = lf_lf_view(&small, iu, iv);
+            const float *src = lf_lightfield_view(lf, iu, iv);
+            float *dst = lf_lightfield_view(&small, iu, iv);
             for (int y = 0; y < small.nt; y++)
                 for (int x = 0; x < small.ns; x++)
                     for (int c = 0; c < 3; c++) {
@@ -1148,7 +1148,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     if (lim > 8)
         lim = 8;
     double step = 0.25 / m; /* 0.25 px at the outermost view, at quarter resolution */
-    lf_lf_depth_opts o = lf_lf_depth_defaults();
+    lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
@@ -1157,13 +1157,13 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     lf_image disp = {0}, conf = {0};
     double s0 = -lim / f, s1 = lim / f;
     if ((rc = depth_core(&small, &o, s0, s1, step, &disp, &conf, err))) {
-        lf_lf_free(&small);
+        lf_lightfield_free(&small);
         return rc;
     }
     size_t np = (size_t)small.ns * small.nt, n = 0;
     float *vals = malloc(sizeof(float) * np);
     if (!vals) {
-        lf_image_free(&disp), lf_image_free(&conf), lf_lf_free(&small);
+        lf_image_free(&disp), lf_image_free(&conf), lf_lightfield_free(&small);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     for (int pass = 0; pass < 2 && n < np / 20; pass++) {
@@ -1176,7 +1176,7 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
     qsort(vals, n, sizeof(float), cmpf);
     double lo = vals[(size_t)(0.01 * (n - 1))] * f, hi = vals[(size_t)(0.99 * (n - 1))] * f;
     free(vals);
-    lf_image_free(&disp), lf_image_free(&conf), lf_lf_free(&small);
+    lf_image_free(&disp), lf_image_free(&conf), lf_lightfield_free(&small);
     double pad = 0.05 * (hi - lo) + step * f;
     *d0 = lo - pad, *d1 = hi + pad;
     if (*d0 < -lim)

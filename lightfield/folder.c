@@ -15,13 +15,13 @@
 
 enum { MAX_SIDE = 4096 };
 
-int lf_lf_is_folder(const char *path)
+int lf_lightfield_is_folder(const char *path)
 {
     struct stat st;
     return path && stat(path, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-void lf_lf_folder_free(lf_lf_folder *f)
+void lf_lightfield_folder_free(lf_lightfield_folder *f)
 {
     if (!f)
         return;
@@ -121,7 +121,7 @@ typedef struct cfg_key {
 } cfg_key;
 
 /* The keys lensfield uses; others are kept by the benchmark and ignored here. */
-static int read_cfg(const char *path, lf_lf_folder *f, lf_error *err)
+static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
 {
     FILE *in = fopen(path, "r");
     if (!in)
@@ -211,10 +211,10 @@ static int read_cfg(const char *path, lf_lf_folder *f, lf_error *err)
     if (s_dmin != s_dmax || (s_dmin && !(dmin <= dmax)))
         return lf_error_set(err, LF_ERR_PARSE, "%s: give both disp_min and disp_max, disp_min <= disp_max", path);
 #undef WHOLE
-    lf_lf_layout *L = &f->layout;
+    lf_lightfield_layout *L = &f->layout;
     if (s_cx) {
         f->nu = (int)camsx, f->nv = (int)camsy;
-        L->cams_x = f->nu, L->cams_y = f->nv, L->have |= LF_LF_HAVE_CAMS;
+        L->cams_x = f->nu, L->cams_y = f->nv, L->have |= LF_LIGHTFIELD_HAVE_CAMS;
     }
     f->cfg_w = s_resx ? (int)resx : 0;
     f->cfg_h = s_resy ? (int)resy : 0;
@@ -223,17 +223,17 @@ static int read_cfg(const char *path, lf_lf_folder *f, lf_error *err)
         double b = base * 1e-3;
         L->grid_bounds[0] = -0.5 * b * (f->nu - 1), L->grid_bounds[1] = 0.5 * b * (f->nu - 1);
         L->grid_bounds[2] = -0.5 * b * (f->nv - 1), L->grid_bounds[3] = 0.5 * b * (f->nv - 1);
-        L->have |= LF_LF_HAVE_BOUNDS;
+        L->have |= LF_LIGHTFIELD_HAVE_BOUNDS;
     }
     if (s_focal && s_sensor) {
         /* HCI: the sensor size spans the longer image side; the fov is set
-         * once the view size is known (lf_lf_folder_load) */
+         * once the view size is known (lf_lightfield_folder_load) */
         f->focal_mm = focal, f->sensor_mm = sensor;
     }
     if (s_focus)
-        L->convergence_m = focus, L->have |= LF_LF_HAVE_CONVERGENCE;
+        L->convergence_m = focus, L->have |= LF_LIGHTFIELD_HAVE_CONVERGENCE;
     if (s_dmin)
-        L->disp_min = dmin, L->disp_max = dmax, L->have |= LF_LF_HAVE_DISP_RANGE;
+        L->disp_min = dmin, L->disp_max = dmax, L->have |= LF_LIGHTFIELD_HAVE_DISP_RANGE;
     return LF_OK;
 }
 
@@ -295,9 +295,9 @@ static void list_append(char *msg, size_t cap, int *count, int limit, const char
     (*count)++;
 }
 
-static int scan_hci(const char *dir, const names *ls, lf_lf_folder *f, lf_error *err)
+static int scan_hci(const char *dir, const names *ls, lf_lightfield_folder *f, lf_error *err)
 {
-    f->kind = LF_LF_FOLDER_HCI;
+    f->kind = LF_LIGHTFIELD_FOLDER_HCI;
     int maxidx = -1, count = 0;
     const char *ext = NULL;
     for (size_t i = 0; i < ls->n; i++) {
@@ -321,7 +321,7 @@ static int scan_hci(const char *dir, const names *ls, lf_lf_folder *f, lf_error 
                                 dir, count, maxidx);
         f->nu = f->nv = side;
         f->layout.cams_x = f->layout.cams_y = side;
-        f->layout.have |= LF_LF_HAVE_CAMS;
+        f->layout.have |= LF_LIGHTFIELD_HAVE_CAMS;
     }
     int n = f->nu * f->nv;
     snprintf(f->pattern, sizeof f->pattern, "input_Cam%%03d.%s", ext);
@@ -362,9 +362,9 @@ static int scan_hci(const char *dir, const names *ls, lf_lf_folder *f, lf_error 
     return LF_OK;
 }
 
-static int scan_rowcol(const char *dir, const names *ls, lf_lf_folder *f, lf_error *err)
+static int scan_rowcol(const char *dir, const names *ls, lf_lightfield_folder *f, lf_error *err)
 {
-    f->kind = LF_LF_FOLDER_ROWCOL;
+    f->kind = LF_LIGHTFIELD_FOLDER_ROWCOL;
     int rmin = MAX_SIDE, cmin = MAX_SIDE, rmax = -1, cmax = -1, count = 0;
     const char *first = NULL;
     size_t first_prefix = 0;
@@ -397,7 +397,7 @@ static int scan_rowcol(const char *dir, const names *ls, lf_lf_folder *f, lf_err
     f->nv = rmax - rmin + 1, f->nu = cmax - cmin + 1;
     if (f->nu > MAX_SIDE || f->nv > MAX_SIDE)
         return lf_error_set(err, LF_ERR_PARSE, "%s: %d x %d views is too many", dir, f->nu, f->nv);
-    f->layout.cams_x = f->nu, f->layout.cams_y = f->nv, f->layout.have |= LF_LF_HAVE_CAMS;
+    f->layout.cams_x = f->nu, f->layout.cams_y = f->nv, f->layout.have |= LF_LIGHTFIELD_HAVE_CAMS;
     snprintf(f->pattern, sizeof f->pattern, "%.*s_RR_CC...%s (rows and columns from %d)", (int)first_prefix, first,
              strrchr(first, '.') ? strrchr(first, '.') : "", f->base);
     size_t n = (size_t)f->nu * f->nv;
@@ -431,18 +431,18 @@ static int scan_rowcol(const char *dir, const names *ls, lf_lf_folder *f, lf_err
     return LF_OK;
 }
 
-int lf_lf_folder_scan(const char *dir, lf_lf_folder *f, lf_error *err)
+int lf_lightfield_folder_scan(const char *dir, lf_lightfield_folder *f, lf_error *err)
 {
     memset(f, 0, sizeof *f);
-    lf_lf_layout_init(&f->layout);
-    f->layout.kind = LF_LF_CAMERA_ARRAY;
-    f->layout.have |= LF_LF_HAVE_KIND;
+    lf_lightfield_layout_init(&f->layout);
+    f->layout.kind = LF_LIGHTFIELD_CAMERA_ARRAY;
+    f->layout.have |= LF_LIGHTFIELD_HAVE_KIND;
     if (!(f->dir = strdup(dir)))
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     names ls;
     int rc = names_list(dir, &ls, err);
     if (rc) {
-        lf_lf_folder_free(f);
+        lf_lightfield_folder_free(f);
         return rc;
     }
     int hci = 0, cfg = 0, gt = 0;
@@ -463,13 +463,13 @@ int lf_lf_folder_scan(const char *dir, lf_lf_folder *f, lf_error *err)
         rc = hci || cfg ? scan_hci(dir, &ls, f, err) : scan_rowcol(dir, &ls, f, err);
     names_free(&ls);
     if (rc)
-        lf_lf_folder_free(f);
+        lf_lightfield_folder_free(f);
     return rc;
 }
 
 /* ---------- loading ---------- */
 
-int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_lightfield *lf, lf_error *err)
+int lf_lightfield_folder_load(const lf_lightfield_folder *f, const lf_lightfield_layout *flags, lf_lightfield *lf, lf_error *err)
 {
     memset(lf, 0, sizeof *lf);
     int n = f->nu * f->nv, rc = LF_OK;
@@ -483,19 +483,19 @@ int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_light
                             f->dir, f->cfg_w ? f->cfg_w : w, f->cfg_h ? f->cfg_h : h);
     }
     /* the folder's layout, completed with the view size, merged with the flags */
-    lf_lf_layout file = f->layout, lay;
-    file.tile_w = w, file.tile_h = h, file.have |= LF_LF_HAVE_TILE;
+    lf_lightfield_layout file = f->layout, lay;
+    file.tile_w = w, file.tile_h = h, file.have |= LF_LIGHTFIELD_HAVE_TILE;
     if (f->focal_mm > 0 && f->sensor_mm > 0) {
         double fpx = f->focal_mm / f->sensor_mm * (w > h ? w : h);
         file.fov_deg = 2 * atan(0.5 * (w < h ? w : h) / fpx) * 180 / M_PI;
-        file.have |= LF_LF_HAVE_FOV;
+        file.have |= LF_LIGHTFIELD_HAVE_FOV;
     }
-    if ((flags && (flags->have & LF_LF_HAVE_KIND) && flags->kind != LF_LF_CAMERA_ARRAY)) {
+    if ((flags && (flags->have & LF_LIGHTFIELD_HAVE_KIND) && flags->kind != LF_LIGHTFIELD_CAMERA_ARRAY)) {
         lf_image_free(&first);
         return lf_error_set(err, LF_ERR_PARAM, "%s: a folder of views is a camera array (--kind plenoptic given)",
                             f->dir);
     }
-    if ((rc = lf_lf_layout_resolve(&file, flags, w * f->nu, h * f->nv, &lay, err))) {
+    if ((rc = lf_lightfield_layout_resolve(&file, flags, w * f->nu, h * f->nv, &lay, err))) {
         lf_image_free(&first);
         return rc;
     }
@@ -504,7 +504,7 @@ int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_light
         return lf_error_set(err, LF_ERR_PARAM, "%s: --tilesize %d %d contradicts the views' size %d x %d", f->dir,
                             lay.tile_w, lay.tile_h, w, h);
     }
-    if ((rc = lf_lf_alloc(lf, f->nu, f->nv, w, h, err))) {
+    if ((rc = lf_lightfield_alloc(lf, f->nu, f->nv, w, h, err))) {
         lf_image_free(&first);
         return rc;
     }
@@ -555,16 +555,16 @@ int lf_lf_folder_load(const lf_lf_folder *f, const lf_lf_layout *flags, lf_light
         rc = lf_error_set(err, LF_ERR_PARSE, "%s: views differ in size: %s is %d x %d, but %s%s", f->dir, f->files[0],
                           w, h, odd, nodd > 4 ? " ..." : "");
     if (rc) {
-        lf_lf_free(lf);
+        lf_lightfield_free(lf);
         return rc;
     }
-    lf_lf_set_geometry(lf, &lay);
+    lf_lightfield_set_geometry(lf, &lay);
     return LF_OK;
 }
 
 /* ---------- writing the HCI layout ---------- */
 
-int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
+int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
 {
     if (mkdir(dir, 0777) && errno != EEXIST)
         return lf_error_set(err, LF_ERR_IO, "cannot create the folder '%s': %s", dir, strerror(errno));
@@ -572,7 +572,7 @@ int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *di
     int rc = LF_OK;
     for (int iv = 0; iv < lf->nv && !rc; iv++)
         for (int iu = 0; iu < lf->nu && !rc; iu++) {
-            lf_image v = {lf->ns, lf->nt, 3, lf_lf_view(lf, iu, iv)};
+            lf_image v = {lf->ns, lf->nt, 3, lf_lightfield_view(lf, iu, iv)};
             snprintf(path, sizeof path, "%s/input_Cam%03d.png", dir, iv * lf->nu + iu);
             rc = lf_image_write(path, &v, NULL, NULL, err);
         }
@@ -583,7 +583,7 @@ int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *di
     if (rc)
         return rc;
     /* parameters.cfg, written beside and renamed into place */
-    const lf_lf_layout *y = &lf->layout;
+    const lf_lightfield_layout *y = &lf->layout;
     char tmp[4200];
     snprintf(path, sizeof path, "%s/parameters.cfg", dir);
     snprintf(tmp, sizeof tmp, "%s/.parameters.cfg.tmp", dir);
@@ -592,7 +592,7 @@ int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *di
         return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", tmp, strerror(errno));
     int wide = lf->ns > lf->nt ? lf->ns : lf->nt, narrow = lf->ns < lf->nt ? lf->ns : lf->nt;
     fprintf(f, "[intrinsics]\n");
-    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_FOV)) {
+    if (y->kind == LF_LIGHTFIELD_CAMERA_ARRAY && (y->have & LF_LIGHTFIELD_HAVE_FOV)) {
         /* HCI: focal length and the sensor size across the longer side, in mm;
          * a 35 mm sensor, the focal length giving the same focal length in pixels */
         double fpx = 0.5 * narrow / tan(y->fov_deg * M_PI / 360);
@@ -601,15 +601,15 @@ int lf_lf_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *di
     }
     fprintf(f, "image_resolution_x_px = %d\nimage_resolution_y_px = %d\n", lf->ns, lf->nt);
     fprintf(f, "\n[extrinsics]\nnum_cams_x = %d\nnum_cams_y = %d\n", lf->nu, lf->nv);
-    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_BOUNDS) && lf->nu > 1)
+    if (y->kind == LF_LIGHTFIELD_CAMERA_ARRAY && (y->have & LF_LIGHTFIELD_HAVE_BOUNDS) && lf->nu > 1)
         fprintf(f, "baseline_mm = %.7g\n", 1000 * (y->grid_bounds[1] - y->grid_bounds[0]) / (lf->nu - 1));
-    if (y->kind == LF_LF_CAMERA_ARRAY && (y->have & LF_LF_HAVE_CONVERGENCE))
+    if (y->kind == LF_LIGHTFIELD_CAMERA_ARRAY && (y->have & LF_LIGHTFIELD_HAVE_CONVERGENCE))
         fprintf(f, "focus_distance_m = %.9g\n", y->convergence_m);
     fprintf(f, "\n[meta]\nsource = lensfield (lftool decode --layout hci)\n");
-    if (y->kind == LF_LF_PLENOPTIC)
+    if (y->kind == LF_LIGHTFIELD_PLENOPTIC)
         fprintf(f, "# plenoptic capture: views are sub-aperture images; disparity 0 at the main lens's focus\n");
     double dmin = y->disp_min, dmax = y->disp_max;
-    int have = (y->have & LF_LF_HAVE_DISP_RANGE) != 0;
+    int have = (y->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) != 0;
     if (disparity) {
         /* the range of the ground truth itself */
         dmin = INFINITY, dmax = -INFINITY;

@@ -24,7 +24,7 @@
 /* Kaiser-Bessel kernel width (taps) and table size */
 enum { KB_WIDTH = 4, KB_TABLE = 4096 };
 
-struct lf_lf_fourier {
+struct lf_lightfield_fourier {
     int ns, nt, Ps, Pt, Pu, Pv, nu, nv;
     double cu, cv;     /* half-integer part of the centred view coordinates */
     double wsum;       /* sum of aperture weights */
@@ -89,7 +89,7 @@ static int next_pow2(int n)
 
 /* In-place radix-2 FFT of n complex floats with stride (in complex units).
  * sign -1 forward, +1 inverse (unnormalised). */
-void lf_lf_fft1d(float *a, int n, int stride, int sign)
+void lf_lightfield_fft1d(float *a, int n, int stride, int sign)
 {
     for (int i = 1, j = 0; i < n; i++) {
         int bit = n >> 1;
@@ -120,15 +120,15 @@ void lf_lf_fft1d(float *a, int n, int stride, int sign)
     }
 }
 
-void lf_lf_fft2d(float *a, int w, int h, int sign)
+void lf_lightfield_fft2d(float *a, int w, int h, int sign)
 {
     for (int y = 0; y < h; y++)
-        lf_lf_fft1d(a + 2 * (size_t)y * w, w, 1, sign);
+        lf_lightfield_fft1d(a + 2 * (size_t)y * w, w, 1, sign);
     for (int x = 0; x < w; x++)
-        lf_lf_fft1d(a + 2 * (size_t)x, h, w, sign);
+        lf_lightfield_fft1d(a + 2 * (size_t)x, h, w, sign);
 }
 
-int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, double oversample, lf_lf_fourier **out,
+int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refocus_opts *ap, double oversample, lf_lightfield_fourier **out,
                       lf_error *err)
 {
     *out = NULL;
@@ -138,10 +138,10 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
                             lf->missing);
     if (!(oversample >= 1))
         oversample = 2;
-    lf_lf_refocus_opts def = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts def = lf_lightfield_refocus_defaults();
     if (!ap)
         ap = &def;
-    lf_lf_fourier *f = calloc(1, sizeof *f);
+    lf_lightfield_fourier *f = calloc(1, sizeof *f);
     if (!f)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     f->ns = lf->ns, f->nt = lf->nt, f->nu = lf->nu, f->nv = lf->nv;
@@ -160,7 +160,7 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
     float *buf = malloc(sizeof(float) * 2 * (size_t)f->Ps * f->Pt);
     f->S = malloc(sizeof(float) * 2 * nfreq * cell);
     if (!Lhat || !buf || !f->S) {
-        free(Lhat), free(buf), lf_lf_fourier_release(f);
+        free(Lhat), free(buf), lf_lightfield_fourier_release(f);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the 4D spectrum (%.0f MB)",
                             sizeof(float) * 2.0 * nfreq * cell / 1e6);
     }
@@ -169,13 +169,13 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
     f->cu = (lf->nu - 1) / 2.0 - ou, f->cv = (lf->nv - 1) / 2.0 - ov; /* u_c = u_i - cu... see slice */
     double *au = malloc(sizeof(double) * (size_t)nviews);
     if (!au) {
-        free(Lhat), free(buf), lf_lf_fourier_release(f);
+        free(Lhat), free(buf), lf_lightfield_fourier_release(f);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     f->wsum = 0;
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
-            lf_lf_refocus_opts o = *ap;
+            lf_lightfield_refocus_opts o = *ap;
             double w = 1;
             if (o.u1 >= 0 && (iu < o.u0 || iu > o.u1))
                 w = 0;
@@ -190,7 +190,7 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
             au[iv * lf->nu + iu] = w / (kb_hat((double)(iu - ou) / f->Pu, f->beta) * kb_hat((double)(iv - ov) / f->Pv, f->beta));
         }
     if (f->wsum == 0) {
-        free(au), free(Lhat), free(buf), lf_lf_fourier_release(f);
+        free(au), free(Lhat), free(buf), lf_lightfield_fourier_release(f);
         return lf_error_set(err, LF_ERR_PARAM, "the synthetic aperture selects no view");
     }
     /* per-view 2D FFTs, half spectrum kept */
@@ -201,7 +201,7 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
             for (int t = 0; t < lf->nt; t++)
                 for (int s = 0; s < lf->ns; s++)
                     buf[2 * ((size_t)t * f->Ps + s)] = view[((size_t)t * lf->ns + s) * 3 + ch];
-            lf_lf_fft2d(buf, f->Ps, f->Pt, -1);
+            lf_lightfield_fft2d(buf, f->Ps, f->Pt, -1);
             float *dst = Lhat + 2 * nfreq * ((size_t)vi * 3 + ch);
             for (int kt = 0; kt < f->Pt; kt++)
                 memcpy(dst + 2 * (size_t)kt * hs, buf + 2 * (size_t)kt * f->Ps, sizeof(float) * 2 * hs);
@@ -211,7 +211,7 @@ int lf_lf_fourier_new(const lf_lightfield *lf, const lf_lf_refocus_opts *ap, dou
     double *tw_u = malloc(sizeof(double) * 2 * f->Pu * lf->nu), *tw_v = malloc(sizeof(double) * 2 * f->Pv * lf->nv);
     double *tmp = malloc(sizeof(double) * 2 * f->Pu * lf->nv);
     if (!tw_u || !tw_v || !tmp) {
-        free(tw_u), free(tw_v), free(tmp), free(au), free(Lhat), free(buf), lf_lf_fourier_release(f);
+        free(tw_u), free(tw_v), free(tmp), free(au), free(Lhat), free(buf), lf_lightfield_fourier_release(f);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     for (int m = 0; m < f->Pu; m++)
@@ -262,7 +262,7 @@ static int wrap(int j, int n)
     return j < 0 ? j + n : j;
 }
 
-int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disp, lf_image *out, lf_error *err)
+int lf_lightfield_fourier_refocus(const lf_lightfield_fourier *f, double disp, lf_image *out, lf_error *err)
 {
     if (!isfinite(disp))
         return lf_error_set(err, LF_ERR_PARAM, "disparity must be finite");
@@ -316,7 +316,7 @@ int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disp, lf_image *out, lf
                 float *d = p + 2 * ((size_t)kt * f->Ps + ks);
                 d[0] = q[0], d[1] = -q[1];
             }
-        lf_lf_fft2d(p, f->Ps, f->Pt, +1);
+        lf_lightfield_fft2d(p, f->Ps, f->Pt, +1);
     }
     if (lf_image_alloc(out, f->ns, f->nt, 3, err)) {
         free(spec);
@@ -331,7 +331,7 @@ int lf_lf_fourier_refocus(const lf_lf_fourier *f, double disp, lf_image *out, lf
     return LF_OK;
 }
 
-void lf_lf_fourier_release(lf_lf_fourier *f)
+void lf_lightfield_fourier_release(lf_lightfield_fourier *f)
 {
     if (!f)
         return;

@@ -7,7 +7,7 @@
 #include "half_internal.h"
 #include "lf_lightfield.h"
 
-uint16_t lf_lf_float_to_half(float f)
+uint16_t lf_lightfield_float_to_half(float f)
 {
     uint32_t x;
     memcpy(&x, &f, 4);
@@ -33,7 +33,7 @@ uint16_t lf_lf_float_to_half(float f)
     return (uint16_t)(sign | h);
 }
 
-float lf_lf_half_to_float(uint16_t h)
+float lf_lightfield_half_to_float(uint16_t h)
 {
     uint32_t sign = (uint32_t)(h & 0x8000u) << 16, e = (h >> 10) & 0x1fu, m = h & 0x3ffu, x;
     if (e == 0) {
@@ -55,7 +55,7 @@ float lf_lf_half_to_float(uint16_t h)
     return f;
 }
 
-int lf_lf_make_half(lf_lightfield *lf, lf_error *err)
+int lf_lightfield_make_half(lf_lightfield *lf, lf_error *err)
 {
     size_t n = (size_t)lf->nu * lf->nv * lf->ns * lf->nt * 3;
     if (!lf->half) {
@@ -65,7 +65,7 @@ int lf_lf_make_half(lf_lightfield *lf, lf_error *err)
     }
     size_t overflow = 0;
     for (size_t i = 0; i < n; i++) {
-        lf->half[i] = lf_lf_float_to_half(lf->data[i]);
+        lf->half[i] = lf_lightfield_float_to_half(lf->data[i]);
         overflow += (lf->half[i] & 0x7c00u) == 0x7c00u && isfinite(lf->data[i]);
     }
     if (overflow) {

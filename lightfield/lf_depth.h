@@ -1,9 +1,9 @@
 /* lf_depth.h - disparity from a 4D light field and depth-based view synthesis.
  *
- *   lf_lf_depth_opts o = lf_lf_depth_defaults();   // range from the data
+ *   lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();   // range from the data
  *   o.d0 = -1.7, o.d1 = 0.7;                        // or a known range
  *   lf_image disp, conf; lf_error err = {0};
- *   if (lf_lf_depth(&lf, &o, &disp, &conf, &err)) fail(err.msg);
+ *   if (lf_lightfield_depth(&lf, &o, &disp, &conf, &err)) fail(err.msg);
  *
  * Disparity d of the reference view (iu, iv) = ((nu-1)/2, (nv-1)/2) (integer
  * division: the centre view of an odd grid) in pixels per view step, as in
@@ -38,7 +38,7 @@
 extern "C" {
 #endif
 
-typedef struct lf_lf_depth_opts {
+typedef struct lf_lightfield_depth_opts {
     double d0, d1;       /* disparity search range (px per view); d0 >= d1: estimate from the data */
     double step;         /* label spacing (px per view); <= 0: auto (about 0.05 px shift at the widest view) */
     int radius;          /* guided-filter radius (px); <= 0: auto (shorter side / 128, at least 2) */
@@ -52,12 +52,12 @@ typedef struct lf_lf_depth_opts {
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
     int threads;         /* <= 0: 2 */
-} lf_lf_depth_opts;
-lf_lf_depth_opts lf_lf_depth_defaults(void);
+} lf_lightfield_depth_opts;
+lf_lightfield_depth_opts lf_lightfield_depth_defaults(void);
 
 /* Disparity map (1 channel) and, when confidence is non-NULL, a confidence
  * map in [0, 1] (1: a single sharp cost minimum).  Needs at least 2 views. */
-int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *disparity, lf_image *confidence,
+int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, lf_image *disparity, lf_image *confidence,
                 lf_error *err);
 
 /* The disparity range the scene occupies, estimated by a coarse sweep at
@@ -65,11 +65,11 @@ int lf_lf_depth(const lf_lightfield *lf, const lf_lf_depth_opts *o, lf_image *di
  * quarter of the view size at the outermost view, at most 8 px per view),
  * kept to the confident pixels' 1st..99th percentile and padded by 5% and
  * one coarse step.  *d0 < *d1 on success. */
-int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
+int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
 
 /* A view at centred view coordinates (u, v) inside the captured aperture
  * with per-pixel geometry: a disparity map of the reference view (given, or
- * estimated with lf_lf_depth) is forward-warped to (u, v) with a z-buffer
+ * estimated with lf_lightfield_depth) is forward-warped to (u, v) with a z-buffer
  * (nearer disparities win).  Every pixel of the views within 3 view steps
  * that sees the point (its own warped depth agrees, no nearer surface
  * within a pixel) lands at a sub-pixel offset from the target pixel; a
@@ -79,10 +79,10 @@ int lf_lf_depth_range(const lf_lightfield *lf, int threads, double *d0, double *
  * distance and resampling phase.  Where confidence is low or no view sees
  * the point the plane at plane_disparity is used.  At a view position it
  * returns that view exactly. */
-typedef struct lf_lf_view_opts {
-    const lf_image *disparity;  /* NULL: estimated (lf_lf_depth with depth) */
+typedef struct lf_lightfield_view_opts {
+    const lf_image *disparity;  /* NULL: estimated (lf_lightfield_depth with depth) */
     const lf_image *confidence; /* NULL with a given disparity: all 1 */
-    lf_lf_depth_opts depth;
+    lf_lightfield_depth_opts depth;
     double plane_disparity;     /* fallback plane */
     double min_confidence;      /* below it the plane takes over gradually; < 0: 0.05 */
     double radius;              /* source views: tent of this radius in view steps, at most 4;
@@ -91,9 +91,9 @@ typedef struct lf_lf_view_opts {
     double kernel;              /* fit: Gaussian sigma in px; <= 0: 0.35 */
     double phase_floor;         /* blend: resampling-phase weight 1/(fx(1-fx)+fy(1-fy)+floor); < 0: 0.05; 0: off */
     int threads;
-} lf_lf_view_opts;
-lf_lf_view_opts lf_lf_view_defaults(void);
-int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_view_opts *o, lf_image *out,
+} lf_lightfield_view_opts;
+lf_lightfield_view_opts lf_lightfield_view_defaults(void);
+int lf_lightfield_view_depth(const lf_lightfield *lf, double u, double v, const lf_lightfield_view_opts *o, lf_image *out,
                      lf_error *err);
 
 /* Self-calibration of the views' effective positions (real captures: a
@@ -104,14 +104,14 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
  * (iv - iv_ref) r), (ox, oy) a constant pixel offset.  Fitted robustly to
  * the measured shifts of textured tiles of near-constant disparity
  * (docs/depth.md); a view with fewer than 8 usable tiles keeps its nominal
- * position.  Stores the result in lf->view_shift, which lf_lf_depth and
- * lf_lf_view_depth then use.  report (may be NULL): 6 doubles per view
+ * position.  Stores the result in lf->view_shift, which lf_lightfield_depth and
+ * lf_lightfield_view_depth then use.  report (may be NULL): 6 doubles per view
  * (su, sv, ox, oy, tiles used, rms residual px; NaN offsets when not fitted). */
-int lf_lf_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf_image *confidence, int threads,
+int lf_lightfield_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf_image *confidence, int threads,
                           double *report, lf_error *err);
 /* (su, sv, ox, oy) of the viewpoint at fractional view indices (fu, fv):
  * nominal without calibration, else interpolated between the views. */
-void lf_lf_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4]);
+void lf_lightfield_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4]);
 
 #ifdef __cplusplus
 }

@@ -4,11 +4,11 @@
  * views' size; writing views, mosaics and focal stacks.  Errors name the
  * file; nothing is printed (warnings come back as counts or flags).
  *
- *   lf_lf_source src; lf_error err = {0};
- *   lf_lf_open_opts oo = {.flags = &flags};
- *   if (lf_lf_open("raw.exr", &oo, &src, &err)) ... err.msg ...;
+ *   lf_lightfield_source src; lf_error err = {0};
+ *   lf_lightfield_open_opts oo = {.flags = &flags};
+ *   if (lf_lightfield_open("raw.exr", &oo, &src, &err)) ... err.msg ...;
  *   ... src.lf ...
- *   lf_lf_close(&src);
+ *   lf_lightfield_close(&src);
  */
 #ifndef LF_SOURCE_H
 #define LF_SOURCE_H
@@ -19,72 +19,72 @@
 extern "C" {
 #endif
 
-typedef struct lf_lf_source {
-    const char *path;     /* as given to lf_lf_open (not copied) */
+typedef struct lf_lightfield_source {
+    const char *path;     /* as given to lf_lightfield_open (not copied) */
     lf_image raw;         /* the raw image (empty for a folder) */
     lf_attrs attrs;       /* its attributes */
-    lf_lf_layout layout;  /* the resolved layout */
+    lf_lightfield_layout layout;  /* the resolved layout */
     lf_lightfield lf;     /* the decoded light field (empty when layout_only) */
-    lf_lf_folder folder;  /* a folder of views when folder.dir != NULL */
+    lf_lightfield_folder folder;  /* a folder of views when folder.dir != NULL */
     size_t raw_nonfinite; /* the raw's NaN/Inf values */
-} lf_lf_source;
+} lf_lightfield_source;
 
-typedef struct lf_lf_open_opts {
-    const lf_lf_layout *flags; /* explicit layout (may be NULL) */
+typedef struct lf_lightfield_open_opts {
+    const lf_lightfield_layout *flags; /* explicit layout (may be NULL) */
     const char *white;         /* raws: divide by this white image (NULL: none) */
     int allow_nonfinite;       /* NaN/Inf samples become missing instead of failing */
     int layout_only;           /* raws: resolve the layout, do not decode (nor check values) */
-    int no_equalize;           /* folders: keep the views' brightness as read (no lf_lf_equalize) */
-} lf_lf_open_opts;
+    int no_equalize;           /* folders: keep the views' brightness as read (no lf_lightfield_equalize) */
+} lf_lightfield_open_opts;
 
 /* Reads a raw or a folder of views (every view is read, even with
  * layout_only, so a missing view is reported at once).  Fails with
  * LF_ERR_NUMERIC on non-finite values unless allow_nonfinite; on failure
  * *src is left empty.  src->lf.nonfinite counts the excluded samples. */
-int lf_lf_open(const char *path, const lf_lf_open_opts *o, lf_lf_source *src, lf_error *err);
-void lf_lf_close(lf_lf_source *src); /* accepts a zeroed struct */
+int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_lightfield_source *src, lf_error *err);
+void lf_lightfield_close(lf_lightfield_source *src); /* accepts a zeroed struct */
 
 /* What `lftool info` says about a source: its kind, size and layout. */
-void lf_lf_source_describe(const lf_lf_source *src, char *buf, size_t n);
+void lf_lightfield_source_describe(const lf_lightfield_source *src, char *buf, size_t n);
 
 /* The centre view's ground-truth disparity (docs/lightfield-format.md,
  * "Disparity AOV"): a raw's lensfield:disparity_file (relative to the raw's
  * folder), decoded with the raw's layout, or a folder's gt_disp_lowres.pfm.
  * *gt stays empty when there is none; *no_centre is set (and *gt left empty)
  * when the view grid has no centre view (even count). */
-int lf_lf_source_gt_disparity(const lf_lf_source *src, lf_image *gt, int *no_centre, lf_error *err);
+int lf_lightfield_source_gt_disparity(const lf_lightfield_source *src, lf_image *gt, int *no_centre, lf_error *err);
 
 /* A disparity range the source states: a folder's disp_min/disp_max, else
  * the raw's lensfield:disp_min/max.  Returns a name for the source of the
  * range ("the folder's disp_min/disp_max", "lensfield:disp_min/max"), or
  * NULL (and 0 0) when it states none. */
-const char *lf_lf_source_disparity_range(const lf_lf_source *src, double *d0, double *d1);
+const char *lf_lightfield_source_disparity_range(const lf_lightfield_source *src, double *d0, double *d1);
 
 /* A 1-channel map of the views' size: the first channel of the image at
  * path, which must be ns x nt with finite values. */
-int lf_lf_read_map(const char *path, const lf_lightfield *lf, lf_image *map, lf_error *err);
+int lf_lightfield_read_map(const char *path, const lf_lightfield *lf, lf_image *map, lf_error *err);
 
 /* The folder dir (created when missing) gets every view as
  * view_ROW_COL.EXT and mosaic.EXT, the views tiled as the cameras sit. */
-int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
+int lf_lightfield_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
                       lf_error *err);
 
 /* The folder dir (created when missing) gets a focal stack: n >= 2 slices
  * stack_NNN.EXT refocused at disparities d0 .. d1 (o->disparity_px is
  * ignored), each with lensfield:refocus_disparity_px. */
-int lf_lf_write_stack(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
+int lf_lightfield_write_stack(const lf_lightfield *lf, const lf_lightfield_refocus_opts *o, double d0, double d1, int n,
                       const char *dir, const char *ext, const lf_write_opts *wo, lf_error *err);
 
 /* Writes a refocused image with lensfield:refocus_disparity_px, the
  * disparity (px per view step) it is focused at. */
-int lf_lf_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
+int lf_lightfield_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
                           lf_error *err);
 
 /* Writes the centre view's disparity map disp (1 channel, searched over
  * [d0, d1]): EXR/PFM get the values, with lensfield:disparity_search_range
  * and lensfield:disparity_convention; PNG/JPEG a picture of them, the
  * colour map over [d0, d1] with its legend (lf_image_colormap). */
-int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
+int lf_lightfield_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
                           lf_error *err);
 
 /* Ng 2005's range of exact refocusing of a plenoptic capture
@@ -92,20 +92,20 @@ int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, dou
  * and describes the range in buf ("Ng 2005: |disparity| <= 1 px/view,
  * alpha A0 .. A1, depths Z0 m .. Z1") when disparity d is outside it; 0 when
  * it is inside or the light field has no alpha (not plenoptic). */
-int lf_lf_refocus_outside(const lf_lightfield *lf, double d, char *buf, size_t n);
+int lf_lightfield_refocus_outside(const lf_lightfield *lf, double d, char *buf, size_t n);
 
 /* Which camera fields of a CS348B synth camera the caller set; the others
- * come from the light field (lf_lf_synth_prepare). */
+ * come from the light field (lf_lightfield_synth_prepare). */
 enum {
-    LF_LF_SYNTH_SET_FOV = 1u << 0,   /* else the data cameras' fov */
-    LF_LF_SYNTH_SET_SIZE = 1u << 1,  /* else the views' size */
-    LF_LF_SYNTH_SET_POS = 1u << 2,   /* else the grid's centre */
-    LF_LF_SYNTH_SET_FOCAL = 1u << 3  /* else the data cameras' focal distance when the layout has one */
+    LF_LIGHTFIELD_SYNTH_SET_FOV = 1u << 0,   /* else the data cameras' fov */
+    LF_LIGHTFIELD_SYNTH_SET_SIZE = 1u << 1,  /* else the views' size */
+    LF_LIGHTFIELD_SYNTH_SET_POS = 1u << 2,   /* else the grid's centre */
+    LF_LIGHTFIELD_SYNTH_SET_FOCAL = 1u << 3  /* else the data cameras' focal distance when the layout has one */
 };
 /* Checks that lf is a camera array with the geometry synth needs (the
  * message names each missing attribute and its flag) and fills the fields
  * of *s not in `set`. */
-int lf_lf_synth_prepare(const lf_lightfield *lf, unsigned set, lf_lf_synth_opts *s, lf_error *err);
+int lf_lightfield_synth_prepare(const lf_lightfield *lf, unsigned set, lf_lightfield_synth_opts *s, lf_error *err);
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,5 @@
 /* Photometric equalisation of a folder's views against the centre view
- * (lf_lf_equalize, docs/lightfield-format.md "Vignetted views").
+ * (lf_lightfield_equalize, docs/lightfield-format.md "Vignetted views").
  *
  * Decoded plenoptic captures (Lytro sets written as one PNG per view) keep
  * the main lens's vignetting: the views near the rim of the aperture are
@@ -161,7 +161,7 @@ static double ratio_spread(const double *cm, const double *vm, size_t ncell, dou
     return tmp[n / 2];
 }
 
-int lf_lf_equalize(lf_lightfield *lf, lf_error *err)
+int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err)
 {
     lf->views_rescaled = lf->views_dark = 0;
     lf->gain_lo = lf->gain_hi = 1;
@@ -187,13 +187,13 @@ int lf_lf_equalize(lf_lightfield *lf, lf_error *err)
     double *cm = means, *vm = means + 4 * ncell; /* per cell: r g b sums and the valid count */
     double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
     const float *refv = lf->valid ? lf->valid + ((size_t)iv0 * lf->nu + iu0) * np : NULL;
-    integral(lf_lf_view(lf, iu0, iv0), refv, ns, nt, ir);
+    integral(lf_lightfield_view(lf, iu0, iv0), refv, ns, nt, ir);
     int rc = LF_OK;
     for (int k = 0; k < lf->nu * lf->nv && !rc; k++) {
         int iu = k % lf->nu, iv = k / lf->nu;
         if (iu == iu0 && iv == iv0)
             continue;
-        float *view = lf_lf_view(lf, iu, iv);
+        float *view = lf_lightfield_view(lf, iu, iv);
         integral(view, lf->valid ? lf->valid + (size_t)k * np : NULL, ns, nt, iv_);
         /* the parallax first: the whole-pixel shift of one disparity d,
          * (-d du, -d dv), that makes the cells' brightness ratios most alike,

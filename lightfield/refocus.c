@@ -14,9 +14,9 @@
 #define LF_HAVE_F16C_PATH 1
 #endif
 
-lf_lf_refocus_opts lf_lf_refocus_defaults(void)
+lf_lightfield_refocus_opts lf_lightfield_refocus_defaults(void)
 {
-    lf_lf_refocus_opts o;
+    lf_lightfield_refocus_opts o;
     memset(&o, 0, sizeof o);
     o.aperture_radius = -1;
     o.u1 = o.v1 = -1;
@@ -24,7 +24,7 @@ lf_lf_refocus_opts lf_lf_refocus_defaults(void)
 }
 
 /* Synthetic-aperture weight of view (iu, iv): 1 inside the disk and window. */
-static float view_weight(const lf_lightfield *lf, const lf_lf_refocus_opts *o, int iu, int iv)
+static float view_weight(const lf_lightfield *lf, const lf_lightfield_refocus_opts *o, int iu, int iv)
 {
     if (o->u1 >= 0 && (iu < o->u0 || iu > o->u1))
         return 0.f;
@@ -106,8 +106,8 @@ __attribute__((target("avx2,fma,f16c"))) static void accumulate_row_half_f16c(fl
         }
     }
     for (; k < n; k++)
-        acc[k] += a * lf_lf_half_to_float(r0[k]) + b * lf_lf_half_to_float(r0[k + 3]) +
-                  c * lf_lf_half_to_float(r1[k]) + e * lf_lf_half_to_float(r1[k + 3]);
+        acc[k] += a * lf_lightfield_half_to_float(r0[k]) + b * lf_lightfield_half_to_float(r0[k + 3]) +
+                  c * lf_lightfield_half_to_float(r1[k]) + e * lf_lightfield_half_to_float(r1[k + 3]);
 }
 #endif
 
@@ -128,14 +128,14 @@ static void accumulate_row_half(float *restrict acc, const uint16_t *restrict r0
     }
 #endif
     for (int k = 0; k < n; k++)
-        acc[k] += a * lf_lf_half_to_float(r0[k]) + b * lf_lf_half_to_float(r0[k + 3]) +
-                  c * lf_lf_half_to_float(r1[k]) + e * lf_lf_half_to_float(r1[k + 3]);
+        acc[k] += a * lf_lightfield_half_to_float(r0[k]) + b * lf_lightfield_half_to_float(r0[k + 3]) +
+                  c * lf_lightfield_half_to_float(r1[k]) + e * lf_lightfield_half_to_float(r1[k + 3]);
 }
 
 /* one value of a view row, float or half */
 static inline float rowval(const view_shift *v, size_t i)
 {
-    return v->half ? lf_lf_half_to_float(v->half[i]) : v->data[i];
+    return v->half ? lf_lightfield_half_to_float(v->half[i]) : v->data[i];
 }
 
 /* Blocks [b0, b1) of BLOCK_ROWS rows (lf_parallel_for): every row sums the
@@ -210,15 +210,15 @@ static void refocus_blocks(void *ctx, int b0, int b1, int tid)
     }
 }
 
-int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image *out, lf_error *err)
+int lf_lightfield_refocus(const lf_lightfield *lf, const lf_lightfield_refocus_opts *o, lf_image *out, lf_error *err)
 {
-    lf_lf_refocus_opts def = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts def = lf_lightfield_refocus_defaults();
     if (!o)
         o = &def;
     if (!isfinite(o->disparity_px))
         return lf_error_set(err, LF_ERR_PARAM, "disparity must be finite");
     if (o->use_half && !lf->half)
-        return lf_error_set(err, LF_ERR_PARAM, "half-float refocusing needs lf_lf_make_half first");
+        return lf_error_set(err, LF_ERR_PARAM, "half-float refocusing needs lf_lightfield_make_half first");
     view_shift *vs = malloc(sizeof *vs * (size_t)lf->nu * lf->nv);
     if (!vs)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
@@ -233,7 +233,7 @@ int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image
             /* L(u, v, s - d u, t - d v) */
             double sx = -dx * (iu - (lf->nu - 1) / 2.0), sy = -dy * (iv - (lf->nv - 1) / 2.0);
             view_shift *v = &vs[n++];
-            v->data = lf_lf_view(lf, iu, iv);
+            v->data = lf_lightfield_view(lf, iu, iv);
             v->half = o->use_half ? lf->half + (v->data - lf->data) : NULL;
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * lf->ns * lf->nt : NULL;
             v->ix = (int)floor(sx), v->iy = (int)floor(sy);
@@ -269,7 +269,7 @@ int lf_lf_refocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, lf_image
  * clamped to the view; validity-weighted. Returns the weight used. */
 static float sample_view(const lf_lightfield *lf, int iu, int iv, double x, double y, float rgb[3])
 {
-    const float *d = lf_lf_view(lf, iu, iv);
+    const float *d = lf_lightfield_view(lf, iu, iv);
     const float *m = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * lf->ns * lf->nt : NULL;
     int x0 = (int)floor(x), y0 = (int)floor(y);
     float fx = (float)(x - x0), fy = (float)(y - y0);
@@ -291,7 +291,7 @@ static float sample_view(const lf_lightfield *lf, int iu, int iv, double x, doub
     return wsum;
 }
 
-int lf_lf_view_at(const lf_lightfield *lf, double u, double v, double disp, lf_image *out, lf_error *err)
+int lf_lightfield_view_at(const lf_lightfield *lf, double u, double v, double disp, lf_image *out, lf_error *err)
 {
     double fu = u + (lf->nu - 1) / 2.0, fv = v + (lf->nv - 1) / 2.0;
     if (!(fu >= -1e-9 && fu <= lf->nu - 1 + 1e-9 && fv >= -1e-9 && fv <= lf->nv - 1 + 1e-9))
@@ -354,7 +354,7 @@ static void contrast(const lf_image *img, float *out, int r)
     free(lap);
 }
 
-int lf_lf_allfocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double d0, double d1, int n,
+int lf_lightfield_allfocus(const lf_lightfield *lf, const lf_lightfield_refocus_opts *o, double d0, double d1, int n,
                    lf_image *allfocus, lf_image *disparity, lf_error *err)
 {
     if (n < 2)
@@ -368,12 +368,12 @@ int lf_lf_allfocus(const lf_lightfield *lf, const lf_lf_refocus_opts *o, double 
     }
     for (size_t i = 0; i < np; i++)
         best[i] = -1.f;
-    lf_lf_refocus_opts ro = o ? *o : lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts ro = o ? *o : lf_lightfield_refocus_defaults();
     int rc = LF_OK;
     for (int k = 0; k < n && !rc; k++) {
         ro.disparity_px = d0 + (d1 - d0) * k / (n - 1);
         lf_image slice;
-        if ((rc = lf_lf_refocus(lf, &ro, &slice, err)))
+        if ((rc = lf_lightfield_refocus(lf, &ro, &slice, err)))
             break;
         contrast(&slice, c, 2);
         for (size_t i = 0; i < np; i++)

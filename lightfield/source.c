@@ -11,62 +11,62 @@
 #include "../base/lf_file_write.h"
 #include "../base/lf_keys.h"
 
-void lf_lf_close(lf_lf_source *src)
+void lf_lightfield_close(lf_lightfield_source *src)
 {
-    lf_lf_free(&src->lf);
+    lf_lightfield_free(&src->lf);
     lf_image_free(&src->raw);
     lf_attrs_free(&src->attrs);
-    lf_lf_folder_free(&src->folder);
+    lf_lightfield_folder_free(&src->folder);
 }
 
 /* Fails (and empties src) with the message of e, prefixed by the path. */
-static int fail_named(lf_lf_source *src, const lf_error *e, lf_error *err)
+static int fail_named(lf_lightfield_source *src, const lf_error *e, lf_error *err)
 {
-    lf_lf_close(src);
+    lf_lightfield_close(src);
     return lf_error_set(err, e->code ? e->code : LF_ERR_INTERNAL, "%s: %s", src->path, e->msg);
 }
 
-static int nonfinite_error(lf_lf_source *src, size_t count, lf_error *err)
+static int nonfinite_error(lf_lightfield_source *src, size_t count, lf_error *err)
 {
-    lf_lf_close(src);
+    lf_lightfield_close(src);
     return lf_error_set(err, LF_ERR_NUMERIC,
                         "%s: %zu non-finite pixel values (NaN/Inf); pass --allow-nonfinite to treat them as missing "
                         "samples",
                         src->path, count);
 }
 
-static int open_folder(const lf_lf_open_opts *o, const lf_lf_layout *flags, lf_lf_source *src, lf_error *err)
+static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_layout *flags, lf_lightfield_source *src, lf_error *err)
 {
     if (o->white)
         return lf_error_set(err, LF_ERR_PARAM, "%s: --white applies to raws, not to a folder of views", src->path);
-    if (lf_lf_folder_scan(src->path, &src->folder, err) || lf_lf_folder_load(&src->folder, flags, &src->lf, err)) {
-        lf_lf_close(src);
+    if (lf_lightfield_folder_scan(src->path, &src->folder, err) || lf_lightfield_folder_load(&src->folder, flags, &src->lf, err)) {
+        lf_lightfield_close(src);
         return err ? err->code : LF_ERR_IO;
     }
     src->layout = src->lf.layout;
     if (src->lf.nonfinite && !o->allow_nonfinite)
         return nonfinite_error(src, src->lf.nonfinite, err);
     lf_error e = {0};
-    if (!o->no_equalize && lf_lf_equalize(&src->lf, &e))
+    if (!o->no_equalize && lf_lightfield_equalize(&src->lf, &e))
         return fail_named(src, &e, err);
     return LF_OK;
 }
 
-int lf_lf_open(const char *path, const lf_lf_open_opts *o, lf_lf_source *src, lf_error *err)
+int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_lightfield_source *src, lf_error *err)
 {
     memset(src, 0, sizeof *src);
     src->path = path;
-    lf_lf_layout none;
-    lf_lf_layout_init(&none);
-    const lf_lf_layout *flags = o->flags ? o->flags : &none;
-    if (lf_lf_is_folder(path))
+    lf_lightfield_layout none;
+    lf_lightfield_layout_init(&none);
+    const lf_lightfield_layout *flags = o->flags ? o->flags : &none;
+    if (lf_lightfield_is_folder(path))
         return open_folder(o, flags, src, err);
     if (lf_image_read(path, &src->raw, &src->attrs, err))
         return err ? err->code : LF_ERR_IO;
     lf_error e = {0};
-    lf_lf_layout file;
-    if (lf_lf_layout_from_attrs(&src->attrs, &file, &e) ||
-        lf_lf_layout_resolve(&file, flags, src->raw.width, src->raw.height, &src->layout, &e))
+    lf_lightfield_layout file;
+    if (lf_lightfield_layout_from_attrs(&src->attrs, &file, &e) ||
+        lf_lightfield_layout_resolve(&file, flags, src->raw.width, src->raw.height, &src->layout, &e))
         return fail_named(src, &e, err);
     src->raw_nonfinite = lf_image_count_nonfinite(&src->raw);
     if (o->layout_only)
@@ -75,24 +75,24 @@ int lf_lf_open(const char *path, const lf_lf_open_opts *o, lf_lf_source *src, lf
         return nonfinite_error(src, src->raw_nonfinite, err);
     lf_image white = {0};
     if (o->white && lf_image_read(o->white, &white, NULL, err)) {
-        lf_lf_close(src);
+        lf_lightfield_close(src);
         return err ? err->code : LF_ERR_IO;
     }
-    int rc = lf_lf_decode(&src->raw, &src->layout, o->white ? &white : NULL, &src->lf, &e);
+    int rc = lf_lightfield_decode(&src->raw, &src->layout, o->white ? &white : NULL, &src->lf, &e);
     lf_image_free(&white);
     return rc ? fail_named(src, &e, err) : LF_OK;
 }
 
-void lf_lf_source_describe(const lf_lf_source *src, char *buf, size_t n)
+void lf_lightfield_source_describe(const lf_lightfield_source *src, char *buf, size_t n)
 {
     char lay[2048];
-    lf_lf_layout_describe(&src->layout, lay, sizeof lay);
+    lf_lightfield_layout_describe(&src->layout, lay, sizeof lay);
     const lf_lightfield *lf = &src->lf;
-    const lf_lf_folder *f = &src->folder;
+    const lf_lightfield_folder *f = &src->folder;
     size_t k;
     if (f->dir) {
         k = (size_t)snprintf(buf, n, "%s: folder of %d x %d views (%s layout, %s)\n%s", src->path, lf->nu, lf->nv,
-                             f->kind == LF_LF_FOLDER_HCI ? "HCI" : "row/column", f->pattern, lay);
+                             f->kind == LF_LIGHTFIELD_FOLDER_HCI ? "HCI" : "row/column", f->pattern, lay);
         if (k < n && lf->disp_per_inv_m > 0)
             k += (size_t)snprintf(buf + k, n - k, "disparity %.6g + %.6g / depth px per view step\n", lf->disp_at_inf,
                                   lf->disp_per_inv_m);
@@ -116,7 +116,7 @@ void lf_lf_source_describe(const lf_lf_source *src, char *buf, size_t n)
         snprintf(buf + k, n - k, "non-finite pixel values: %zu\n", src->raw_nonfinite);
 }
 
-int lf_lf_source_gt_disparity(const lf_lf_source *src, lf_image *gt, int *no_centre, lf_error *err)
+int lf_lightfield_source_gt_disparity(const lf_lightfield_source *src, lf_image *gt, int *no_centre, lf_error *err)
 {
     memset(gt, 0, sizeof *gt);
     *no_centre = 0;
@@ -144,14 +144,14 @@ int lf_lf_source_gt_disparity(const lf_lf_source *src, lf_image *gt, int *no_cen
         rc = lf_error_set(&e, LF_ERR_PARAM, "%s is %d x %d, the raw %d x %d", path, raw.width, raw.height,
                           src->raw.width, src->raw.height);
     if (!rc)
-        rc = lf_lf_decode(&raw, &src->layout, NULL, &d, &e) || lf_image_alloc(gt, d.ns, d.nt, 1, &e);
+        rc = lf_lightfield_decode(&raw, &src->layout, NULL, &d, &e) || lf_image_alloc(gt, d.ns, d.nt, 1, &e);
     if (!rc) {
-        const float *v = lf_lf_view(&d, d.nu / 2, d.nv / 2);
+        const float *v = lf_lightfield_view(&d, d.nu / 2, d.nv / 2);
         for (size_t i = 0; i < (size_t)d.ns * d.nt; i++)
             gt->data[i] = v[i * 3];
     }
     lf_image_free(&raw);
-    lf_lf_free(&d);
+    lf_lightfield_free(&d);
     if (rc) {
         lf_image_free(gt);
         return lf_error_set(err, e.code ? e.code : LF_ERR_INTERNAL, "%s: disparity: %s", src->path, e.msg);
@@ -159,11 +159,11 @@ int lf_lf_source_gt_disparity(const lf_lf_source *src, lf_image *gt, int *no_cen
     return LF_OK;
 }
 
-const char *lf_lf_source_disparity_range(const lf_lf_source *src, double *d0, double *d1)
+const char *lf_lightfield_source_disparity_range(const lf_lightfield_source *src, double *d0, double *d1)
 {
-    const lf_lf_layout *lay = &src->lf.layout;
+    const lf_lightfield_layout *lay = &src->lf.layout;
     *d0 = *d1 = 0;
-    if ((lay->have & LF_LF_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
+    if ((lay->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
         *d0 = lay->disp_min, *d1 = lay->disp_max;
         return "the folder's disp_min/disp_max";
     }
@@ -178,7 +178,7 @@ const char *lf_lf_source_disparity_range(const lf_lf_source *src, double *d0, do
     return NULL;
 }
 
-int lf_lf_read_map(const char *path, const lf_lightfield *lf, lf_image *m, lf_error *err)
+int lf_lightfield_read_map(const char *path, const lf_lightfield *lf, lf_image *m, lf_error *err)
 {
     lf_image img;
     memset(m, 0, sizeof *m);
@@ -200,7 +200,7 @@ int lf_lf_read_map(const char *path, const lf_lightfield *lf, lf_image *m, lf_er
     return rc;
 }
 
-int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
+int lf_lightfield_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
                       lf_error *err)
 {
     if (lf_dir_create(dir, err))
@@ -208,7 +208,7 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
     char path[PATH_MAX];
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
-            lf_image v = {lf->ns, lf->nt, 3, lf_lf_view(lf, iu, iv)};
+            lf_image v = {lf->ns, lf->nt, 3, lf_lightfield_view(lf, iu, iv)};
             snprintf(path, sizeof path, "%s/view_%02d_%02d.%s", dir, iv, iu, ext); /* row, column */
             if (lf_image_write(path, &v, NULL, wo, err))
                 return err ? err->code : LF_ERR_IO;
@@ -220,7 +220,7 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++)
             for (int t = 0; t < lf->nt; t++)
-                memcpy(lf_image_px(&m, iu * lf->ns, iv * lf->nt + t), lf_lf_view(lf, iu, iv) + (size_t)t * lf->ns * 3,
+                memcpy(lf_image_px(&m, iu * lf->ns, iv * lf->nt + t), lf_lightfield_view(lf, iu, iv) + (size_t)t * lf->ns * 3,
                        sizeof(float) * 3 * lf->ns);
     snprintf(path, sizeof path, "%s/mosaic.%s", dir, ext);
     int rc = lf_image_write(path, &m, NULL, wo, err);
@@ -228,7 +228,7 @@ int lf_lf_write_views(const lf_lightfield *lf, const char *dir, const char *ext,
     return rc;
 }
 
-int lf_lf_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
+int lf_lightfield_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,
                           lf_error *err)
 {
     lf_attrs a = {0};
@@ -239,7 +239,7 @@ int lf_lf_write_refocused(const char *path, const lf_image *img, double disparit
     return rc;
 }
 
-int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
+int lf_lightfield_write_disparity(const char *path, const lf_image *disp, double d0, double d1, const lf_write_opts *wo,
                           lf_error *err)
 {
     int rc;
@@ -263,7 +263,7 @@ int lf_lf_write_disparity(const char *path, const lf_image *disp, double d0, dou
     return rc;
 }
 
-int lf_lf_refocus_outside(const lf_lightfield *lf, double d, char *buf, size_t n)
+int lf_lightfield_refocus_outside(const lf_lightfield *lf, double d, char *buf, size_t n)
 {
     if (lf->disp_per_alpha == 0 || !(fabs(d) > 1.0 + 1e-9))
         return 0;
@@ -283,28 +283,28 @@ int lf_lf_refocus_outside(const lf_lightfield *lf, double d, char *buf, size_t n
     return 1;
 }
 
-int lf_lf_synth_prepare(const lf_lightfield *lf, unsigned set, lf_lf_synth_opts *s, lf_error *err)
+int lf_lightfield_synth_prepare(const lf_lightfield *lf, unsigned set, lf_lightfield_synth_opts *s, lf_error *err)
 {
-    const lf_lf_layout *y = &lf->layout;
-    if (y->kind != LF_LF_CAMERA_ARRAY)
+    const lf_lightfield_layout *y = &lf->layout;
+    if (y->kind != LF_LIGHTFIELD_CAMERA_ARRAY)
         return lf_error_set(err, LF_ERR_PARAM, "synth needs a camera-array light field (lensfield:kind camera-array)");
     char missing[256] = "";
-    if (!(y->have & LF_LF_HAVE_BOUNDS))
+    if (!(y->have & LF_LIGHTFIELD_HAVE_BOUNDS))
         strcat(missing, " lensfield:camera_grid_bounds (--griddim minx maxx miny maxy)");
-    if (!(y->have & LF_LF_HAVE_FOV))
+    if (!(y->have & LF_LIGHTFIELD_HAVE_FOV))
         strcat(missing, " lensfield:fov_deg (--inputfov DEG)");
     if (missing[0])
         return lf_error_set(err, LF_ERR_PARAM, "synth needs:%s", missing);
-    if (!(set & LF_LF_SYNTH_SET_FOV))
+    if (!(set & LF_LIGHTFIELD_SYNTH_SET_FOV))
         s->fov_deg = y->fov_deg;
-    if (!(set & LF_LF_SYNTH_SET_SIZE))
+    if (!(set & LF_LIGHTFIELD_SYNTH_SET_SIZE))
         s->width = lf->ns, s->height = lf->nt;
-    if (!(set & LF_LF_SYNTH_SET_POS)) {
+    if (!(set & LF_LIGHTFIELD_SYNTH_SET_POS)) {
         s->pos[0] = 0.5 * (y->grid_bounds[0] + y->grid_bounds[1]);
         s->pos[1] = 0.5 * (y->grid_bounds[2] + y->grid_bounds[3]);
         s->pos[2] = 0;
     }
-    if (!(set & LF_LF_SYNTH_SET_FOCAL) && (y->have & LF_LF_HAVE_CAM_LENS) && y->focal_distance > 0)
+    if (!(set & LF_LIGHTFIELD_SYNTH_SET_FOCAL) && (y->have & LF_LIGHTFIELD_HAVE_CAM_LENS) && y->focal_distance > 0)
         s->focal_distance = y->focal_distance;
     return LF_OK;
 }

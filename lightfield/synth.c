@@ -18,9 +18,9 @@
 #include "../base/lf_parallel.h"
 #include "lf_lightfield.h"
 
-lf_lf_synth_opts lf_lf_synth_defaults(void)
+lf_lightfield_synth_opts lf_lightfield_synth_defaults(void)
 {
-    lf_lf_synth_opts o;
+    lf_lightfield_synth_opts o;
     memset(&o, 0, sizeof o);
     o.spp = 1;
     o.seed = 1;
@@ -34,7 +34,7 @@ enum { SYNTH_GROUPS = 4, SYNTH_BATCH = 4 * SYNTH_GROUPS }; /* samples set up bef
 
 typedef struct synth_ctx {
     const lf_lightfield *lf;
-    const lf_lf_synth_opts *o;
+    const lf_lightfield_synth_opts *o;
     double R[9];                   /* virtual camera to grid space */
     double in_tan, in_half;        /* data cameras: tan(fov/2), half shorter side (px) */
     double in_scale;               /* in_half / in_tan */
@@ -410,7 +410,7 @@ static float *strata_new(int spp)
 static void synth_rows(void *arg, int y0, int y1, int tid)
 {
     synth_ctx *c = arg;
-    const lf_lf_synth_opts *o = c->o;
+    const lf_lightfield_synth_opts *o = c->o;
     const int spp = o->spp > 0 ? o->spp : 1, spp4 = (spp + 3) & ~3;
     const int m = (int)ceil(sqrt((double)spp)), rows = (spp + m - 1) / m;
     const float u24 = 1.0f / 16777216.0f;
@@ -494,16 +494,16 @@ static void synth_rows(void *arg, int y0, int y1, int tid)
     }
 }
 
-int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *out, lf_image *coverage,
+int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts *o, lf_image *out, lf_image *coverage,
                 size_t *uncovered, lf_error *err)
 {
-    const lf_lf_layout *l = &lf->layout;
-    if (l->kind != LF_LF_CAMERA_ARRAY)
+    const lf_lightfield_layout *l = &lf->layout;
+    if (l->kind != LF_LIGHTFIELD_CAMERA_ARRAY)
         return lf_error_set(err, LF_ERR_PARAM, "synth needs a camera-array light field");
-    if (!(l->have & LF_LF_HAVE_BOUNDS) || !(l->have & LF_LF_HAVE_FOV))
+    if (!(l->have & LF_LIGHTFIELD_HAVE_BOUNDS) || !(l->have & LF_LIGHTFIELD_HAVE_FOV))
         return lf_error_set(err, LF_ERR_PARAM, "synth needs%s%s",
-                            (l->have & LF_LF_HAVE_BOUNDS) ? "" : " lensfield:camera_grid_bounds (--griddim minx maxx miny maxy)",
-                            (l->have & LF_LF_HAVE_FOV) ? "" : " lensfield:fov_deg (--inputfov DEG)");
+                            (l->have & LF_LIGHTFIELD_HAVE_BOUNDS) ? "" : " lensfield:camera_grid_bounds (--griddim minx maxx miny maxy)",
+                            (l->have & LF_LIGHTFIELD_HAVE_FOV) ? "" : " lensfield:fov_deg (--inputfov DEG)");
     if (o->width < 1 || o->height < 1 || !(o->fov_deg > 0 && o->fov_deg < 180) || !(l->fov_deg > 0 && l->fov_deg < 180))
         return lf_error_set(err, LF_ERR_PARAM, "synth: bad output size %dx%d or fov (out %g, in %g degrees)", o->width,
                             o->height, o->fov_deg, l->fov_deg);
@@ -518,7 +518,7 @@ int lf_lf_synth(const lf_lightfield *lf, const lf_lf_synth_opts *o, lf_image *ou
      * pixel would integrate a second time and blur (at a data camera's own
      * position, fov and size this reproduces the view exactly).  Larger
      * virtual pixels (minification) and lenses keep their samples. */
-    lf_lf_synth_opts centred;
+    lf_lightfield_synth_opts centred;
     {
         double out_px = tan(o->fov_deg * M_PI / 360) / (0.5 * (o->width < o->height ? o->width : o->height));
         double in_px = tan(l->fov_deg * M_PI / 360) / (0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt));

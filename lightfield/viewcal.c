@@ -17,7 +17,7 @@
 #include "lf_depth.h"
 #include "../base/lf_parallel.h"
 
-void lf_lf_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4])
+void lf_lightfield_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4])
 {
     int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
     double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
@@ -220,7 +220,7 @@ static void cal_views(void *vctx, int k0, int k1, int tid)
     free(td), free(use);
 }
 
-int lf_lf_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf_image *confidence, int threads,
+int lf_lightfield_calibrate_views(lf_lightfield *lf, const lf_image *disparity, const lf_image *confidence, int threads,
                           double *report, lf_error *err)
 {
     if (!lf || !lf->data || lf->nu * lf->nv < 2)

@@ -21,7 +21,7 @@
  *    shifted backgrounds (two_layer); with the blend, the candidates compete
  *    by photo-consistency (soft weights).
  * 4. Where the splatted confidence is low the result fades to the plane
- *    blend at plane_disparity (lf_lf_view_at). */
+ *    blend at plane_disparity (lf_lightfield_view_at). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -31,11 +31,11 @@
 #include "lf_depth.h"
 #include "../base/lf_parallel.h"
 
-lf_lf_view_opts lf_lf_view_defaults(void)
+lf_lightfield_view_opts lf_lightfield_view_defaults(void)
 {
-    lf_lf_view_opts o;
+    lf_lightfield_view_opts o;
     memset(&o, 0, sizeof o);
-    o.depth = lf_lf_depth_defaults();
+    o.depth = lf_lightfield_depth_defaults();
     o.min_confidence = -1;
     o.phase_floor = -1;
     return o;
@@ -209,7 +209,7 @@ static double fit_sigma(const vs_ctx *c, int x, int y, float d, double sigma, fl
         float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
         if (dk > dtol)
             continue;
-        const float *img = lf_lf_view(c->lf, c->iu[k], c->iv[k]);
+        const float *img = lf_lightfield_view(c->lf, c->iu[k], c->iv[k]);
         const float *valid = c->lf->valid ? c->lf->valid + ((size_t)c->iv[k] * c->lf->nu + c->iu[k]) * (size_t)w * h : NULL;
         int xc = (int)lrint(sx), yc = (int)lrint(sy);
         for (int j = yc - rad; j <= yc + rad; j++) {
@@ -316,7 +316,7 @@ static double blend_at(const vs_ctx *c, int x, int y, float d, float rgb[3], flo
         /* I_target(x, y) = I_k(x - d (u_k - u), y - d (v_k - v)) */
         double sx = x - d * c->du[k] + c->ox[k], sy = y - d * c->dv[k] + c->oy[k];
         float col[3];
-        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
+        sample(lf_lightfield_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
         float dk = c->ds[k][(size_t)clampi((int)lrint(sy), 0, h - 1) * w + clampi((int)lrint(sx), 0, w - 1)];
         double vis = dk > occluder_tol(d) ? 0.0 : 1.0;
         double inside = (sx < 0 || sy < 0 || sx > w - 1 || sy > h - 1) ? 0.1 : 1.0;
@@ -371,7 +371,7 @@ static int bg_at(const vs_ctx *c, double xf, double yf, float db, float rgb[3])
         if (c->dx[k][(size_t)lrint(sy) * w + lrint(sx)] > tol)
             continue;
         float col[3];
-        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
+        sample(lf_lightfield_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, col);
         for (int ch = 0; ch < 3; ch++)
             acc[ch] += c->wv[k] * col[ch];
         wsum += c->wv[k];
@@ -410,7 +410,7 @@ static int two_layer(const vs_ctx *c, int x, int y, float df, float db, const fl
         float I[3], B[3];
         if (!bg_at(c, x - (df - db) * c->du[k], y - (df - db) * c->dv[k], db, B))
             continue;
-        sample(lf_lf_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, I);
+        sample(lf_lightfield_view(c->lf, c->iu[k], c->iv[k]), w, h, sx, sy, I);
         double wk = c->wv[k];
         for (int ch = 0; ch < 3; ch++) {
             sI[ch] += wk * I[ch], sB[ch] += wk * B[ch];
@@ -492,10 +492,10 @@ static void vs_rows(void *vctx, int y0, int y1, int tid)
         }
 }
 
-int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_view_opts *o, lf_image *out,
+int lf_lightfield_view_depth(const lf_lightfield *lf, double u, double v, const lf_lightfield_view_opts *o, lf_image *out,
                      lf_error *err)
 {
-    lf_lf_view_opts def = lf_lf_view_defaults();
+    lf_lightfield_view_opts def = lf_lightfield_view_defaults();
     if (!o)
         o = &def;
     double fu = u + (lf->nu - 1) / 2.0, fv = v + (lf->nv - 1) / 2.0;
@@ -512,14 +512,14 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
                             o->confidence->height, w, h);
     /* exactly at a view: that view */
     if (fabs(fu - lrint(fu)) < 1e-9 && fabs(fv - lrint(fv)) < 1e-9)
-        return lf_lf_view_at(lf, u, v, 0.0, out, err);
+        return lf_lightfield_view_at(lf, u, v, 0.0, out, err);
     lf_image disp = {0}, conf = {0};
     int rc;
     if (!o->disparity) {
-        lf_lf_depth_opts dopt = o->depth;
+        lf_lightfield_depth_opts dopt = o->depth;
         if (dopt.threads <= 0)
             dopt.threads = o->threads;
-        if ((rc = lf_lf_depth(lf, &dopt, &disp, &conf, err)))
+        if ((rc = lf_lightfield_depth(lf, &dopt, &disp, &conf, err)))
             return rc;
     }
     const float *D = o->disparity ? o->disparity->data : disp.data;
@@ -537,7 +537,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     c.phase0 = o->phase_floor < 0 ? 0.05 : o->phase_floor;
     int rr = (int)ceil(R - 1e-9);
     double st[4]; /* the target's (su, sv, ox, oy) */
-    lf_lf_view_shift(lf, fu, fv, st);
+    lf_lightfield_view_shift(lf, fu, fv, st);
     for (int iv = (int)floor(fv) - rr + 1; iv <= (int)floor(fv) + rr; iv++)
         for (int iu = (int)floor(fu) - rr + 1; iu <= (int)floor(fu) + rr; iu++) {
             if (iu < 0 || iv < 0 || iu >= lf->nu || iv >= lf->nv || c.nsrc >= VS_MAXSRC)
@@ -545,12 +545,12 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
             double wu = 1 - fabs(iu - fu) / R, wvv = 1 - fabs(iv - fv) / R;
             if (wu <= 1e-9 || wvv <= 1e-9)
                 continue;
-            /* a view lf_lf_equalize brightened carries noise grown by 1 / gain: inverse-variance weight */
+            /* a view lf_lightfield_equalize brightened carries noise grown by 1 / gain: inverse-variance weight */
             double g = lf->view_gain ? lf->view_gain[(size_t)iv * lf->nu + iu] : 1.0;
             g = g < 1 ? g : 1;
             c.iu[c.nsrc] = iu, c.iv[c.nsrc] = iv, c.wv[c.nsrc] = wu * wvv * g * g;
             double sk[4];
-            lf_lf_view_shift(lf, iu, iv, sk);
+            lf_lightfield_view_shift(lf, iu, iv, sk);
             c.du[c.nsrc] = sk[0] - st[0], c.dv[c.nsrc] = sk[1] - st[1];
             c.ox[c.nsrc] = sk[2] - st[2], c.oy[c.nsrc] = sk[3] - st[3];
             c.nsrc++;
@@ -566,7 +566,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     for (int k = 0; k < c.nsrc && ok; k++) {
         float *dk = buf + (2 + (size_t)k) * np;
         double sk[4];
-        lf_lf_view_shift(lf, c.iu[k], c.iv[k], sk);
+        lf_lightfield_view_shift(lf, c.iu[k], c.iv[k], sk);
         ok = splat(D, NULL, w, h, sk[0], sk[1], sk[2], sk[3], dk, NULL);
         c.ds[k] = dk;
         float *dxk = buf + (2 + (size_t)c.nsrc + k) * np;
@@ -588,7 +588,7 @@ int lf_lf_view_depth(const lf_lightfield *lf, double u, double v, const lf_lf_vi
     }
     c.dt = dt, c.ct = ct;
     c.cmin = o->min_confidence < 0 ? 0.05f : (float)o->min_confidence;
-    if ((rc = lf_lf_view_at(lf, u, v, o->plane_disparity, &plane, err)) || (rc = lf_image_alloc(out, w, h, 3, err))) {
+    if ((rc = lf_lightfield_view_at(lf, u, v, o->plane_disparity, &plane, err)) || (rc = lf_image_alloc(out, w, h, 3, err))) {
         free(buf), lf_image_free(&plane), lf_image_free(&disp), lf_image_free(&conf);
         return rc ? rc : LF_ERR_NOMEM;
     }

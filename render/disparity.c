@@ -73,7 +73,7 @@ int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparit
             return lf_error_set(err, LF_ERR_PARAM,
                                 "disparity AOV: the camera array's attributes are incomplete (cameras_per_dim, "
                                 "tile_size, camera_grid_bounds, fov_deg)");
-        g->kind = LF_LF_CAMERA_ARRAY_KIND;
+        g->kind = LF_LIGHTFIELD_CAMERA_ARRAY_KIND;
         g->nx = (int)dims[0], g->ny = (int)dims[1], g->tw = (int)tile[0], g->th = (int)tile[1];
         if (g->nx < 1 || g->ny < 1 || g->tw < 1 || g->th < 1 || !(fov > 0 && fov < 180))
             return lf_error_set(err, LF_ERR_PARAM, "disparity AOV: bad camera-array attributes");
@@ -107,7 +107,7 @@ int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparit
                                 "offset, count and focal length, sensor size, main lens)");
         get_num(meta, LF_KEY_MICROLENS_ROTATION_RAD, &rot);
         get_num(meta, LF_KEY_SENSOR_OFFSET_MM, &g->sensor_offset_mm);
-        g->kind = LF_LF_PLENOPTIC_KIND;
+        g->kind = LF_LIGHTFIELD_PLENOPTIC_KIND;
         g->hex = grid && grid->type == LF_ATTR_STRING && !strcmp(grid->s, "hex");
         g->cos_r = cos(rot), g->sin_r = sin(rot);
         g->origin[0] = off[0], g->origin[1] = off[1];
@@ -134,7 +134,7 @@ static double grid_position(double lo, double hi, int k, int n)
 
 void lf_disparity_centre_ray(const lf_disparity_geom *g, double fx, double fy, double o[3], double d[3])
 {
-    if (g->kind == LF_LF_CAMERA_ARRAY_KIND) {
+    if (g->kind == LF_LIGHTFIELD_CAMERA_ARRAY_KIND) {
         int i = (int)floor(fx / g->tw), j = (int)floor(fy / g->th);
         i = i < 0 ? 0 : i >= g->nx ? g->nx - 1 : i;
         j = j < 0 ? 0 : j >= g->ny ? g->ny - 1 : j;

@@ -280,7 +280,7 @@ static inline lf_vec3 lf_offset_origin(lf_vec3 p, lf_vec3 ng, lf_vec3 w)
 
 /* ---- ground-truth disparity of light-field cameras (render/disparity.c) ---- */
 typedef struct lf_disparity_geom {
-    int kind; /* LF_LF_CAMERA_ARRAY_KIND or LF_LF_PLENOPTIC_KIND */
+    int kind; /* LF_LIGHTFIELD_CAMERA_ARRAY_KIND or LF_LIGHTFIELD_PLENOPTIC_KIND */
     int xres, yres;
     double a, b; /* d = a + b / Z */
     /* camera array */
@@ -291,7 +291,7 @@ typedef struct lf_disparity_geom {
     double pitch_px, row_px, cos_r, sin_r, origin[2], slope_per_px;
     double fmla_mm, sensor_offset_mm, zi_mm, f_mm;
 } lf_disparity_geom;
-enum { LF_LF_CAMERA_ARRAY_KIND = 1, LF_LF_PLENOPTIC_KIND = 2 };
+enum { LF_LIGHTFIELD_CAMERA_ARRAY_KIND = 1, LF_LIGHTFIELD_PLENOPTIC_KIND = 2 };
 /* From the camera's lensfield:* attributes; LF_ERR_PARAM for other cameras. */
 int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparity_geom *g, lf_error *err);
 /* Centre-view ray (camera space, unit direction) for the film point (fx, fy). */

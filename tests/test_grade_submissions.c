@@ -274,17 +274,17 @@ static void student_synth(const char *dir, const char *lfname, double lens_radiu
     lf_image raw;
     lf_attrs a = {0};
     lf_error err = {0};
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&flags);
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&flags);
     lf_lightfield lf;
     memset(&lf, 0, sizeof lf);
-    if (lf_image_read(p, &raw, &a, &err) || lf_lf_layout_from_attrs(&a, &file, &err) ||
-        lf_lf_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err) ||
-        lf_lf_decode(&raw, &lay, NULL, &lf, &err)) {
+    if (lf_image_read(p, &raw, &a, &err) || lf_lightfield_layout_from_attrs(&a, &file, &err) ||
+        lf_lightfield_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err) ||
+        lf_lightfield_decode(&raw, &lay, NULL, &lf, &err)) {
         CHECK_MSG(0, "student synth: %s", err.msg);
         return;
     }
-    lf_lf_synth_opts s = lf_lf_synth_defaults();
+    lf_lightfield_synth_opts s = lf_lightfield_synth_defaults();
     s.width = 96, s.height = 72, s.fov_deg = 30;
     s.pos[0] = 0.03, s.pos[1] = 0.05, s.pos[2] = 0;
     s.lens_radius = lens_radius;
@@ -292,12 +292,12 @@ static void student_synth(const char *dir, const char *lfname, double lens_radiu
     s.spp = 64;
     s.seed = 99;
     lf_image img;
-    if (!lf_lf_synth(&lf, &s, &img, NULL, NULL, &err)) {
+    if (!lf_lightfield_synth(&lf, &s, &img, NULL, NULL, &err)) {
         snprintf(p, sizeof p, "%s/%s", dir, out);
         lf_image_write(p, &img, NULL, NULL, &err);
         lf_image_free(&img);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
     lf_attrs_free(&a);
 }
@@ -312,27 +312,27 @@ static void student_refocus(const char *dir, const char *rawname, double d, doub
     lf_image raw;
     lf_attrs a = {0};
     lf_error err = {0};
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&flags);
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&flags);
     lf_lightfield lf;
     memset(&lf, 0, sizeof lf);
-    if (lf_image_read(p, &raw, &a, &err) || lf_lf_layout_from_attrs(&a, &file, &err) ||
-        lf_lf_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err) ||
-        lf_lf_decode(&raw, &lay, NULL, &lf, &err)) {
+    if (lf_image_read(p, &raw, &a, &err) || lf_lightfield_layout_from_attrs(&a, &file, &err) ||
+        lf_lightfield_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err) ||
+        lf_lightfield_decode(&raw, &lay, NULL, &lf, &err)) {
         CHECK_MSG(0, "student refocus: %s", err.msg);
         return;
     }
-    lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
     o.disparity_px = d;
     if (aperture >= 0)
         o.aperture_radius = aperture;
     lf_image img;
-    if (!lf_lf_refocus(&lf, &o, &img, &err)) {
+    if (!lf_lightfield_refocus(&lf, &o, &img, &err)) {
         snprintf(p, sizeof p, "%s/%s", dir, out);
         lf_image_write(p, &img, NULL, NULL, &err);
         lf_image_free(&img);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
     lf_attrs_free(&a);
 }

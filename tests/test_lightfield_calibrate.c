@@ -8,9 +8,9 @@
 #include "lf_test.h"
 #include "lightfield/lf_lightfield.h"
 
-static void centre(const lf_lf_layout *l, int i, int j, double *x, double *y)
+static void centre(const lf_lightfield_layout *l, int i, int j, double *x, double *y)
 {
-    int hex = l->grid == LF_LF_GRID_HEX;
+    int hex = l->grid == LF_LIGHTFIELD_GRID_HEX;
     double lx = i * l->pitch_px + (hex && (j & 1) ? l->pitch_px / 2 : 0);
     double ly = j * l->pitch_px * (hex ? sqrt(3.0) / 2 : 1);
     double c = cos(l->rotation_rad), s = sin(l->rotation_rad);
@@ -19,7 +19,7 @@ static void centre(const lf_lf_layout *l, int i, int j, double *x, double *y)
 }
 
 /* distance from (x, y) to the nearest true lens centre */
-static double nearest(const lf_lf_layout *l, double x, double y)
+static double nearest(const lf_lightfield_layout *l, double x, double y)
 {
     double best = 1e30;
     for (int j = -3; j < 200; j++)
@@ -34,7 +34,7 @@ static double nearest(const lf_lf_layout *l, double x, double y)
 }
 
 /* white image: a soft-edged, slightly vignetted disk of radius r * pitch per lens */
-static void make_white(const lf_lf_layout *l, int w, int h, double r, lf_image *img)
+static void make_white(const lf_lightfield_layout *l, int w, int h, double r, lf_image *img)
 {
     lf_error err = {0};
     lf_image_alloc(img, w, h, 3, &err);
@@ -56,22 +56,22 @@ static void make_white(const lf_lf_layout *l, int w, int h, double r, lf_image *
         }
 }
 
-static void check_case(const char *name, lf_lf_grid grid, double pitch, double rot, double ox, double oy, double r,
+static void check_case(const char *name, lf_lightfield_grid grid, double pitch, double rot, double ox, double oy, double r,
                        int w, int h)
 {
     lf_error err = {0};
-    lf_lf_layout truth, none, t;
-    lf_lf_layout_init(&truth);
-    lf_lf_layout_init(&none);
-    truth.kind = LF_LF_PLENOPTIC, truth.grid = grid, truth.pitch_px = pitch, truth.rotation_rad = rot;
+    lf_lightfield_layout truth, none, t;
+    lf_lightfield_layout_init(&truth);
+    lf_lightfield_layout_init(&none);
+    truth.kind = LF_LIGHTFIELD_PLENOPTIC, truth.grid = grid, truth.pitch_px = pitch, truth.rotation_rad = rot;
     truth.offset_px[0] = ox, truth.offset_px[1] = oy;
-    truth.have = LF_LF_HAVE_KIND | LF_LF_HAVE_GRID | LF_LF_HAVE_PITCH | LF_LF_HAVE_ROTATION | LF_LF_HAVE_OFFSET;
-    lf_lf_layout_resolve(&truth, &none, w, h, &t, &err);
+    truth.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_GRID | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_ROTATION | LF_LIGHTFIELD_HAVE_OFFSET;
+    lf_lightfield_layout_resolve(&truth, &none, w, h, &t, &err);
     lf_image white;
     make_white(&t, w, h, r, &white);
-    lf_lf_layout est;
-    lf_lf_layout_init(&est);
-    CHECK_MSG(lf_lf_calibrate(&white, &est, &err) == 0, "%s: %s", name, err.msg);
+    lf_lightfield_layout est;
+    lf_lightfield_layout_init(&est);
+    CHECK_MSG(lf_lightfield_calibrate(&white, &est, &err) == 0, "%s: %s", name, err.msg);
     /* every estimated centre inside the image lies on a true one */
     double worst = 0;
     for (int j = 0; j < est.lens_y; j++)
@@ -84,7 +84,7 @@ static void check_case(const char *name, lf_lf_grid grid, double pitch, double r
         }
     printf("%s: grid %s, pitch %.4f (true %.4f), rotation %.5f (true %.5f), offset (%.3f, %.3f); worst centre error "
            "%.3f px (tol 0.1)\n",
-           name, est.grid == LF_LF_GRID_HEX ? "hex" : "square", est.pitch_px, pitch, est.rotation_rad, rot,
+           name, est.grid == LF_LIGHTFIELD_GRID_HEX ? "hex" : "square", est.pitch_px, pitch, est.rotation_rad, rot,
            est.offset_px[0], est.offset_px[1], worst);
     CHECK(est.grid == grid);
     CHECK(fabs(est.pitch_px - pitch) < 0.01);
@@ -97,19 +97,19 @@ static void check_case(const char *name, lf_lf_grid grid, double pitch, double r
 
 int main(void)
 {
-    check_case("square, separate disks", LF_LF_GRID_SQUARE, 10.3, 0.03, 3.2, 8.9, 0.42, 420, 330);
-    check_case("square, touching disks", LF_LF_GRID_SQUARE, 14.7, -0.012, 7.0, 6.1, 0.5, 600, 400);
-    check_case("hex, separate disks", LF_LF_GRID_HEX, 9.7, -0.02, 6.1, 6.4, 0.42, 400, 300);
-    check_case("hex, touching disks", LF_LF_GRID_HEX, 12.25, 0.04, 2.0, 9.5, 0.5, 520, 390);
+    check_case("square, separate disks", LF_LIGHTFIELD_GRID_SQUARE, 10.3, 0.03, 3.2, 8.9, 0.42, 420, 330);
+    check_case("square, touching disks", LF_LIGHTFIELD_GRID_SQUARE, 14.7, -0.012, 7.0, 6.1, 0.5, 600, 400);
+    check_case("hex, separate disks", LF_LIGHTFIELD_GRID_HEX, 9.7, -0.02, 6.1, 6.4, 0.42, 400, 300);
+    check_case("hex, touching disks", LF_LIGHTFIELD_GRID_HEX, 12.25, 0.04, 2.0, 9.5, 0.5, 520, 390);
     /* a flat image has no lattice */
     lf_image flat;
     lf_error err = {0};
     lf_image_alloc(&flat, 128, 128, 1, &err);
     for (int i = 0; i < 128 * 128; i++)
         flat.data[i] = 1.f;
-    lf_lf_layout est;
-    lf_lf_layout_init(&est);
-    CHECK(lf_lf_calibrate(&flat, &est, &err) != 0);
+    lf_lightfield_layout est;
+    lf_lightfield_layout_init(&est);
+    CHECK(lf_lightfield_calibrate(&flat, &est, &err) != 0);
     lf_image_free(&flat);
     return lf_test_end();
 }

@@ -10,9 +10,9 @@
 #include "lightfield/lf_lightfield.h"
 
 /* Lens centre in pixels, the format's formula (docs/lightfield-format.md). */
-static void lens_centre(const lf_lf_layout *l, int i, int j, double *x, double *y)
+static void lens_centre(const lf_lightfield_layout *l, int i, int j, double *x, double *y)
 {
-    int hex = l->grid == LF_LF_GRID_HEX;
+    int hex = l->grid == LF_LIGHTFIELD_GRID_HEX;
     double lx = i * l->pitch_px + (hex && (j & 1) ? l->pitch_px / 2 : 0);
     double ly = j * l->pitch_px * (hex ? sqrt(3.0) / 2 : 1);
     double c = cos(l->rotation_rad), s = sin(l->rotation_rad);
@@ -23,9 +23,9 @@ static void lens_centre(const lf_lf_layout *l, int i, int j, double *x, double *
 /* Per-lens linear microimage: value(i, j, du, dv, ch) = A + B du + C dv, where
  * (du, dv) is the pixel offset from the lens centre.  A is a function of the
  * lens's lattice position (linear for hex, so resampling is exact). */
-static double lensA(const lf_lf_layout *l, int i, int j, int ch)
+static double lensA(const lf_lightfield_layout *l, int i, int j, int ch)
 {
-    int hex = l->grid == LF_LF_GRID_HEX;
+    int hex = l->grid == LF_LIGHTFIELD_GRID_HEX;
     double lx = i + (hex && (j & 1) ? 0.5 : 0), ly = j * (hex ? sqrt(3.0) / 2 : 1);
     if (hex)
         return 0.3 + 0.01 * lx + 0.007 * ly + 0.1 * ch;
@@ -34,12 +34,12 @@ static double lensA(const lf_lf_layout *l, int i, int j, int ch)
 static const double LB[3] = {0.011, -0.007, 0.004}, LC[3] = {-0.005, 0.009, 0.006};
 
 /* nearest lens by brute force over a neighbourhood of the rounded guess */
-static void nearest_lens(const lf_lf_layout *l, double px, double py, int *bi, int *bj)
+static void nearest_lens(const lf_lightfield_layout *l, double px, double py, int *bi, int *bj)
 {
     double c = cos(l->rotation_rad), s = sin(l->rotation_rad);
     double rx = px - l->offset_px[0], ry = py - l->offset_px[1];
     double lx = c * rx + s * ry, ly = -s * rx + c * ry; /* inverse rotation */
-    int hex = l->grid == LF_LF_GRID_HEX;
+    int hex = l->grid == LF_LIGHTFIELD_GRID_HEX;
     int gj = (int)lround(ly / (l->pitch_px * (hex ? sqrt(3.0) / 2 : 1))), gi = (int)lround(lx / l->pitch_px);
     double best = 1e30;
     for (int j = gj - 2; j <= gj + 2; j++)
@@ -52,7 +52,7 @@ static void nearest_lens(const lf_lf_layout *l, double px, double py, int *bi, i
         }
 }
 
-static void make_raw(const lf_lf_layout *l, int w, int h, lf_image *raw, const lf_image *white)
+static void make_raw(const lf_lightfield_layout *l, int w, int h, lf_image *raw, const lf_image *white)
 {
     lf_error err = {0};
     lf_image_alloc(raw, w, h, 3, &err);
@@ -73,7 +73,7 @@ static void make_raw(const lf_lf_layout *l, int w, int h, lf_image *raw, const l
 
 /* view (iu, iv) of lens (i, j) samples pixel offset +(u, v) (a pixel right
  * of its image centre sees the right of the aperture): expected value */
-static double expected(const lf_lf_layout *l, int i, int j, int ou, int ov, int ch)
+static double expected(const lf_lightfield_layout *l, int i, int j, int ou, int ov, int ch)
 {
     return lensA(l, i, j, ch) + LB[ch] * ou + LC[ch] * ov;
 }
@@ -81,19 +81,19 @@ static double expected(const lf_lf_layout *l, int i, int j, int ou, int ov, int 
 static void test_square(void)
 {
     lf_error err = {0};
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&file);
-    lf_lf_layout_init(&flags);
-    file.kind = LF_LF_PLENOPTIC, file.grid = LF_LF_GRID_SQUARE;
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&file);
+    lf_lightfield_layout_init(&flags);
+    file.kind = LF_LIGHTFIELD_PLENOPTIC, file.grid = LF_LIGHTFIELD_GRID_SQUARE;
     file.pitch_px = 10.3, file.rotation_rad = 0.03, file.offset_px[0] = 3.2, file.offset_px[1] = 8.9;
-    file.have = LF_LF_HAVE_KIND | LF_LF_HAVE_GRID | LF_LF_HAVE_PITCH | LF_LF_HAVE_ROTATION | LF_LF_HAVE_OFFSET;
+    file.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_GRID | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_ROTATION | LF_LIGHTFIELD_HAVE_OFFSET;
     const int w = 211, h = 187;
-    CHECK_MSG(lf_lf_layout_resolve(&file, &flags, w, h, &lay, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_layout_resolve(&file, &flags, w, h, &lay, &err) == 0, "%s", err.msg);
     CHECK(lay.lens_x == 21 && lay.lens_y == 18);
     lf_image raw;
     make_raw(&lay, w, h, &raw, NULL);
     lf_lightfield lf;
-    CHECK_MSG(lf_lf_decode(&raw, &lay, NULL, &lf, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_decode(&raw, &lay, NULL, &lf, &err) == 0, "%s", err.msg);
     CHECK(lf.nu == 9 && lf.nv == 9 && lf.ns == 21 && lf.nt == 18);
     /* views whose bilinear footprint stays in its own lens (|o| <= 3 at this
      * pitch and rotation) are exact; samples off the sensor are missing */
@@ -113,7 +113,7 @@ static void test_square(void)
                         missing_ok = 0;
                     if (off || abs(ou) > 3 || abs(ov) > 3)
                         continue;
-                    const float *p = lf_lf_view(&lf, iu, iv) + ((size_t)j * lf.ns + i) * 3;
+                    const float *p = lf_lightfield_view(&lf, iu, iv) + ((size_t)j * lf.ns + i) * 3;
                     for (int ch = 0; ch < 3; ch++)
                         maxerr = fmax(maxerr, fabs(p[ch] - expected(&lay, i, j, ou, ov, ch)));
                     checked++;
@@ -124,26 +124,26 @@ static void test_square(void)
     CHECK(maxerr < 1e-5);
     CHECK(missing_ok);
     CHECK(lf.missing > 0);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
 }
 
 static void test_hex(void)
 {
     lf_error err = {0};
-    lf_lf_layout lay, none;
-    lf_lf_layout_init(&lay);
-    lf_lf_layout_init(&none);
-    lay.kind = LF_LF_PLENOPTIC, lay.grid = LF_LF_GRID_HEX;
+    lf_lightfield_layout lay, none;
+    lf_lightfield_layout_init(&lay);
+    lf_lightfield_layout_init(&none);
+    lay.kind = LF_LIGHTFIELD_PLENOPTIC, lay.grid = LF_LIGHTFIELD_GRID_HEX;
     lay.pitch_px = 9.7, lay.rotation_rad = -0.02, lay.offset_px[0] = 6.1, lay.offset_px[1] = 6.4;
-    lay.have = LF_LF_HAVE_KIND | LF_LF_HAVE_GRID | LF_LF_HAVE_PITCH | LF_LF_HAVE_ROTATION | LF_LF_HAVE_OFFSET;
+    lay.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_GRID | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_ROTATION | LF_LIGHTFIELD_HAVE_OFFSET;
     const int w = 200, h = 170;
-    lf_lf_layout r;
-    CHECK(lf_lf_layout_resolve(&lay, &none, w, h, &r, &err) == 0);
+    lf_lightfield_layout r;
+    CHECK(lf_lightfield_layout_resolve(&lay, &none, w, h, &r, &err) == 0);
     lf_image raw;
     make_raw(&r, w, h, &raw, NULL);
     lf_lightfield lf;
-    CHECK_MSG(lf_lf_decode(&raw, &r, NULL, &lf, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_decode(&raw, &r, NULL, &lf, &err) == 0, "%s", err.msg);
     int nt = (int)floor((r.lens_y - 1) * sqrt(3.0) / 2) + 1;
     CHECK(lf.nu == 9 && lf.ns == r.lens_x && lf.nt == nt);
     /* output (s, t) sits at lattice position (s, t) pitches: A there, exactly */
@@ -166,7 +166,7 @@ static void test_hex(void)
            lf.ns, lf.nt, checked, maxerr);
     CHECK(checked > 7000); /* of 25 x 20 x 17 */
     CHECK(maxerr < 1e-5);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
 }
 
@@ -175,16 +175,16 @@ static void test_hex(void)
 static void test_white_and_nonfinite(void)
 {
     lf_error err = {0};
-    lf_lf_layout lay, none;
-    lf_lf_layout_init(&lay);
-    lf_lf_layout_init(&none);
-    lay.kind = LF_LF_PLENOPTIC;
+    lf_lightfield_layout lay, none;
+    lf_lightfield_layout_init(&lay);
+    lf_lightfield_layout_init(&none);
+    lay.kind = LF_LIGHTFIELD_PLENOPTIC;
     lay.pitch_px = 9, lay.offset_px[0] = 4.5, lay.offset_px[1] = 4.5;
-    lay.have = LF_LF_HAVE_KIND | LF_LF_HAVE_PITCH | LF_LF_HAVE_OFFSET;
+    lay.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_PITCH | LF_LIGHTFIELD_HAVE_OFFSET;
     lay.main_focal_mm = 50, lay.main_fstop = 4, lay.mla_distance_mm = 52, lay.pitch_um = 90;
-    lay.have |= LF_LF_HAVE_MAIN_LENS;
-    lf_lf_layout r;
-    CHECK(lf_lf_layout_resolve(&lay, &none, 90, 72, &r, &err) == 0);
+    lay.have |= LF_LIGHTFIELD_HAVE_MAIN_LENS;
+    lf_lightfield_layout r;
+    CHECK(lf_lightfield_layout_resolve(&lay, &none, 90, 72, &r, &err) == 0);
     CHECK(r.lens_x == 10 && r.lens_y == 8);
     lf_image white, raw;
     lf_image_alloc(&white, 90, 72, 3, &err);
@@ -196,7 +196,7 @@ static void test_white_and_nonfinite(void)
         }
     make_raw(&r, 90, 72, &raw, &white);
     lf_lightfield lf;
-    CHECK_MSG(lf_lf_decode(&raw, &r, &white, &lf, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_decode(&raw, &r, &white, &lf, &err) == 0, "%s", err.msg);
     double maxerr = 0;
     size_t dark = 0, dark_missing = 0;
     for (int iv = 0; iv < 9; iv++)
@@ -222,22 +222,22 @@ static void test_white_and_nonfinite(void)
 
     /* alpha = 1 is the plain average of the (valid) views */
     double d = 1;
-    CHECK(lf_lf_alpha_to_disparity(&lf, 1.0, &d, &err) == 0);
+    CHECK(lf_lightfield_alpha_to_disparity(&lf, 1.0, &d, &err) == 0);
     CHECK(d == 0);
     /* depth: the plane conjugate to the microlens array (1/z + 1/F = 1/f) has d = 0 */
     double zf = 1.0 / (1.0 / 0.050 - 1.0 / 0.052);
-    CHECK(lf_lf_depth_to_disparity(&lf, zf, &d, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, zf, &d, &err) == 0);
     CHECK_NEAR(d, 0, 1e-9);
-    CHECK(lf_lf_depth_to_disparity(&lf, zf / 2, &d, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, zf / 2, &d, &err) == 0);
     CHECK(d > 0); /* nearer than focus: positive disparity */
     /* alpha for a depth: 1/z + 1/(alpha F) = 1/f, same disparity both ways */
     double z = 0.8, alpha = 1.0 / (0.052 * (1.0 / 0.050 - 1.0 / z)), da, dz;
-    CHECK(lf_lf_alpha_to_disparity(&lf, alpha, &da, &err) == 0);
-    CHECK(lf_lf_depth_to_disparity(&lf, z, &dz, &err) == 0);
+    CHECK(lf_lightfield_alpha_to_disparity(&lf, alpha, &da, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, z, &dz, &err) == 0);
     CHECK_NEAR(da, dz, 1e-9);
-    lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
     lf_image img;
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == 0);
     double maxd = 0;
     for (int t = 0; t < lf.nt; t++)
         for (int s = 0; s < lf.ns; s++)
@@ -253,19 +253,19 @@ static void test_white_and_nonfinite(void)
     printf("alpha = 1 refocus vs plain mean of valid views: max |diff| %.2g (tol 1e-6)\n", maxd);
     CHECK(maxd < 1e-6);
     lf_image_free(&img);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 
     /* non-finite raw pixels: counted, their samples missing, never averaged in */
     lf_image_px(&raw, 40, 31)[1] = NAN;
     lf_image_px(&raw, 13, 50)[0] = INFINITY;
     lf_image_px(&raw, 77, 9)[2] = NAN;
-    CHECK(lf_lf_decode(&raw, &r, NULL, &lf, &err) == 0);
+    CHECK(lf_lightfield_decode(&raw, &r, NULL, &lf, &err) == 0);
     CHECK(lf.nonfinite == 3);
     CHECK(lf.missing >= 3);
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == 0);
     CHECK(lf_image_count_nonfinite(&img) == 0);
     lf_image_free(&img);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
     lf_image_free(&white);
 }
@@ -274,11 +274,11 @@ static void test_layouts(void)
 {
     lf_error err = {0};
     lf_attrs a = {0};
-    lf_lf_layout file, flags, out;
-    lf_lf_layout_init(&flags);
+    lf_lightfield_layout file, flags, out;
+    lf_lightfield_layout_init(&flags);
     /* nothing at all: the message lists what is missing */
-    CHECK(lf_lf_layout_from_attrs(&a, &file, &err) == 0);
-    CHECK(lf_lf_layout_resolve(&file, &flags, 64, 64, &out, &err) == LF_ERR_PARAM);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == 0);
+    CHECK(lf_lightfield_layout_resolve(&file, &flags, 64, 64, &out, &err) == LF_ERR_PARAM);
     CHECK(strstr(err.msg, "lensfield:kind") && strstr(err.msg, "--camsperdim") && strstr(err.msg, "--pitch"));
     lf_error_clear(&err);
     /* camera-array attributes, as lfrender writes them */
@@ -287,40 +287,40 @@ static void test_layouts(void)
     lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2);
     lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4);
     lf_attrs_set_double(&a, "lensfield:fov_deg", 30);
-    CHECK(lf_lf_layout_from_attrs(&a, &file, &err) == 0);
-    CHECK(lf_lf_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == 0);
+    CHECK(lf_lightfield_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
     CHECK(out.tile_w == 20 && out.tile_h == 15);
-    CHECK(lf_lf_layout_resolve(&file, &flags, 81, 45, &out, &err) == LF_ERR_PARAM); /* does not divide */
+    CHECK(lf_lightfield_layout_resolve(&file, &flags, 81, 45, &out, &err) == LF_ERR_PARAM); /* does not divide */
     lf_error_clear(&err);
     /* agreeing flags pass, contradicting ones fail naming both */
-    flags.cams_x = 4, flags.cams_y = 3, flags.have = LF_LF_HAVE_CAMS;
-    CHECK(lf_lf_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
-    flags.fov_deg = 35, flags.have |= LF_LF_HAVE_FOV;
-    CHECK(lf_lf_layout_resolve(&file, &flags, 80, 45, &out, &err) == LF_ERR_PARAM);
+    flags.cams_x = 4, flags.cams_y = 3, flags.have = LF_LIGHTFIELD_HAVE_CAMS;
+    CHECK(lf_lightfield_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
+    flags.fov_deg = 35, flags.have |= LF_LIGHTFIELD_HAVE_FOV;
+    CHECK(lf_lightfield_layout_resolve(&file, &flags, 80, 45, &out, &err) == LF_ERR_PARAM);
     CHECK(strstr(err.msg, "--inputfov") && strstr(err.msg, "lensfield:fov_deg"));
     lf_error_clear(&err);
     /* flags alone describe a raw without attributes */
-    lf_lf_layout empty;
-    lf_lf_layout_init(&empty);
-    flags.kind = LF_LF_CAMERA_ARRAY, flags.have |= LF_LF_HAVE_KIND;
-    CHECK(lf_lf_layout_resolve(&empty, &flags, 80, 45, &out, &err) == 0);
+    lf_lightfield_layout empty;
+    lf_lightfield_layout_init(&empty);
+    flags.kind = LF_LIGHTFIELD_CAMERA_ARRAY, flags.have |= LF_LIGHTFIELD_HAVE_KIND;
+    CHECK(lf_lightfield_layout_resolve(&empty, &flags, 80, 45, &out, &err) == 0);
     /* a camera array without cameras per dim lists it */
-    lf_lf_layout_init(&flags);
-    flags.kind = LF_LF_CAMERA_ARRAY, flags.have = LF_LF_HAVE_KIND;
-    CHECK(lf_lf_layout_resolve(&empty, &flags, 80, 45, &out, &err) == LF_ERR_PARAM);
+    lf_lightfield_layout_init(&flags);
+    flags.kind = LF_LIGHTFIELD_CAMERA_ARRAY, flags.have = LF_LIGHTFIELD_HAVE_KIND;
+    CHECK(lf_lightfield_layout_resolve(&empty, &flags, 80, 45, &out, &err) == LF_ERR_PARAM);
     CHECK(strstr(err.msg, "lensfield:cameras_per_dim") && strstr(err.msg, "--camsperdim"));
     lf_error_clear(&err);
     /* round trip through attributes */
     lf_attrs b = {0};
-    CHECK(lf_lf_layout_resolve(&file, NULL, 80, 45, &out, &err) == 0);
-    CHECK(lf_lf_layout_to_attrs(&out, &b, &err) == 0);
-    lf_lf_layout back;
-    CHECK(lf_lf_layout_from_attrs(&b, &back, &err) == 0);
+    CHECK(lf_lightfield_layout_resolve(&file, NULL, 80, 45, &out, &err) == 0);
+    CHECK(lf_lightfield_layout_to_attrs(&out, &b, &err) == 0);
+    lf_lightfield_layout back;
+    CHECK(lf_lightfield_layout_from_attrs(&b, &back, &err) == 0);
     CHECK(back.cams_x == 4 && back.cams_y == 3 && back.tile_w == 20 && fabs(back.fov_deg - 30) < 1e-9);
     CHECK(fabs(back.grid_bounds[2] + 0.2) < 1e-6);
     /* wrong types are parse errors */
     lf_attrs_set_string(&a, "lensfield:kind", "hologram");
-    CHECK(lf_lf_layout_from_attrs(&a, &file, &err) == LF_ERR_PARSE);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == LF_ERR_PARSE);
     lf_error_clear(&err);
     lf_attrs_free(&a);
     lf_attrs_free(&b);
@@ -332,12 +332,12 @@ static void test_layouts(void)
         for (int x = 0; x < 80; x++)
             lf_image_px(&raw, x, y)[0] = (float)(x / 20 + 10 * (y / 15)) + 0.001f * (x % 20);
     lf_lightfield lf;
-    CHECK(lf_lf_decode(&raw, &out, NULL, &lf, &err) == 0);
+    CHECK(lf_lightfield_decode(&raw, &out, NULL, &lf, &err) == 0);
     CHECK(lf.nu == 4 && lf.nv == 3 && lf.ns == 20 && lf.nt == 15);
-    CHECK(lf_lf_view(&lf, 3, 2)[3 * 5 + 1] == (float)(3 + 20) + 0.005f);
-    CHECK(lf_lf_view(&lf, 1, 0)[0] == 1.f);
+    CHECK(lf_lightfield_view(&lf, 3, 2)[3 * 5 + 1] == (float)(3 + 20) + 0.005f);
+    CHECK(lf_lightfield_view(&lf, 1, 0)[0] == 1.f);
     CHECK(lf.valid == NULL && lf.missing == 0);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
 }
 

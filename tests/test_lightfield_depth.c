@@ -105,19 +105,19 @@ static void render(double fu, double fv, float *dst)
 static void make_lf(lf_lightfield *lf)
 {
     lf_error err = {0};
-    lf_lf_alloc(lf, N, N, W, H, &err);
+    lf_lightfield_alloc(lf, N, N, W, H, &err);
     lf->disp_v_per_u = 1.0;
     /* as a CS348B camera array (synth): cameras on z = 0, y up, fov across W */
-    lf_lf_layout *l = &lf->layout;
-    l->kind = LF_LF_CAMERA_ARRAY;
+    lf_lightfield_layout *l = &lf->layout;
+    l->kind = LF_LIGHTFIELD_CAMERA_ARRAY;
     l->cams_x = l->cams_y = N;
     l->grid_bounds[0] = l->grid_bounds[2] = -B * (N - 1) / 2;
     l->grid_bounds[1] = l->grid_bounds[3] = B * (N - 1) / 2;
     l->fov_deg = 2 * atan(W / 2.0 / F) * 180 / M_PI, l->tile_w = W, l->tile_h = H;
-    l->have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_BOUNDS | LF_LF_HAVE_FOV | LF_LF_HAVE_TILE;
+    l->have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_BOUNDS | LF_LIGHTFIELD_HAVE_FOV | LF_LIGHTFIELD_HAVE_TILE;
     for (int v = 0; v < N; v++)
         for (int u = 0; u < N; u++)
-            render(u, v, lf_lf_view(lf, u, v));
+            render(u, v, lf_lightfield_view(lf, u, v));
 }
 
 static void ground_truth(float *gt)
@@ -191,15 +191,15 @@ int main(void)
     for (int i = 0; i < W * H; i++)
         gmin = gt[i] < gmin ? gt[i] : gmin, gmax = gt[i] > gmax ? gt[i] : gmax;
     double r0, r1;
-    CHECK_MSG(lf_lf_depth_range(&lf, 2, &r0, &r1, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_depth_range(&lf, 2, &r0, &r1, &err) == 0, "%s", err.msg);
     printf("tilted plane: true disparity %.3f .. %.3f, estimated search range %.3f .. %.3f\n", gmin, gmax, r0, r1);
     /* the search range must hold every true disparity, and not be absurdly wide
      * (at most 3x the true span plus 1 px/view) */
     CHECK(r0 <= gmin && r1 >= gmax);
     CHECK(r1 - r0 <= 3 * (gmax - gmin) + 1.0);
-    lf_lf_depth_opts o = lf_lf_depth_defaults();
+    lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
     lf_image d, c;
-    CHECK_MSG(lf_lf_depth(&lf, &o, &d, &c, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_depth(&lf, &o, &d, &c, &err) == 0, "%s", err.msg);
     scores s = score(d.data, gt, NULL);
     printf("  depth: BadPix0.07 %.2f %%, MSE x 100 %.4f, mean |err| %.4f px/view\n", s.bad07, s.mse100, s.mean_abs);
     /* targets: the benchmark goal (BadPix0.07 <= 5 %, MSE x 100 <= 4) with a
@@ -217,10 +217,10 @@ int main(void)
          * Gauss-Newton refinement must place the plane well inside a label
          * (mean |err| below a quarter label) and beat the bilinear,
          * label-and-parabola estimate (measured: 0.0030 against 0.0066) */
-        lf_lf_depth_opts ob = lf_lf_depth_defaults();
+        lf_lightfield_depth_opts ob = lf_lightfield_depth_defaults();
         ob.interp = 1, ob.refine = -1;
         lf_image db;
-        CHECK_MSG(lf_lf_depth(&lf, &ob, &db, NULL, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&lf, &ob, &db, NULL, &err) == 0, "%s", err.msg);
         scores sb = score(db.data, gt, NULL);
         printf("  sub-label: mean |err| %.4f px/view (bilinear lookups, no refinement: %.4f)\n", s.mean_abs,
                sb.mean_abs);
@@ -234,10 +234,10 @@ int main(void)
          * outermost view: 0.067 px/view here, so -18 .. 18 would be 541
          * labels) spreads the labels instead of failing; the plane is still
          * found (labels 0.07 px/view apart, refined within them) */
-        lf_lf_depth_opts ow = lf_lf_depth_defaults();
+        lf_lightfield_depth_opts ow = lf_lightfield_depth_defaults();
         ow.d0 = -18, ow.d1 = 18;
         lf_image dw;
-        CHECK_MSG(lf_lf_depth(&lf, &ow, &dw, NULL, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&lf, &ow, &dw, NULL, &err) == 0, "%s", err.msg);
         scores sw = score(dw.data, gt, NULL);
         printf("  range -18 .. 18 px/view: BadPix0.07 %.2f %%, MSE x 100 %.4f\n", sw.bad07, sw.mse100);
         CHECK(sw.bad07 < 2.0);
@@ -260,10 +260,10 @@ int main(void)
         for (int y = 30; y < 70; y++)
             for (int x = 30; x < 70; x++) {
                 lf.valid[((size_t)(iv * N + iu) * H + y) * W + x] = 0.f;
-                memset(lf_lf_view(&lf, iu, iv) + ((size_t)y * W + x) * 3, 0, 3 * sizeof(float));
+                memset(lf_lightfield_view(&lf, iu, iv) + ((size_t)y * W + x) * 3, 0, 3 * sizeof(float));
             }
     }
-    CHECK_MSG(lf_lf_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
     s = score(d.data, gt, NULL);
     printf("  depth with missing samples: BadPix0.07 %.2f %%, MSE x 100 %.4f\n", s.bad07, s.mse100);
     CHECK(s.bad07 < 2.0);
@@ -272,10 +272,10 @@ int main(void)
         /* and a view between the cameras from those views: the missing
          * samples (0) left out, the view as good as from complete views
          * below (> 45 dB) */
-        lf_lf_view_opts mvo = lf_lf_view_defaults();
+        lf_lightfield_view_opts mvo = lf_lightfield_view_defaults();
         mvo.disparity = &d;
         lf_image mv;
-        CHECK_MSG(lf_lf_view_depth(&lf, 0.5, -1.5, &mvo, &mv, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_view_depth(&lf, 0.5, -1.5, &mvo, &mv, &err) == 0, "%s", err.msg);
         render(3.5, 1.5, truth);
         double pm = psnr(mv.data, truth, 8);
         printf("  view (0.5, -1.5) with missing samples: %.2f dB\n", pm);
@@ -287,16 +287,16 @@ int main(void)
     lf.valid = NULL;
     for (int v = 0; v < N; v++) /* restore the views */
         for (int u = 0; u < N; u++)
-            render(u, v, lf_lf_view(&lf, u, v));
+            render(u, v, lf_lightfield_view(&lf, u, v));
 
     /* a view at a position between the data cameras, against its analytic render */
-    lf_lf_view_opts vo = lf_lf_view_defaults();
+    lf_lightfield_view_opts vo = lf_lightfield_view_defaults();
     lf_image view;
-    CHECK_MSG(lf_lf_view_depth(&lf, 0.5, -1.5, &vo, &view, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_view_depth(&lf, 0.5, -1.5, &vo, &view, &err) == 0, "%s", err.msg);
     render(3.5, 1.5, truth);
     double p_depth = psnr(view.data, truth, 8);
     lf_image_free(&view);
-    CHECK(lf_lf_view_at(&lf, 0.5, -1.5, 0.0, &view, &err) == 0);
+    CHECK(lf_lightfield_view_at(&lf, 0.5, -1.5, 0.0, &view, &err) == 0);
     double p_plane = psnr(view.data, truth, 8);
     lf_image_free(&view);
     printf("  view (0.5, -1.5): per-pixel depth %.2f dB, plane d=0 %.2f dB\n", p_depth, p_plane);
@@ -306,26 +306,26 @@ int main(void)
     CHECK(p_depth > 45);
     CHECK(p_depth > p_plane + 6);
     /* at a data view: that view, exactly */
-    CHECK(lf_lf_view_depth(&lf, 1, 1, &vo, &view, &err) == 0);
-    CHECK(psnr(view.data, lf_lf_view(&lf, 4, 4), 0) > 200);
+    CHECK(lf_lightfield_view_depth(&lf, 1, 1, &vo, &view, &err) == 0);
+    CHECK(psnr(view.data, lf_lightfield_view(&lf, 4, 4), 0) > 200);
     lf_image_free(&view);
     {
         /* ---- vignetted capture (decoded plenoptic sets): a known smooth gain
          * field on the outer ring of views, the corner views dark.
-         * lf_lf_equalize must find the dark views, give the ring back its
+         * lf_lightfield_equalize must find the dark views, give the ring back its
          * brightness (the field, exp(quadratic), is in its model; parallax
          * moves texture across the cells, which its robust fit must not
          * follow), leave the inner views bit-identical, and the range
          * estimate and the depth must hold as on the clean views ---- */
         lf_lightfield vg = {0};
-        CHECK(lf_lf_alloc(&vg, N, N, W, H, &err) == 0);
+        CHECK(lf_lightfield_alloc(&vg, N, N, W, H, &err) == 0);
         vg.disp_v_per_u = 1.0;
         memcpy(vg.data, lf.data, sizeof(float) * 3 * N * N * W * H);
         static const double chg[3] = {0.5, 0.55, 0.45};
         for (int v = 0; v < N; v++)
             for (int u = 0; u < N; u++) {
                 int ring = abs(u - N / 2) + abs(v - N / 2);
-                float *p = lf_lf_view(&vg, u, v);
+                float *p = lf_lightfield_view(&vg, u, v);
                 for (int y = 0; y < H; y++)
                     for (int x = 0; x < W; x++) {
                         double xx = (x + 0.5) / W * 2 - 1, yy = (y + 0.5) / H * 2 - 1;
@@ -335,13 +335,13 @@ int main(void)
                         }
                     }
             }
-        CHECK_MSG(lf_lf_equalize(&vg, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_equalize(&vg, &err) == 0, "%s", err.msg);
         int ndark = 0, dark_ok = 1, inner_same = 1, nring = 0;
         double ring_err = 0, ring_ref = 0;
         for (int v = 0; v < N; v++)
             for (int u = 0; u < N; u++) {
                 int ring = abs(u - N / 2) + abs(v - N / 2);
-                const float *a = lf_lf_view(&vg, u, v), *b = lf_lf_view(&lf, u, v);
+                const float *a = lf_lightfield_view(&vg, u, v), *b = lf_lightfield_view(&lf, u, v);
                 const float *va = vg.valid ? vg.valid + ((size_t)v * N + u) * W * H : NULL;
                 if (ring >= 5) {
                     ndark++;
@@ -378,21 +378,21 @@ int main(void)
         CHECK(vg.gain_lo > 0.95 * 0.5 * exp(-0.6) && vg.gain_hi < 1.05 * 0.5);
         CHECK(vg.view_gain && fabs(vg.view_gain[0 * N + 2] - 0.5 * fmean) < 0.02 && vg.view_gain[3 * N + 3] == 1.f);
         double v0, v1;
-        CHECK_MSG(lf_lf_depth_range(&vg, 2, &v0, &v1, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth_range(&vg, 2, &v0, &v1, &err) == 0, "%s", err.msg);
         printf("  range %.3f .. %.3f (clean views: %.3f .. %.3f)\n", v0, v1, r0, r1);
         CHECK(v0 <= gmin && v1 >= gmax);
         CHECK(v1 - v0 <= 3 * (gmax - gmin) + 1.0);
         lf_image dv;
-        CHECK_MSG(lf_lf_depth(&vg, &o, &dv, NULL, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&vg, &o, &dv, NULL, &err) == 0, "%s", err.msg);
         scores sv = score(dv.data, gt, NULL);
         printf("  depth: BadPix0.07 %.2f %%, MSE x 100 %.4f (clean: %.2f %%, %.4f)\n", sv.bad07, sv.mse100, s.bad07,
                s.mse100);
         CHECK(sv.bad07 < 2.0);
         CHECK(sv.mse100 < 1.6);
         lf_image_free(&dv);
-        lf_lf_free(&vg);
+        lf_lightfield_free(&vg);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 
     /* ---- 2. a box face occluding the plane ---- */
     g_box = 1;
@@ -415,9 +415,9 @@ int main(void)
         }
     scores so[2], sb[2], si[2];
     for (int occ = 0; occ < 2; occ++) {
-        o = lf_lf_depth_defaults();
+        o = lf_lightfield_depth_defaults();
         o.occlusion = occ ? 2 : 0;
-        CHECK_MSG(lf_lf_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
         so[occ] = score(d.data, gt, NULL);
         sb[occ] = score(d.data, gt, band_out);
         si[occ] = score(d.data, gt, band_in);
@@ -428,17 +428,17 @@ int main(void)
             /* view synthesis across the occlusion boundary */
             lf_image conf = {0};
             lf_image_free(&d);
-            CHECK(lf_lf_depth(&lf, &o, &d, &conf, &err) == 0);
-            vo = lf_lf_view_defaults();
+            CHECK(lf_lightfield_depth(&lf, &o, &d, &conf, &err) == 0);
+            vo = lf_lightfield_view_defaults();
             vo.disparity = &d, vo.confidence = &conf;
             render(2.5, 3.5, truth);
-            CHECK(lf_lf_view_depth(&lf, -0.5, 0.5, &vo, &view, &err) == 0);
+            CHECK(lf_lightfield_view_depth(&lf, -0.5, 0.5, &vo, &view, &err) == 0);
             p_depth = psnr(view.data, truth, 8);
             lf_image_free(&view);
-            CHECK(lf_lf_view_at(&lf, -0.5, 0.5, 0.0, &view, &err) == 0);
+            CHECK(lf_lightfield_view_at(&lf, -0.5, 0.5, 0.0, &view, &err) == 0);
             p_plane = psnr(view.data, truth, 8);
             lf_image_free(&view);
-            CHECK(lf_lf_view_at(&lf, -0.5, 0.5, 1.0, &view, &err) == 0);
+            CHECK(lf_lightfield_view_at(&lf, -0.5, 0.5, 1.0, &view, &err) == 0);
             double p_plane1 = psnr(view.data, truth, 8);
             lf_image_free(&view);
             printf("  view (-0.5, 0.5): per-pixel depth %.2f dB, plane d=0 %.2f dB, plane d=1 %.2f dB\n", p_depth,
@@ -451,21 +451,21 @@ int main(void)
              * view position (2.5, 3.5) against its analytic render, with the
              * estimated map; the focal-plane geometry (plane at the
              * background's centre depth Z0) for comparison */
-            lf_lf_synth_opts so_ = lf_lf_synth_defaults();
+            lf_lightfield_synth_opts so_ = lf_lightfield_synth_defaults();
             so_.width = W, so_.height = H, so_.fov_deg = lf.layout.fov_deg, so_.spp = 4, so_.seed = 5;
             so_.pos[0] = (2.5 - (N - 1) / 2.0) * B, so_.pos[1] = -(3.5 - (N - 1) / 2.0) * B;
             so_.focal_distance = Z0;
             lf_image sy;
-            CHECK(lf_lf_synth(&lf, &so_, &sy, NULL, NULL, &err) == 0);
+            CHECK(lf_lightfield_synth(&lf, &so_, &sy, NULL, NULL, &err) == 0);
             double p_syn_plane = psnr(sy.data, truth, 8);
             lf_image_free(&sy);
             so_.disparity = &d;
-            CHECK_MSG(lf_lf_synth(&lf, &so_, &sy, NULL, NULL, &err) == 0, "%s", err.msg);
+            CHECK_MSG(lf_lightfield_synth(&lf, &so_, &sy, NULL, NULL, &err) == 0, "%s", err.msg);
             double p_syn_depth = psnr(sy.data, truth, 8);
             lf_image_free(&sy);
             printf("  synth at (2.5, 3.5): per-pixel depth %.2f dB, focal plane at Z0 %.2f dB\n", p_syn_depth,
                    p_syn_plane);
-            /* synth looks the cameras up bilinearly (lf_lf_view_depth bicubically),
+            /* synth looks the cameras up bilinearly (lf_lightfield_view_depth bicubically),
              * so it stays below the view synthesis: 39 dB, and better than the
              * best single focal plane */
             CHECK(p_syn_depth > 39);
@@ -474,7 +474,7 @@ int main(void)
             lf_image small;
             lf_image_alloc(&small, W / 2, H / 2, 1, &err);
             vo.disparity = &small, vo.confidence = NULL;
-            CHECK(lf_lf_view_depth(&lf, -0.5, 0.5, &vo, &view, &err) == LF_ERR_PARAM);
+            CHECK(lf_lightfield_view_depth(&lf, -0.5, 0.5, &vo, &view, &err) == LF_ERR_PARAM);
             lf_image_free(&small), lf_image_free(&conf);
         }
         lf_image_free(&d);
@@ -500,12 +500,12 @@ int main(void)
         lf_image gtm;
         CHECK(lf_image_alloc(&gtm, W, H, 1, &err) == 0);
         memcpy(gtm.data, gt, sizeof(float) * W * H);
-        vo = lf_lf_view_defaults();
+        vo = lf_lightfield_view_defaults();
         vo.disparity = &gtm;
         render(5.5, 5.5, truth);
-        CHECK(lf_lf_view_depth(&lf, 2.5, 2.5, &vo, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&lf, 2.5, 2.5, &vo, &view, &err) == 0);
         lf_image pl;
-        CHECK(lf_lf_view_at(&lf, 2.5, 2.5, 1.0, &pl, &err) == 0);
+        CHECK(lf_lightfield_view_at(&lf, 2.5, 2.5, 1.0, &pl, &err) == 0);
         double cx = 2.5 * B, cy = -2.5 * B, se[2] = {0, 0}, sp = 0;
         size_t nb[2] = {0, 0};
         for (int y = 8; y < H - 8; y++)
@@ -539,7 +539,7 @@ int main(void)
         CHECK(p_hole > p_pl + 5);
         lf_image_free(&view), lf_image_free(&gtm), lf_image_free(&pl);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 
     /* ---- 3. thin structures ----
      * The wedge (4 px down to nothing) and the 1-px rod of trace() in front
@@ -561,10 +561,10 @@ int main(void)
         ground_truth(gt);
         double rec[2], fat[2], bad[2];
         for (int on = 0; on < 2; on++) {
-            o = lf_lf_depth_defaults();
+            o = lf_lightfield_depth_defaults();
             o.thin = on ? 0 : -1;
             o.radius = 4; /* the window of views 512 px wide (the default is a 128th of the side) */
-            CHECK_MSG(lf_lf_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
+            CHECK_MSG(lf_lightfield_depth(&lf, &o, &d, NULL, &err) == 0, "%s", err.msg);
             size_t ns_ = 0, ok = 0, nb_ = 0, nf = 0;
             for (int y = 8; y < H - 8; y++)
                 for (int x = 8; x < W - 8; x++) {
@@ -589,7 +589,7 @@ int main(void)
         CHECK(rec[1] >= rec[0] + 40);
         CHECK(fat[1] <= 10);
         CHECK(bad[1] < bad[0]);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
 
     /* ---- 4. resampling phase ----
@@ -613,11 +613,11 @@ int main(void)
         enum { N4 = 7 };
         const double d4 = 2.0 / 3.0;
         lf_lightfield pl = {0};
-        CHECK(lf_lf_alloc(&pl, N4, N4, W, H, &err) == 0);
+        CHECK(lf_lightfield_alloc(&pl, N4, N4, W, H, &err) == 0);
         pl.disp_v_per_u = 1.0;
         for (int iv = 0; iv < N4; iv++)
             for (int iu = 0; iu < N4; iu++) {
-                float *v = lf_lf_view(&pl, iu, iv);
+                float *v = lf_lightfield_view(&pl, iu, iv);
                 for (int y = 0; y < H; y++)
                     for (int x = 0; x < W; x++)
                         for (int ch = 0; ch < 3; ch++)
@@ -632,17 +632,17 @@ int main(void)
         CHECK(lf_image_alloc(&dm, W, H, 1, &err) == 0);
         for (int i = 0; i < W * H; i++)
             dm.data[i] = (float)d4;
-        lf_lf_view_opts po = lf_lf_view_defaults();
+        lf_lightfield_view_opts po = lf_lightfield_view_defaults();
         po.disparity = &dm;
-        CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
         double p_fit = psnr(view.data, truth, 8);
         lf_image_free(&view);
         po.blend = 1;
-        CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
         double p_phase = psnr(view.data, truth, 8);
         lf_image_free(&view);
         po.radius = 1, po.phase_floor = 0;
-        CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
         double p_near4 = psnr(view.data, truth, 8);
         lf_image_free(&view);
         printf("resampling phase, plane d = 2/3, view (0.5, 0.5): scattered-data fit %.2f dB; blend: 16 views "
@@ -666,20 +666,20 @@ int main(void)
                 }
                 pl.data[q] += (float)(0.01 * (a - 6));
             }
-            po = lf_lf_view_defaults();
+            po = lf_lightfield_view_defaults();
             po.disparity = &dm;
-            CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+            CHECK(lf_lightfield_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
             double n_fit = psnr(view.data, truth, 8);
             lf_image_free(&view);
             po.blend = 1;
-            CHECK(lf_lf_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
+            CHECK(lf_lightfield_view_depth(&pl, 0.5, 0.5, &po, &view, &err) == 0);
             double n_phase = psnr(view.data, truth, 8);
             lf_image_free(&view);
             printf("  with noise 0.01: scattered-data fit %.2f dB, blend %.2f dB\n", n_fit, n_phase);
             CHECK(n_fit > n_phase + 3);
         }
         lf_image_free(&dm);
-        lf_lf_free(&pl);
+        lf_lightfield_free(&pl);
     }
 
     /* ---- 5. self-calibration of view positions ----
@@ -710,19 +710,19 @@ int main(void)
                 te[k][2] = ctr ? 0 : 0.8 * (hash2(iu, 80 + iv) - 0.5);
                 te[k][3] = ctr ? 0 : 0.8 * (hash2(iu, 90 + iv) - 0.5);
                 g_ox = te[k][2], g_oy = te[k][3];
-                render(iu + te[k][0], iv + te[k][1], lf_lf_view(&pl, iu, iv));
+                render(iu + te[k][0], iv + te[k][1], lf_lightfield_view(&pl, iu, iv));
             }
         g_ox = g_oy = 0;
         ground_truth(gt);
-        lf_lf_depth_opts co = lf_lf_depth_defaults();
+        lf_lightfield_depth_opts co = lf_lightfield_depth_defaults();
         lf_image d0, c0;
-        CHECK_MSG(lf_lf_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
         scores s_nom = score(d0.data, gt, NULL);
         double rep[N * N * 6];
-        CHECK_MSG(lf_lf_calibrate_views(&pl, &d0, &c0, 2, rep, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_calibrate_views(&pl, &d0, &c0, 2, rep, &err) == 0, "%s", err.msg);
         lf_image_free(&d0), lf_image_free(&c0);
-        CHECK_MSG(lf_lf_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
-        CHECK_MSG(lf_lf_calibrate_views(&pl, &d0, &c0, 2, rep, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_calibrate_views(&pl, &d0, &c0, 2, rep, &err) == 0, "%s", err.msg);
         /* the error that matters: of the predicted shift -d su + o over the
          * scene's disparities (baseline and offset trade off against each
          * other the less the disparities spread) */
@@ -746,7 +746,7 @@ int main(void)
                        esv, eox, eoy, rep[6 * k + 4], rep[6 * k + 5]);
         }
         lf_image_free(&d0), lf_image_free(&c0);
-        CHECK_MSG(lf_lf_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_depth(&pl, &co, &d0, &c0, &err) == 0, "%s", err.msg);
         scores s_cal = score(d0.data, gt, NULL);
         printf("perturbed views: %d of %d fitted, predicted shift error at most %.4f px over d %.2f .. %.2f "
                "(nominal grid %.4f px); depth BadPix0.07 %.2f %% (nominal grid %.2f %%), MSE x 100 %.4f (%.4f)\n",
@@ -758,7 +758,7 @@ int main(void)
         CHECK(s_cal.bad07 < 2.0);
         CHECK(s_cal.mse100 < 1.6);
         /* a view between the calibrated cameras: at the position interpolated
-         * between its 4 neighbours (lf_lf_view_shift) */
+         * between its 4 neighbours (lf_lightfield_view_shift) */
         double st[4] = {0, 0, 0, 0};
         for (int k = 0; k < 4; k++) {
             int iu = 3 + (k & 1), iv = 1 + (k >> 1);
@@ -768,14 +768,14 @@ int main(void)
         g_ox = st[2], g_oy = st[3];
         render(3.5 + st[0], 1.5 + st[1], truth);
         g_ox = g_oy = 0;
-        lf_lf_view_opts cvo = lf_lf_view_defaults();
+        lf_lightfield_view_opts cvo = lf_lightfield_view_defaults();
         cvo.disparity = &d0, cvo.confidence = &c0;
-        CHECK(lf_lf_view_depth(&pl, 0.5, -1.5, &cvo, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&pl, 0.5, -1.5, &cvo, &view, &err) == 0);
         double p_cal = psnr(view.data, truth, 8);
         lf_image_free(&view);
         double *keep = pl.view_shift;
         pl.view_shift = NULL;
-        CHECK(lf_lf_view_depth(&pl, 0.5, -1.5, &cvo, &view, &err) == 0);
+        CHECK(lf_lightfield_view_depth(&pl, 0.5, -1.5, &cvo, &view, &err) == 0);
         double p_nom = psnr(view.data, truth, 8);
         lf_image_free(&view);
         pl.view_shift = keep;
@@ -785,17 +785,17 @@ int main(void)
         /* bad input */
         lf_image small;
         lf_image_alloc(&small, W / 2, H / 2, 1, &err);
-        CHECK(lf_lf_calibrate_views(&pl, &small, NULL, 2, NULL, &err) == LF_ERR_PARAM);
+        CHECK(lf_lightfield_calibrate_views(&pl, &small, NULL, 2, NULL, &err) == LF_ERR_PARAM);
         lf_image_free(&small);
         lf_image_free(&d0), lf_image_free(&c0);
-        lf_lf_free(&pl);
+        lf_lightfield_free(&pl);
     }
 
     /* ---- 3. bad input ---- */
     lf_lightfield one = {0};
-    lf_lf_alloc(&one, 1, 1, 16, 16, &err);
-    CHECK(lf_lf_depth(&one, NULL, &d, NULL, &err) == LF_ERR_PARAM);
-    lf_lf_free(&one);
+    lf_lightfield_alloc(&one, 1, 1, 16, 16, &err);
+    CHECK(lf_lightfield_depth(&one, NULL, &d, NULL, &err) == LF_ERR_PARAM);
+    lf_lightfield_free(&one);
 
     free(gt), free(band_out), free(band_in), free(truth);
     return lf_test_end();

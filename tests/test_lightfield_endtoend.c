@@ -91,26 +91,26 @@ int main(void)
         CHECK_MSG(0, "plenoptic render failed: %s", msg);
         return lf_test_end();
     }
-    lf_lf_layout file, flags, lay;
-    lf_lf_layout_init(&file);
-    lf_lf_layout_init(&flags);
-    CHECK(lf_lf_layout_from_attrs(&meta, &file, &err) == 0);
-    if (lf_lf_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err)) {
+    lf_lightfield_layout file, flags, lay;
+    lf_lightfield_layout_init(&file);
+    lf_lightfield_layout_init(&flags);
+    CHECK(lf_lightfield_layout_from_attrs(&meta, &file, &err) == 0);
+    if (lf_lightfield_layout_resolve(&file, &flags, raw.width, raw.height, &lay, &err)) {
         CHECK_MSG(0, "layout: %s", err.msg);
         return lf_test_end();
     }
-    CHECK(lay.kind == LF_LF_PLENOPTIC && lay.lens_x == NLX && lay.lens_y == NLY);
+    CHECK(lay.kind == LF_LIGHTFIELD_PLENOPTIC && lay.lens_x == NLX && lay.lens_y == NLY);
 
     /* ---- alpha = 1 is the plain mean of the views (no white: every sample valid) ---- */
     {
         lf_lightfield lf = {0};
-        CHECK(lf_lf_decode(&raw, &lay, NULL, &lf, &err) == 0);
+        CHECK(lf_lightfield_decode(&raw, &lay, NULL, &lf, &err) == 0);
         double disp = NAN;
-        CHECK(lf_lf_alpha_to_disparity(&lf, 1.0, &disp, &err) == 0 && disp == 0.0);
-        lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+        CHECK(lf_lightfield_alpha_to_disparity(&lf, 1.0, &disp, &err) == 0 && disp == 0.0);
+        lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
         o.disparity_px = disp;
         lf_image out;
-        if (lf_lf_refocus(&lf, &o, &out, &err) == 0) {
+        if (lf_lightfield_refocus(&lf, &o, &out, &err) == 0) {
             double worst = 0, scale = 0;
             size_t plane = (size_t)lf.ns * lf.nt * 3;
             for (size_t k = 0; k < plane; k++) {
@@ -120,7 +120,7 @@ int main(void)
                     for (int u = 0; u < lf.nu; u++) {
                         if (lf.valid && lf.valid[((size_t)v * lf.nu + u) * lf.ns * lf.nt + k / 3] == 0.f)
                             continue;
-                        sum += lf_lf_view(&lf, u, v)[k], n++;
+                        sum += lf_lightfield_view(&lf, u, v)[k], n++;
                     }
                 double mean = n ? sum / n : 0;
                 worst = fmax(worst, fabs(out.data[k] - mean));
@@ -134,21 +134,21 @@ int main(void)
         } else {
             CHECK_MSG(0, "refocus: %s", err.msg);
         }
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
 
     /* ---- refocus at plane A, devignetted by the white image ---- */
     lf_lightfield lf = {0};
-    if (lf_lf_decode(&raw, &lay, &white, &lf, &err)) {
+    if (lf_lightfield_decode(&raw, &lay, &white, &lf, &err)) {
         CHECK_MSG(0, "decode: %s", err.msg);
         return lf_test_end();
     }
     CHECK(lf.ns == NLX && lf.nt == NLY);
     double disp = NAN, disp_alpha = NAN;
-    CHECK(lf_lf_depth_to_disparity(&lf, ZA, &disp, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, ZA, &disp, &err) == 0);
     /* the same through alpha: 1/z + 1/(alpha z_i) = 1/f */
     double f = F_MM * 1e-3, zi = f * FOCUS_M / (FOCUS_M - f), alpha = 1 / (zi * (1 / f - 1 / ZA));
-    CHECK(lf_lf_alpha_to_disparity(&lf, alpha, &disp_alpha, &err) == 0);
+    CHECK(lf_lightfield_alpha_to_disparity(&lf, alpha, &disp_alpha, &err) == 0);
     CHECK_MSG(fabs(disp - disp_alpha) < 1e-9, "depth -> disparity %.9g, alpha %.6g -> %.9g", disp, alpha, disp_alpha);
     /* expected disparity per view step, from the design: a pixel one pixel
      * (Pm / 15 on the sensor) off a microlens image's centre sees, through the
@@ -161,18 +161,18 @@ int main(void)
     double disp_expect = (1 - 1 / alpha) * (Pm / PITCH_PX) * zi / fm / p;
     CHECK_NEAR((Pm / PITCH_PX) * zi / fm, (D + p) / PITCH_PX, 1e-12);
     CHECK_MSG(fabs(disp / disp_expect - 1) < 1e-6, "disparity %.6g px per view, expected %.6g", disp, disp_expect);
-    lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
     o.disparity_px = disp;
     lf_image refocused;
-    if (lf_lf_refocus(&lf, &o, &refocused, &err)) {
+    if (lf_lightfield_refocus(&lf, &o, &refocused, &err)) {
         CHECK_MSG(0, "refocus: %s", err.msg);
         return lf_test_end();
     }
     /* and at the capture's own focus (alpha = 1), plane A is blurred: the
      * comparison below can tell */
-    lf_lf_refocus_opts o1 = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts o1 = lf_lightfield_refocus_defaults();
     lf_image unfocused;
-    CHECK(lf_lf_refocus(&lf, &o1, &unfocused, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o1, &unfocused, &err) == 0);
 
     /* ---- the thin-lens reference focused on A, at the view resolution ---- */
     double zs = f * ZA / (ZA - f), wt = SENSOR_W * zs / (zi + fm);
@@ -243,7 +243,7 @@ int main(void)
     lf_image_free(&thin_white);
     lf_image_free(&refocused);
     lf_image_free(&unfocused);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
     lf_image_free(&white);
     lf_attrs_free(&meta);

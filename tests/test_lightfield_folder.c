@@ -129,17 +129,17 @@ static void write_view(const char *path, int k, int w, int h)
     lf_image_free(&img);
 }
 
-static int scan_load(const char *dir, lf_lf_folder *f, lf_lightfield *lf, lf_error *err)
+static int scan_load(const char *dir, lf_lightfield_folder *f, lf_lightfield *lf, lf_error *err)
 {
     memset(lf, 0, sizeof *lf);
-    int rc = lf_lf_folder_scan(dir, f, err);
+    int rc = lf_lightfield_folder_scan(dir, f, err);
     if (!rc)
-        rc = lf_lf_folder_load(f, NULL, lf, err);
+        rc = lf_lightfield_folder_load(f, NULL, lf, err);
     return rc;
 }
 
 /* Every view of lf equals the file read on its own (placement). */
-static int views_match_files(const lf_lf_folder *f, const lf_lightfield *lf)
+static int views_match_files(const lf_lightfield_folder *f, const lf_lightfield *lf)
 {
     int ok = 1;
     for (int iv = 0; iv < lf->nv; iv++)
@@ -148,7 +148,7 @@ static int views_match_files(const lf_lf_folder *f, const lf_lightfield *lf)
             lf_error err = {0};
             if (lf_image_read(f->files[iv * lf->nu + iu], &img, NULL, &err))
                 return 0;
-            ok &= memcmp(img.data, lf_lf_view(lf, iu, iv), sizeof(float) * 3 * lf->ns * lf->nt) == 0;
+            ok &= memcmp(img.data, lf_lightfield_view(lf, iu, iv), sizeof(float) * 3 * lf->ns * lf->nt) == 0;
             lf_image_free(&img);
         }
     return ok;
@@ -179,41 +179,41 @@ static void test_hci(void)
     make_hci(dir);
     snprintf(path, sizeof path, "%s/LICENSE.txt", dir); /* other files are ignored */
     write_text(path, "x");
-    lf_lf_folder f;
+    lf_lightfield_folder f;
     lf_lightfield lf;
     lf_error err = {0};
     CHECK_MSG(scan_load(dir, &f, &lf, &err) == 0, "%s", err.msg);
-    CHECK(f.kind == LF_LF_FOLDER_HCI && lf.nu == 3 && lf.nv == 2 && lf.ns == W && lf.nt == H);
+    CHECK(f.kind == LF_LIGHTFIELD_FOLDER_HCI && lf.nu == 3 && lf.nv == 2 && lf.ns == W && lf.nt == H);
     if (lf.data) {
         CHECK(views_match_files(&f, &lf));
         /* view (2, 1) is file 1 * 3 + 2 = 5, 8-bit sRGB linearised */
-        float v = lf_lf_view(&lf, 2, 1)[(3 * W + 4) * 3 + 1];
+        float v = lf_lightfield_view(&lf, 2, 1)[(3 * W + 4) * 3 + 1];
         double byte = floor(255 * (1.055 * pow(pattern(5, 4, 3, 1), 1 / 2.4) - 0.055) + 0.5);
         CHECK_NEAR(v, srgb_linear(byte / 255), 1e-6);
     }
     /* geometry from parameters.cfg: F = 50 / 36 * 8 px (sensor across the
      * longer side), baseline 2 cm, disparity 0 at 3 m */
     double F = 50.0 / 36 * 8;
-    CHECK(lf.layout.kind == LF_LF_CAMERA_ARRAY && lf.layout.cams_x == 3 && lf.layout.cams_y == 2);
+    CHECK(lf.layout.kind == LF_LIGHTFIELD_CAMERA_ARRAY && lf.layout.cams_x == 3 && lf.layout.cams_y == 2);
     CHECK_NEAR(lf.disp_per_inv_m, F * 0.02, 1e-9);
     CHECK_NEAR(lf.disp_at_inf, -F * 0.02 / 3, 1e-9);
     CHECK_NEAR(lf.layout.fov_deg, 2 * atan(3 / F) * 180 / M_PI, 1e-9);
     CHECK_NEAR(lf.layout.grid_bounds[1] - lf.layout.grid_bounds[0], 0.04, 1e-12);
     CHECK_NEAR(lf.layout.grid_bounds[3] - lf.layout.grid_bounds[2], 0.02, 1e-12);
-    CHECK((lf.layout.have & LF_LF_HAVE_DISP_RANGE) && lf.layout.disp_min == -0.5 && lf.layout.disp_max == 1.25);
+    CHECK((lf.layout.have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && lf.layout.disp_min == -0.5 && lf.layout.disp_max == 1.25);
     double d;
-    CHECK(lf_lf_depth_to_disparity(&lf, 3.0, &d, &err) == 0 && fabs(d) < 1e-12);
-    lf_lf_free(&lf);
-    lf_lf_folder_free(&f);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, 3.0, &d, &err) == 0 && fabs(d) < 1e-12);
+    lf_lightfield_free(&lf);
+    lf_lightfield_folder_free(&f);
 
     /* flags that contradict the folder fail; agreeing ones pass */
-    lf_lf_layout fl;
-    lf_lf_layout_init(&fl);
-    fl.cams_x = 2, fl.cams_y = 3, fl.have = LF_LF_HAVE_CAMS;
+    lf_lightfield_layout fl;
+    lf_lightfield_layout_init(&fl);
+    fl.cams_x = 2, fl.cams_y = 3, fl.have = LF_LIGHTFIELD_HAVE_CAMS;
     lf_error e2 = {0};
-    CHECK(lf_lf_folder_scan(dir, &f, &e2) == 0);
-    CHECK(lf_lf_folder_load(&f, &fl, &lf, &e2) != 0 && strstr(e2.msg, "--camsperdim"));
-    lf_lf_folder_free(&f);
+    CHECK(lf_lightfield_folder_scan(dir, &f, &e2) == 0);
+    CHECK(lf_lightfield_folder_load(&f, &fl, &lf, &e2) != 0 && strstr(e2.msg, "--camsperdim"));
+    lf_lightfield_folder_free(&f);
 
     /* no parameters.cfg: a square count of views makes the grid */
     snprintf(path, sizeof path, "%s/hci_nocfg", root);
@@ -226,14 +226,14 @@ static void test_hci(void)
     lf_error e3 = {0};
     CHECK_MSG(scan_load(path, &f, &lf, &e3) == 0, "%s", e3.msg);
     CHECK(lf.nu == 2 && lf.nv == 2 && lf.disp_per_inv_m == 0);
-    lf_lf_free(&lf);
-    lf_lf_folder_free(&f);
+    lf_lightfield_free(&lf);
+    lf_lightfield_folder_free(&f);
 }
 
 /* One failure: scan or load fails and the message names each of `names`. */
 static void expect_fail(const char *dir, const char *a, const char *b)
 {
-    lf_lf_folder f;
+    lf_lightfield_folder f;
     lf_lightfield lf;
     lf_error err = {0};
     int rc = scan_load(dir, &f, &lf, &err);
@@ -242,8 +242,8 @@ static void expect_fail(const char *dir, const char *a, const char *b)
     if (b)
         CHECK_MSG(strstr(err.msg, b) != NULL, "\"%s\" lacks \"%s\"", err.msg, b);
     if (!rc)
-        lf_lf_free(&lf);
-    lf_lf_folder_free(&f);
+        lf_lightfield_free(&lf);
+    lf_lightfield_folder_free(&f);
 }
 
 static void test_hci_failures(void)
@@ -304,18 +304,18 @@ static void test_rowcol(void)
         }
     snprintf(path, sizeof path, "%s/scene_depth.png", dir); /* no row/column: ignored */
     write_view(path, 99, 3, 3);
-    lf_lf_folder f;
+    lf_lightfield_folder f;
     lf_lightfield lf;
     lf_error err = {0};
     CHECK_MSG(scan_load(dir, &f, &lf, &err) == 0, "%s", err.msg);
-    CHECK(f.kind == LF_LF_FOLDER_ROWCOL && f.base == 0 && lf.nu == 3 && lf.nv == 2);
+    CHECK(f.kind == LF_LIGHTFIELD_FOLDER_ROWCOL && f.base == 0 && lf.nu == 3 && lf.nv == 2);
     if (lf.data) {
         /* EXR is linear float: row 1, column 2 holds pattern 12 exactly */
-        CHECK(lf_lf_view(&lf, 2, 1)[(2 * W + 5) * 3 + 2] == pattern(12, 5, 2, 2));
-        CHECK(lf_lf_view(&lf, 0, 1)[0] == pattern(10, 0, 0, 0));
+        CHECK(lf_lightfield_view(&lf, 2, 1)[(2 * W + 5) * 3 + 2] == pattern(12, 5, 2, 2));
+        CHECK(lf_lightfield_view(&lf, 0, 1)[0] == pattern(10, 0, 0, 0));
     }
-    lf_lf_free(&lf);
-    lf_lf_folder_free(&f);
+    lf_lightfield_free(&lf);
+    lf_lightfield_folder_free(&f);
     /* a missing view named by row and column */
     snprintf(path, sizeof path, "%s/scene_01_00.exr", dir);
     remove(path);
@@ -338,10 +338,10 @@ static void test_rowcol(void)
         /* row 2, column 1 = view (0, 1); sample i of it */
         int i = (3 * W + 2) * 3 + 1;
         double c16 = (double)((i * 997 + 2 * 4099 + 1 * 13) % 65536) / 65535;
-        CHECK_NEAR(lf_lf_view(&lf, 0, 1)[i], srgb_linear(c16), 2e-6);
+        CHECK_NEAR(lf_lightfield_view(&lf, 0, 1)[i], srgb_linear(c16), 2e-6);
     }
-    lf_lf_free(&lf);
-    lf_lf_folder_free(&f);
+    lf_lightfield_free(&lf);
+    lf_lightfield_folder_free(&f);
     /* rows from 1, columns from 0: refused */
     snprintf(path, sizeof path, "%s/out_01_00_0.0_0.0.png", dir);
     write_png16(path, W, H, px);
@@ -358,31 +358,31 @@ static void test_rowcol(void)
     expect_fail(dir, "no light-field views", "input_CamNNN");
 }
 
-/* lf_lf_write_hci, read back by the folder reader. */
+/* lf_lightfield_write_hci, read back by the folder reader. */
 static void test_write_hci(void)
 {
     lf_lightfield lf;
     lf_error err = {0};
-    CHECK(lf_lf_alloc(&lf, 3, 3, 10, 7, &err) == 0);
+    CHECK(lf_lightfield_alloc(&lf, 3, 3, 10, 7, &err) == 0);
     for (int k = 0; k < 9; k++)
         for (int p = 0; p < 70; p++)
             for (int c = 0; c < 3; c++)
                 lf.data[((size_t)k * 70 + p) * 3 + c] = (float)srgb_linear(pattern(k, p % 10, p / 10, c));
-    lf_lf_layout lay;
-    lf_lf_layout_init(&lay);
-    lay.kind = LF_LF_CAMERA_ARRAY, lay.cams_x = lay.cams_y = 3, lay.tile_w = 10, lay.tile_h = 7;
+    lf_lightfield_layout lay;
+    lf_lightfield_layout_init(&lay);
+    lay.kind = LF_LIGHTFIELD_CAMERA_ARRAY, lay.cams_x = lay.cams_y = 3, lay.tile_w = 10, lay.tile_h = 7;
     lay.grid_bounds[0] = -0.05, lay.grid_bounds[1] = 0.05, lay.grid_bounds[2] = -0.05, lay.grid_bounds[3] = 0.05;
     lay.fov_deg = 35;
-    lay.have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_TILE | LF_LF_HAVE_BOUNDS | LF_LF_HAVE_FOV;
-    lf_lf_set_geometry(&lf, &lay);
+    lay.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_TILE | LF_LIGHTFIELD_HAVE_BOUNDS | LF_LIGHTFIELD_HAVE_FOV;
+    lf_lightfield_set_geometry(&lf, &lay);
     lf_image gt;
     CHECK(lf_image_alloc(&gt, 10, 7, 1, &err) == 0);
     for (int p = 0; p < 70; p++)
         gt.data[p] = (float)(-0.3 + 0.021 * p);
     char dir[512], path[700];
     snprintf(dir, sizeof dir, "%s/written", root);
-    CHECK_MSG(lf_lf_write_hci(dir, &lf, &gt, &err) == 0, "%s", err.msg);
-    lf_lf_folder f;
+    CHECK_MSG(lf_lightfield_write_hci(dir, &lf, &gt, &err) == 0, "%s", err.msg);
+    lf_lightfield_folder f;
     lf_lightfield back;
     CHECK_MSG(scan_load(dir, &f, &back, &err) == 0, "%s", err.msg);
     CHECK(back.nu == 3 && back.nv == 3 && back.ns == 10 && back.nt == 7);
@@ -399,7 +399,7 @@ static void test_write_hci(void)
     CHECK_NEAR(back.layout.fov_deg, 35, 1e-6);
     CHECK_NEAR(back.layout.grid_bounds[1] - back.layout.grid_bounds[0], 0.1, 1e-9);
     CHECK_NEAR(back.disp_per_inv_m, lf.disp_per_inv_m, 1e-6 * lf.disp_per_inv_m);
-    CHECK(back.layout.have & LF_LF_HAVE_DISP_RANGE);
+    CHECK(back.layout.have & LF_LIGHTFIELD_HAVE_DISP_RANGE);
     CHECK_NEAR(back.layout.disp_min, -0.3, 1e-6);
     CHECK_NEAR(back.layout.disp_max, -0.3 + 0.021 * 69, 1e-6);
     CHECK(f.gt_disparity != NULL);
@@ -408,10 +408,10 @@ static void test_write_hci(void)
     CHECK(lf_image_read(path, &g2, NULL, &err) == 0);
     CHECK(g2.width == 10 && g2.height == 7 && g2.data && memcmp(g2.data, gt.data, 70 * sizeof(float)) == 0);
     lf_image_free(&g2);
-    lf_lf_free(&back);
-    lf_lf_folder_free(&f);
+    lf_lightfield_free(&back);
+    lf_lightfield_folder_free(&f);
     lf_image_free(&gt);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 }
 
 int main(void)

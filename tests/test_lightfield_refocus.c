@@ -39,17 +39,17 @@ static void render_view(double cx, double cy, float *dst)
 static void make_lf(lf_lightfield *lf)
 {
     lf_error err = {0};
-    lf_lf_alloc(lf, N, N, W, H, &err);
+    lf_lightfield_alloc(lf, N, N, W, H, &err);
     double minx = -B * (N - 1) / 2, maxy = B * (N - 1) / 2;
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++)
-            render_view(minx + i * B, maxy - j * B, lf_lf_view(lf, i, j));
-    lf_lf_layout *l = &lf->layout;
-    l->kind = LF_LF_CAMERA_ARRAY;
+            render_view(minx + i * B, maxy - j * B, lf_lightfield_view(lf, i, j));
+    lf_lightfield_layout *l = &lf->layout;
+    l->kind = LF_LIGHTFIELD_CAMERA_ARRAY;
     l->cams_x = l->cams_y = N;
     l->grid_bounds[0] = minx, l->grid_bounds[1] = -minx, l->grid_bounds[2] = -maxy, l->grid_bounds[3] = maxy;
     l->fov_deg = FOV, l->tile_w = W, l->tile_h = H;
-    l->have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_BOUNDS | LF_LF_HAVE_FOV | LF_LF_HAVE_TILE;
+    l->have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_BOUNDS | LF_LIGHTFIELD_HAVE_FOV | LF_LIGHTFIELD_HAVE_TILE;
     lf->disp_per_inv_m = fpx() * B;
     lf->disp_v_per_u = 1;
 }
@@ -75,21 +75,21 @@ int main(void)
     lf_error err = {0};
     const double d_plane = fpx() * B / Z; /* 2.197 px per view step */
     const int margin = (int)ceil(d_plane * (N - 1) / 2) + 2;
-    float *centre = lf_lf_view(&lf, N / 2, N / 2);
+    float *centre = lf_lightfield_view(&lf, N / 2, N / 2);
 
     /* depth -> disparity uses F_px b / Z */
     double d = 0;
-    CHECK(lf_lf_depth_to_disparity(&lf, Z, &d, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, Z, &d, &err) == 0);
     CHECK_NEAR(d, d_plane, 1e-9);
-    CHECK(lf_lf_alpha_to_disparity(&lf, 1.0, &d, &err) != 0); /* no main lens: alpha refused */
+    CHECK(lf_lightfield_alpha_to_disparity(&lf, 1.0, &d, &err) != 0); /* no main lens: alpha refused */
     CHECK(strstr(err.msg, "alpha") != NULL);
     lf_error_clear(&err);
 
     /* refocus at the plane's disparity reproduces the sharp texture */
-    lf_lf_refocus_opts o = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts o = lf_lightfield_refocus_defaults();
     o.disparity_px = d_plane;
     lf_image img;
-    CHECK_MSG(lf_lf_refocus(&lf, &o, &img, &err) == 0, "%s", err.msg);
+    CHECK_MSG(lf_lightfield_refocus(&lf, &o, &img, &err) == 0, "%s", err.msg);
     double p_focus = psnr_interior(&img, centre, margin);
     printf("refocus at plane disparity %.3f px: PSNR %.2f dB vs the sharp centre view (threshold 40)\n", d_plane,
            p_focus);
@@ -98,7 +98,7 @@ int main(void)
 
     /* refocus elsewhere is blurred: at least 10 dB worse */
     o.disparity_px = 0;
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == 0);
     double p_off = psnr_interior(&img, centre, margin);
     printf("refocus at disparity 0: PSNR %.2f dB (must be 10 dB below)\n", p_off);
     CHECK(p_off < p_focus - 10);
@@ -122,16 +122,16 @@ int main(void)
     lf_image one, two;
     o.disparity_px = 1.37;
     o.threads = 1;
-    CHECK(lf_lf_refocus(&lf, &o, &one, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &one, &err) == 0);
     o.threads = 2;
-    CHECK(lf_lf_refocus(&lf, &o, &two, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &two, &err) == 0);
     CHECK(memcmp(one.data, two.data, sizeof(float) * W * H * 3) == 0);
     lf_image_free(&one);
 
     /* half-float storage: the same refocus within half precision (2^-11 relative) */
-    CHECK(lf_lf_make_half(&lf, &err) == 0);
+    CHECK(lf_lightfield_make_half(&lf, &err) == 0);
     o.use_half = 1;
-    CHECK(lf_lf_refocus(&lf, &o, &one, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &one, &err) == 0);
     double hmax = 0;
     for (size_t i = 0; i < (size_t)W * H * 3; i++)
         hmax = fmax(hmax, fabs(one.data[i] - two.data[i]));
@@ -141,48 +141,48 @@ int main(void)
     o.use_half = 0;
 
     /* synthetic aperture: radius 0 selects the centre view only; a window selects one view */
-    o = lf_lf_refocus_defaults();
+    o = lf_lightfield_refocus_defaults();
     o.disparity_px = d_plane;
     o.aperture_radius = 0;
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == 0);
     CHECK(memcmp(img.data, centre, sizeof(float) * W * H * 3) == 0);
     lf_image_free(&img);
     o.aperture_radius = -1;
     o.disparity_px = 0;
     o.u0 = o.u1 = 2, o.v0 = o.v1 = 5;
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == 0);
-    CHECK(memcmp(img.data, lf_lf_view(&lf, 2, 5), sizeof(float) * W * H * 3) == 0);
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == 0);
+    CHECK(memcmp(img.data, lf_lightfield_view(&lf, 2, 5), sizeof(float) * W * H * 3) == 0);
     lf_image_free(&img);
     o.u0 = 20, o.u1 = 30;
-    CHECK(lf_lf_refocus(&lf, &o, &img, &err) == LF_ERR_PARAM); /* empty aperture */
+    CHECK(lf_lightfield_refocus(&lf, &o, &img, &err) == LF_ERR_PARAM); /* empty aperture */
     lf_error_clear(&err);
 
     /* view interpolation: at a view position it is that view, exactly */
-    CHECK(lf_lf_view_at(&lf, -2, 1, 0, &img, &err) == 0);
-    CHECK(memcmp(img.data, lf_lf_view(&lf, 2, 5), sizeof(float) * W * H * 3) == 0);
+    CHECK(lf_lightfield_view_at(&lf, -2, 1, 0, &img, &err) == 0);
+    CHECK(memcmp(img.data, lf_lightfield_view(&lf, 2, 5), sizeof(float) * W * H * 3) == 0);
     lf_image_free(&img);
     /* between views, reprojected at the plane's disparity: the analytic view from there */
     float *truth = malloc(sizeof(float) * W * H * 3);
     render_view(0.35 * B, -0.6 * B, truth); /* u = 0.35, v = +0.6 (down) */
-    CHECK(lf_lf_view_at(&lf, 0.35, 0.6, d_plane, &img, &err) == 0);
+    CHECK(lf_lightfield_view_at(&lf, 0.35, 0.6, d_plane, &img, &err) == 0);
     double p_view = psnr_interior(&img, truth, 4);
     printf("view at (0.35, 0.6): PSNR %.2f dB vs analytic view (threshold 40)\n", p_view);
     CHECK(p_view > 40);
     lf_image_free(&img);
-    CHECK(lf_lf_view_at(&lf, 4.5, 0, 0, &img, &err) == LF_ERR_PARAM); /* outside the aperture */
+    CHECK(lf_lightfield_view_at(&lf, 4.5, 0, 0, &img, &err) == LF_ERR_PARAM); /* outside the aperture */
     CHECK(strstr(err.msg, "outside") != NULL);
     lf_error_clear(&err);
 
     /* Fourier slice agrees with shift-and-add away from the border */
-    lf_lf_fourier *fs = NULL;
-    CHECK_MSG(lf_lf_fourier_new(&lf, NULL, 2.0, &fs, &err) == 0, "%s", err.msg);
+    lf_lightfield_fourier *fs = NULL;
+    CHECK_MSG(lf_lightfield_fourier_new(&lf, NULL, 2.0, &fs, &err) == 0, "%s", err.msg);
     const double ds[3] = {d_plane, 0.0, -1.3};
     for (int k = 0; k < 3 && fs; k++) {
-        o = lf_lf_refocus_defaults();
+        o = lf_lightfield_refocus_defaults();
         o.disparity_px = ds[k];
         lf_image a, b;
-        CHECK(lf_lf_refocus(&lf, &o, &a, &err) == 0);
-        CHECK_MSG(lf_lf_fourier_refocus(fs, ds[k], &b, &err) == 0, "%s", err.msg);
+        CHECK(lf_lightfield_refocus(&lf, &o, &a, &err) == 0);
+        CHECK_MSG(lf_lightfield_fourier_refocus(fs, ds[k], &b, &err) == 0, "%s", err.msg);
         int m = (int)ceil(fabs(ds[k]) * (N - 1) / 2) + 2;
         double p = psnr_interior(&b, a.data, m);
         printf("Fourier slice vs shift-and-add at d = %.3f: PSNR %.2f dB over [%d, %d) (threshold 35)\n", ds[k], p, m,
@@ -190,12 +190,12 @@ int main(void)
         CHECK(p > 35);
         lf_image_free(&a), lf_image_free(&b);
     }
-    lf_lf_fourier_release(fs);
+    lf_lightfield_fourier_release(fs);
 
     /* all-in-focus and disparity from a stack: the plane's disparity is found */
     lf_image af, dm;
-    o = lf_lf_refocus_defaults();
-    CHECK(lf_lf_allfocus(&lf, &o, 0, 4, 21, &af, &dm, &err) == 0);
+    o = lf_lightfield_refocus_defaults();
+    CHECK(lf_lightfield_allfocus(&lf, &o, 0, 4, 21, &af, &dm, &err) == 0);
     double dsum = 0;
     int dn = 0;
     for (int y = margin; y < H - margin; y++)
@@ -207,6 +207,6 @@ int main(void)
 
     free(truth);
     lf_image_free(&two);
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     return lf_test_end();
 }

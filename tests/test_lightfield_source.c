@@ -39,12 +39,12 @@ static int write_raw(const char *path, float nan_at, const char *disp_file, int 
                         lf_image_px(&raw, iu * TW + s, iv * TH + t)[c] = sample(iu, iv, s, t, c);
     if (nan_at >= 0)
         raw.data[(size_t)nan_at] = NAN;
-    lf_lf_layout lay;
-    lf_lf_layout_init(&lay);
-    lay.kind = LF_LF_CAMERA_ARRAY, lay.cams_x = NU, lay.cams_y = NV, lay.tile_w = TW, lay.tile_h = TH;
-    lay.have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_TILE;
+    lf_lightfield_layout lay;
+    lf_lightfield_layout_init(&lay);
+    lay.kind = LF_LIGHTFIELD_CAMERA_ARRAY, lay.cams_x = NU, lay.cams_y = NV, lay.tile_w = TW, lay.tile_h = TH;
+    lay.have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_TILE;
     lf_attrs a = {0};
-    int rc = lf_lf_layout_to_attrs(&lay, &a, &err);
+    int rc = lf_lightfield_layout_to_attrs(&lay, &a, &err);
     if (disp_file)
         lf_attrs_set_string(&a, LF_KEY_DISPARITY_FILE, disp_file);
     if (with_range)
@@ -64,10 +64,10 @@ static void test_open_and_views(void)
     char raw_path[300], views[300], p[400];
     snprintf(raw_path, sizeof raw_path, "%s/raw.exr", dir);
     CHECK(write_raw(raw_path, -1, NULL, 1) == 0);
-    lf_lf_source src;
+    lf_lightfield_source src;
     lf_error err = {0};
-    lf_lf_open_opts oo = {0};
-    CHECK(lf_lf_open(raw_path, &oo, &src, &err) == 0);
+    lf_lightfield_open_opts oo = {0};
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &err) == 0);
     CHECK(src.lf.nu == NU && src.lf.nv == NV && src.lf.ns == TW && src.lf.nt == TH);
     CHECK(src.folder.dir == NULL && src.raw_nonfinite == 0);
     int bad = 0;
@@ -76,22 +76,22 @@ static void test_open_and_views(void)
             for (int t = 0; t < TH; t++)
                 for (int s = 0; s < TW; s++)
                     for (int c = 0; c < 3; c++)
-                        bad += lf_lf_view(&src.lf, iu, iv)[(t * TW + s) * 3 + c] != sample(iu, iv, s, t, c);
+                        bad += lf_lightfield_view(&src.lf, iu, iv)[(t * TW + s) * 3 + c] != sample(iu, iv, s, t, c);
     CHECK_MSG(bad == 0, "%d decoded samples differ from the raw's", bad);
 
     char text[4096];
-    lf_lf_source_describe(&src, text, sizeof text);
+    lf_lightfield_source_describe(&src, text, sizeof text);
     snprintf(p, sizeof p, "%s: %d x %d raw, 3 channels\n", raw_path, NU * TW, NV * TH);
     CHECK_MSG(!strncmp(text, p, strlen(p)), "describe: %s", text);
 
     /* the disparity range the file states */
     double d0, d1;
-    const char *from = lf_lf_source_disparity_range(&src, &d0, &d1);
+    const char *from = lf_lightfield_source_disparity_range(&src, &d0, &d1);
     CHECK(from && !strcmp(from, "lensfield:disp_min/max") && d0 == -1.5 && d1 == 2.5);
 
     /* views and the mosaic: the mosaic of a camera array's views is its raw */
     snprintf(views, sizeof views, "%s/views", dir);
-    CHECK(lf_lf_write_views(&src.lf, views, "exr", NULL, &err) == 0);
+    CHECK(lf_lightfield_write_views(&src.lf, views, "exr", NULL, &err) == 0);
     lf_image v, m, raw;
     snprintf(p, sizeof p, "%s/view_01_02.exr", views); /* row 1, column 2 */
     CHECK(lf_image_read(p, &v, NULL, &err) == 0);
@@ -105,16 +105,16 @@ static void test_open_and_views(void)
     /* a folder that cannot be created is named */
     snprintf(p, sizeof p, "%s/raw.exr/sub", dir);
     lf_error e2 = {0};
-    CHECK(lf_lf_write_views(&src.lf, p, "exr", NULL, &e2) == LF_ERR_IO && strstr(e2.msg, "cannot create directory"));
+    CHECK(lf_lightfield_write_views(&src.lf, p, "exr", NULL, &e2) == LF_ERR_IO && strstr(e2.msg, "cannot create directory"));
 
     /* maps of the views' size: channel 0, size and values checked */
     lf_image map;
     snprintf(p, sizeof p, "%s/views/view_00_00.exr", dir);
-    CHECK(lf_lf_read_map(p, &src.lf, &map, &err) == 0);
+    CHECK(lf_lightfield_read_map(p, &src.lf, &map, &err) == 0);
     CHECK(map.channels == 1 && map.width == TW && map.data[2 * TW + 1] == sample(0, 0, 1, 2, 0));
     lf_image_free(&map);
     lf_error e3 = {0};
-    CHECK(lf_lf_read_map(raw_path, &src.lf, &map, &e3) == LF_ERR_PARAM && strstr(e3.msg, "map is 12x15"));
+    CHECK(lf_lightfield_read_map(raw_path, &src.lf, &map, &e3) == LF_ERR_PARAM && strstr(e3.msg, "map is 12x15"));
     lf_image nanmap;
     CHECK(lf_image_alloc(&nanmap, TW, TH, 1, &err) == 0);
     nanmap.data[5] = NAN;
@@ -122,7 +122,7 @@ static void test_open_and_views(void)
     lf_write_opts wo = {.allow_nonfinite = 1};
     CHECK(lf_image_write(p, &nanmap, NULL, &wo, &err) == 0);
     lf_error e4 = {0};
-    CHECK(lf_lf_read_map(p, &src.lf, &map, &e4) == LF_ERR_NUMERIC && strstr(e4.msg, "non-finite"));
+    CHECK(lf_lightfield_read_map(p, &src.lf, &map, &e4) == LF_ERR_NUMERIC && strstr(e4.msg, "non-finite"));
     lf_image_free(&nanmap);
 
     /* the disparity writer: values with the search range, or a colour picture
@@ -133,27 +133,27 @@ static void test_open_and_views(void)
         disp.data[i] = -1 + 0.1f * i;
     lf_attrs a = {0};
     snprintf(p, sizeof p, "%s/disp.exr", dir);
-    CHECK(lf_lf_write_disparity(p, &disp, -1, 1, NULL, &err) == 0);
+    CHECK(lf_lightfield_write_disparity(p, &disp, -1, 1, NULL, &err) == 0);
     CHECK(lf_image_read(p, &m, &a, &err) == 0 && m.data[7] == disp.data[7]);
     const lf_attr *r = lf_attrs_get(&a, LF_KEY_DISPARITY_SEARCH_RANGE);
     CHECK(r && r->type == LF_ATTR_FLOATS && r->n == 2 && r->v[0] == -1 && r->v[1] == 1);
     lf_image_free(&m), lf_attrs_free(&a);
     snprintf(p, sizeof p, "%s/refocused.exr", dir);
-    CHECK(lf_lf_write_refocused(p, &disp, -0.75, NULL, &err) == 0);
+    CHECK(lf_lightfield_write_refocused(p, &disp, -0.75, NULL, &err) == 0);
     CHECK(lf_image_read(p, &m, &a, &err) == 0 && m.data[3] == disp.data[3]);
     r = lf_attrs_get(&a, LF_KEY_REFOCUS_DISPARITY_PX);
     CHECK(r && (r->type == LF_ATTR_DOUBLE || r->type == LF_ATTR_FLOAT) && r->d == -0.75);
     lf_image_free(&m), lf_attrs_free(&a);
     snprintf(p, sizeof p, "%s/disp.png", dir);
-    CHECK(lf_lf_write_disparity(p, &disp, -1, 1, NULL, &err) == 0);
+    CHECK(lf_lightfield_write_disparity(p, &disp, -1, 1, NULL, &err) == 0);
     CHECK(lf_image_read(p, &m, NULL, &err) == 0 && m.channels >= 3 && m.width == TW && m.height == TH);
     lf_image_free(&m), lf_image_free(&disp);
-    lf_lf_close(&src);
+    lf_lightfield_close(&src);
 
     /* layout only: nothing decoded */
     oo.layout_only = 1;
-    CHECK(lf_lf_open(raw_path, &oo, &src, &err) == 0 && src.lf.data == NULL && src.layout.cams_x == NU);
-    lf_lf_close(&src);
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &err) == 0 && src.lf.data == NULL && src.layout.cams_x == NU);
+    lf_lightfield_close(&src);
 }
 
 static void test_nonfinite(void)
@@ -161,20 +161,20 @@ static void test_nonfinite(void)
     char raw_path[300];
     snprintf(raw_path, sizeof raw_path, "%s/nan_raw.exr", dir);
     CHECK(write_raw(raw_path, 3 * (NU * TW + 1), NULL, 0) == 0); /* pixel (1, 1) of view (0, 0) */
-    lf_lf_source src;
+    lf_lightfield_source src;
     lf_error err = {0};
-    lf_lf_open_opts oo = {0};
-    CHECK(lf_lf_open(raw_path, &oo, &src, &err) == LF_ERR_NUMERIC);
+    lf_lightfield_open_opts oo = {0};
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &err) == LF_ERR_NUMERIC);
     CHECK_MSG(strstr(err.msg, "1 non-finite pixel values") && strstr(err.msg, raw_path), "%s", err.msg);
     CHECK(src.lf.data == NULL && src.raw.data == NULL);
     oo.allow_nonfinite = 1;
     lf_error e2 = {0};
-    CHECK(lf_lf_open(raw_path, &oo, &src, &e2) == 0 && src.lf.nonfinite == 1 && src.raw_nonfinite == 1);
-    lf_lf_close(&src);
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &e2) == 0 && src.lf.nonfinite == 1 && src.raw_nonfinite == 1);
+    lf_lightfield_close(&src);
     /* a folder of views takes no white image */
     oo.white = raw_path;
     lf_error e3 = {0};
-    CHECK(lf_lf_open(dir, &oo, &src, &e3) != 0);
+    CHECK(lf_lightfield_open(dir, &oo, &src, &e3) != 0);
 }
 
 static void test_gt_disparity(void)
@@ -185,22 +185,22 @@ static void test_gt_disparity(void)
     snprintf(disp_path, sizeof disp_path, "%s/gt_raw.disparity.exr", dir);
     CHECK(write_raw(raw_path, -1, "gt_raw.disparity.exr", 0) == 0);
     CHECK(write_raw(disp_path, -1, NULL, 0) == 0);
-    lf_lf_source src;
+    lf_lightfield_source src;
     lf_error err = {0};
-    lf_lf_open_opts oo = {0};
-    CHECK(lf_lf_open(raw_path, &oo, &src, &err) == 0);
+    lf_lightfield_open_opts oo = {0};
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &err) == 0);
     lf_image gt;
     int no_centre = -1;
-    CHECK(lf_lf_source_gt_disparity(&src, &gt, &no_centre, &err) == 0 && no_centre == 0);
+    CHECK(lf_lightfield_source_gt_disparity(&src, &gt, &no_centre, &err) == 0 && no_centre == 0);
     CHECK(gt.data && gt.width == TW && gt.height == TH && gt.channels == 1);
     CHECK(gt.data && gt.data[3 * TW + 2] == sample(1, 1, 2, 3, 0)); /* the centre view (1, 1) */
     lf_image_free(&gt);
-    lf_lf_close(&src);
+    lf_lightfield_close(&src);
     /* a raw without lensfield:disparity_file has none */
     snprintf(raw_path, sizeof raw_path, "%s/raw.exr", dir);
-    CHECK(lf_lf_open(raw_path, &oo, &src, &err) == 0);
-    CHECK(lf_lf_source_gt_disparity(&src, &gt, &no_centre, &err) == 0 && gt.data == NULL);
-    lf_lf_close(&src);
+    CHECK(lf_lightfield_open(raw_path, &oo, &src, &err) == 0);
+    CHECK(lf_lightfield_source_gt_disparity(&src, &gt, &no_centre, &err) == 0 && gt.data == NULL);
+    lf_lightfield_close(&src);
 }
 
 static void test_refocus_range(void)
@@ -213,14 +213,14 @@ static void test_refocus_range(void)
     memset(&lf, 0, sizeof lf);
     lf.disp_per_alpha = 4, lf.disp_at_inf = -0.5, lf.disp_per_inv_m = 2;
     char buf[256];
-    CHECK(lf_lf_refocus_outside(&lf, 0.999, buf, sizeof buf) == 0);
-    CHECK(lf_lf_refocus_outside(&lf, -1.0, buf, sizeof buf) == 0);
-    CHECK(lf_lf_refocus_outside(&lf, 1.2, buf, sizeof buf) == 1);
+    CHECK(lf_lightfield_refocus_outside(&lf, 0.999, buf, sizeof buf) == 0);
+    CHECK(lf_lightfield_refocus_outside(&lf, -1.0, buf, sizeof buf) == 0);
+    CHECK(lf_lightfield_refocus_outside(&lf, 1.2, buf, sizeof buf) == 1);
     CHECK_MSG(strstr(buf, "alpha 0.8 .. 1.3333") && strstr(buf, "depths 1.333 m .. infinity"), "%s", buf);
     lf.disp_at_inf = -3; /* far end d = -1 at z = 2 / 2 = 1 m; near end d = 1 at z = 2 / 4 = 0.5 m */
-    CHECK(lf_lf_refocus_outside(&lf, -1.5, buf, sizeof buf) == 1 && strstr(buf, "depths 0.5 m .. 1 m"));
+    CHECK(lf_lightfield_refocus_outside(&lf, -1.5, buf, sizeof buf) == 1 && strstr(buf, "depths 0.5 m .. 1 m"));
     lf.disp_per_alpha = 0; /* not plenoptic: no alpha, no warning */
-    CHECK(lf_lf_refocus_outside(&lf, 5, buf, sizeof buf) == 0);
+    CHECK(lf_lightfield_refocus_outside(&lf, 5, buf, sizeof buf) == 0);
 }
 
 static void test_synth_prepare(void)
@@ -228,26 +228,26 @@ static void test_synth_prepare(void)
     lf_lightfield lf;
     memset(&lf, 0, sizeof lf);
     lf.ns = 40, lf.nt = 30;
-    lf_lf_layout *y = &lf.layout;
-    y->kind = LF_LF_CAMERA_ARRAY, y->have = LF_LF_HAVE_KIND | LF_LF_HAVE_BOUNDS;
+    lf_lightfield_layout *y = &lf.layout;
+    y->kind = LF_LIGHTFIELD_CAMERA_ARRAY, y->have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_BOUNDS;
     y->grid_bounds[0] = -1, y->grid_bounds[1] = 3, y->grid_bounds[2] = 2, y->grid_bounds[3] = 4;
-    lf_lf_synth_opts s = lf_lf_synth_defaults();
+    lf_lightfield_synth_opts s = lf_lightfield_synth_defaults();
     lf_error err = {0};
-    CHECK(lf_lf_synth_prepare(&lf, 0, &s, &err) == LF_ERR_PARAM);
+    CHECK(lf_lightfield_synth_prepare(&lf, 0, &s, &err) == LF_ERR_PARAM);
     CHECK_MSG(strstr(err.msg, "lensfield:fov_deg (--inputfov DEG)") && !strstr(err.msg, "grid_bounds"), "%s", err.msg);
-    y->have |= LF_LF_HAVE_FOV | LF_LF_HAVE_CAM_LENS, y->fov_deg = 33, y->focal_distance = 7;
+    y->have |= LF_LIGHTFIELD_HAVE_FOV | LF_LIGHTFIELD_HAVE_CAM_LENS, y->fov_deg = 33, y->focal_distance = 7;
     lf_error e2 = {0};
-    CHECK(lf_lf_synth_prepare(&lf, 0, &s, &e2) == 0);
+    CHECK(lf_lightfield_synth_prepare(&lf, 0, &s, &e2) == 0);
     CHECK(s.fov_deg == 33 && s.width == 40 && s.height == 30 && s.focal_distance == 7);
     CHECK(s.pos[0] == 1 && s.pos[1] == 3 && s.pos[2] == 0); /* the grid's centre */
-    s = lf_lf_synth_defaults();
+    s = lf_lightfield_synth_defaults();
     s.fov_deg = 10, s.width = 8, s.height = 6, s.pos[0] = 9, s.focal_distance = 2;
-    CHECK(lf_lf_synth_prepare(&lf, LF_LF_SYNTH_SET_FOV | LF_LF_SYNTH_SET_SIZE | LF_LF_SYNTH_SET_POS |
-                                       LF_LF_SYNTH_SET_FOCAL, &s, &e2) == 0);
+    CHECK(lf_lightfield_synth_prepare(&lf, LF_LIGHTFIELD_SYNTH_SET_FOV | LF_LIGHTFIELD_SYNTH_SET_SIZE | LF_LIGHTFIELD_SYNTH_SET_POS |
+                                       LF_LIGHTFIELD_SYNTH_SET_FOCAL, &s, &e2) == 0);
     CHECK(s.fov_deg == 10 && s.width == 8 && s.height == 6 && s.pos[0] == 9 && s.focal_distance == 2);
-    y->kind = LF_LF_PLENOPTIC;
+    y->kind = LF_LIGHTFIELD_PLENOPTIC;
     lf_error e3 = {0};
-    CHECK(lf_lf_synth_prepare(&lf, 0, &s, &e3) == LF_ERR_PARAM && strstr(e3.msg, "camera-array"));
+    CHECK(lf_lightfield_synth_prepare(&lf, 0, &s, &e3) == LF_ERR_PARAM && strstr(e3.msg, "camera-array"));
 }
 
 int main(void)

@@ -38,17 +38,17 @@ static void render_view(double cx, double cy, double Z, int w, int h, float *dst
 static void make_lf(lf_lightfield *lf, int n, double b, double Z, int w, int h)
 {
     lf_error err = {0};
-    lf_lf_alloc(lf, n, n, w, h, &err);
+    lf_lightfield_alloc(lf, n, n, w, h, &err);
     double minx = -b * (n - 1) / 2, maxy = b * (n - 1) / 2;
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++)
-            render_view(minx + i * b, maxy - j * b, Z, w, h, lf_lf_view(lf, i, j));
-    lf_lf_layout *l = &lf->layout;
-    l->kind = LF_LF_CAMERA_ARRAY;
+            render_view(minx + i * b, maxy - j * b, Z, w, h, lf_lightfield_view(lf, i, j));
+    lf_lightfield_layout *l = &lf->layout;
+    l->kind = LF_LIGHTFIELD_CAMERA_ARRAY;
     l->cams_x = l->cams_y = n;
     l->grid_bounds[0] = minx, l->grid_bounds[1] = -minx, l->grid_bounds[2] = -maxy, l->grid_bounds[3] = maxy;
     l->fov_deg = FOV, l->tile_w = w, l->tile_h = h;
-    l->have = LF_LF_HAVE_KIND | LF_LF_HAVE_CAMS | LF_LF_HAVE_BOUNDS | LF_LF_HAVE_FOV | LF_LF_HAVE_TILE;
+    l->have = LF_LIGHTFIELD_HAVE_KIND | LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_BOUNDS | LF_LIGHTFIELD_HAVE_FOV | LF_LIGHTFIELD_HAVE_TILE;
 }
 
 
@@ -113,15 +113,15 @@ int main(void)
     /* a pinhole at a data camera's position and orientation reproduces its tile */
     const int cams[3][2] = {{2, 2}, {0, 0}, {4, 1}};
     for (int k = 0; k < 3; k++) {
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = w, o.height = h, o.fov_deg = FOV;
         o.pos[0] = -b * (n - 1) / 2 + cams[k][0] * b;
         o.pos[1] = b * (n - 1) / 2 - cams[k][1] * b;
         o.focal_distance = Z;
         lf_image img, cov;
         size_t unc = 99;
-        CHECK_MSG(lf_lf_synth(&lf, &o, &img, &cov, &unc, &err) == 0, "%s", err.msg);
-        const float *tile = lf_lf_view(&lf, cams[k][0], cams[k][1]);
+        CHECK_MSG(lf_lightfield_synth(&lf, &o, &img, &cov, &unc, &err) == 0, "%s", err.msg);
+        const float *tile = lf_lightfield_view(&lf, cams[k][0], cams[k][1]);
         double maxd = 0;
         for (size_t i = 0; i < (size_t)w * h * 3; i++)
             maxd = fmax(maxd, fabs(img.data[i] - tile[i]));
@@ -136,13 +136,13 @@ int main(void)
      * so a pinhole whose pixels match the data pixels samples pixel centres
      * instead of integrating (blurring) a second time: > 60 dB */
     for (int k = 0; k < 2; k++) {
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = w, o.height = h, o.fov_deg = FOV, o.spp = 16, o.seed = 7;
         o.pos[0] = -b * (n - 1) / 2 + cams[k][0] * b;
         o.pos[1] = b * (n - 1) / 2 - cams[k][1] * b;
         lf_image img;
-        CHECK_MSG(lf_lf_synth(&lf, &o, &img, NULL, NULL, &err) == 0, "%s", err.msg);
-        const float *tile = lf_lf_view(&lf, cams[k][0], cams[k][1]);
+        CHECK_MSG(lf_lightfield_synth(&lf, &o, &img, NULL, NULL, &err) == 0, "%s", err.msg);
+        const float *tile = lf_lightfield_view(&lf, cams[k][0], cams[k][1]);
         double se = 0;
         for (size_t i = 0; i < (size_t)w * h * 3; i++)
             se += (img.data[i] - tile[i]) * (double)(img.data[i] - tile[i]);
@@ -155,12 +155,12 @@ int main(void)
 
     /* between cameras: a pinhole render from there (focal plane at the scene) */
     {
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = w, o.height = h, o.fov_deg = FOV;
         o.pos[0] = 0.37 * b, o.pos[1] = -0.71 * b;
         o.focal_distance = Z;
         lf_image img;
-        CHECK(lf_lf_synth(&lf, &o, &img, NULL, NULL, &err) == 0);
+        CHECK(lf_lightfield_synth(&lf, &o, &img, NULL, NULL, &err) == 0);
         float *truth = malloc(sizeof(float) * w * h * 3);
         render_view(o.pos[0], o.pos[1], Z, w, h, truth);
         double se = 0;
@@ -172,7 +172,7 @@ int main(void)
         /* the same with a wrong focal plane is visibly worse */
         o.focal_distance = 0.5 * Z;
         lf_image bad;
-        CHECK(lf_lf_synth(&lf, &o, &bad, NULL, NULL, &err) == 0);
+        CHECK(lf_lightfield_synth(&lf, &o, &bad, NULL, NULL, &err) == 0);
         se = 0;
         for (size_t i = 0; i < (size_t)w * h * 3; i++)
             se += (bad.data[i] - truth[i]) * (bad.data[i] - truth[i]);
@@ -185,26 +185,26 @@ int main(void)
 
     /* rays that leave the captured aperture are reported */
     {
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = w, o.height = h, o.fov_deg = FOV;
         o.pos[0] = 1.0; /* far outside the grid, pinhole: every ray misses it */
         lf_image img, cov;
         size_t unc = 0;
-        CHECK(lf_lf_synth(&lf, &o, &img, &cov, &unc, &err) == 0);
+        CHECK(lf_lightfield_synth(&lf, &o, &img, &cov, &unc, &err) == 0);
         CHECK(unc == (size_t)w * h);
         CHECK(cov.data[0] == 0.f);
         lf_image_free(&img), lf_image_free(&cov);
         /* looking sideways from inside the grid: partly outside the data cameras' view */
         o.pos[0] = 0, o.rot_deg[1] = 30;
-        CHECK(lf_lf_synth(&lf, &o, &img, &cov, &unc, &err) == 0);
+        CHECK(lf_lightfield_synth(&lf, &o, &img, &cov, &unc, &err) == 0);
         printf("rotated 30 deg about y: %zu of %d pixels uncovered\n", unc, w * h);
         CHECK(unc > 0 && unc < (size_t)w * h);
         lf_image_free(&img), lf_image_free(&cov);
         o.lens_radius = 0.01, o.focal_distance = 0;
-        CHECK(lf_lf_synth(&lf, &o, &img, &cov, &unc, &err) == LF_ERR_PARAM);
+        CHECK(lf_lightfield_synth(&lf, &o, &img, &cov, &unc, &err) == LF_ERR_PARAM);
         lf_error_clear(&err);
     }
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 
     /* blur: 9 x 9 cameras 10 cm apart, step edge on a plane at Zs = 2 m,
      * virtual lens radius r focused at fd = 1 m.  Thin lens: circle of
@@ -236,11 +236,11 @@ int main(void)
         vq /= nq;
         /* + input pixel tent (1/6), output pixel jitter (1/12), pixel binning of the ESF (1/12) */
         double sigma_expect = sqrt(k * k * vq + s_in * s_in / 6 + 1.0 / 12 + 1.0 / 12);
-        lf_lf_synth_opts o = lf_lf_synth_defaults();
+        lf_lightfield_synth_opts o = lf_lightfield_synth_defaults();
         o.width = wb, o.height = hb, o.fov_deg = FOV;
         o.lens_radius = r, o.focal_distance = fd, o.spp = 256, o.seed = 3;
         lf_image img;
-        CHECK_MSG(lf_lf_synth(&lf, &o, &img, NULL, NULL, &err) == 0, "%s", err.msg);
+        CHECK_MSG(lf_lightfield_synth(&lf, &o, &img, NULL, NULL, &err) == 0, "%s", err.msg);
         double sigma = edge_sigma(&img);
         printf("blur: thin-lens D = %.2f px (disk sigma %.3f); expected sigma with camera blending %.3f, measured %.3f "
                "(tol 3%%)\n",
@@ -257,12 +257,12 @@ int main(void)
         lf_image_free(&img);
         /* pinhole: sharp */
         o.lens_radius = 0, o.spp = 16, o.focal_distance = Zs;
-        CHECK(lf_lf_synth(&lf, &o, &img, NULL, NULL, &err) == 0);
+        CHECK(lf_lightfield_synth(&lf, &o, &img, NULL, NULL, &err) == 0);
         double s0 = edge_sigma(&img);
         printf("pinhole edge sigma %.3f px\n", s0);
         CHECK(s0 < 1.0);
         lf_image_free(&img);
-        lf_lf_free(&lf);
+        lf_lightfield_free(&lf);
     }
     return lf_test_end();
 }

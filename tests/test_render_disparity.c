@@ -162,19 +162,19 @@ static void test_plenoptic(double z0)
     CHECK_MSG(worst < 1e-5 * fabs(expect) + 1e-7, "plane at %g m: expected %.9g, worst error %g", z0, expect, worst);
     CHECK_MSG(z0 < 1 ? expect > 0.005 : expect < -0.005, "expected %g", expect); /* nearer than focus: d > 0 */
     /* the decoded light field's own depth -> disparity map agrees */
-    lf_lf_layout lay, resolved;
+    lf_lightfield_layout lay, resolved;
     lf_error err = {0};
     lf_image raw = {0};
     lf_lightfield lf = {0};
-    CHECK(lf_lf_layout_from_attrs(&meta, &lay, &err) == 0);
-    CHECK(lf_lf_layout_resolve(&lay, NULL, 240, 160, &resolved, &err) == 0);
+    CHECK(lf_lightfield_layout_from_attrs(&meta, &lay, &err) == 0);
+    CHECK(lf_lightfield_layout_resolve(&lay, NULL, 240, 160, &resolved, &err) == 0);
     CHECK(lf_image_alloc(&raw, 240, 160, 1, &err) == 0);
-    CHECK(lf_lf_decode(&raw, &resolved, NULL, &lf, &err) == 0);
+    CHECK(lf_lightfield_decode(&raw, &resolved, NULL, &lf, &err) == 0);
     double dd = 0;
-    CHECK(lf_lf_depth_to_disparity(&lf, z0, &dd, &err) == 0);
+    CHECK(lf_lightfield_depth_to_disparity(&lf, z0, &dd, &err) == 0);
     CHECK_NEAR(dd, expect, 1e-6 * fabs(expect));
     (void)mean;
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
     lf_image_free(&raw);
     lf_image_free(&d);
     lf_attrs_free(&meta);

@@ -144,10 +144,10 @@ int main(void)
     CHECK(mkdtemp(dir) != NULL);
     lf_lightfield lf = {0};
     lf_error err = {0};
-    CHECK(lf_lf_alloc(&lf, 3, 3, 24, 16, &err) == 0);
+    CHECK(lf_lightfield_alloc(&lf, 3, 3, 24, 16, &err) == 0);
     for (int iv = 0; iv < 3; iv++)
         for (int iu = 0; iu < 3; iu++) {
-            float *v = lf_lf_view(&lf, iu, iv);
+            float *v = lf_lightfield_view(&lf, iu, iv);
             for (int t = 0; t < 16; t++)
                 for (int s = 0; s < 24; s++) {
                     int x = s + (iu - 1), y = t + (iv - 1); /* the scene point seen at (s, t) */
@@ -156,7 +156,7 @@ int main(void)
                         v[((size_t)t * 24 + s) * 3 + c] = g;
                 }
         }
-    lf.layout.kind = LF_LF_CAMERA_ARRAY;
+    lf.layout.kind = LF_LIGHTFIELD_CAMERA_ARRAY;
     lf.disp_per_inv_m = 2.0; /* 1 px/view at 2 m; the search runs from infinity to 0.5 m (0..4) */
     lf.disp_v_per_u = 1.0;
     lf_web_export_opts o = lf_web_export_defaults();
@@ -215,7 +215,7 @@ int main(void)
     o.format = "png", o.have_range = 1, o.focus_min = 2, o.focus_max = 1;
     lf_error e3 = {0};
     CHECK(lf_web_export(&lf, page, &o, &info, &e3) != 0 && strstr(e3.msg, "max > min"));
-    lf_lf_free(&lf);
+    lf_lightfield_free(&lf);
 
     /* The server: a page, a file outside the root, four requests. */
     snprintf(path, sizeof path, "%s/secret.txt", dir);

@@ -28,13 +28,13 @@ enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
 typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
     const char *confidence, *dispmap, *geometry; /* depth, view, synth */
-    lf_lf_layout flags;
+    lf_lightfield_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
     int have_u, have_v;
     int views[4], steps, threads, allow_nonfinite, calibrate_views;
     /* synth */
-    lf_lf_synth_opts synth;
+    lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal;
     /* export-web, serve */
     int port, have_steps;
@@ -204,22 +204,22 @@ static const lf_arg serve_args[] = {
 /* Turns the gathered layout and synth flags into opt.flags and opt.synth. */
 static void apply_flags(void)
 {
-    lf_lf_layout *f = &opt.flags;
-    lf_lf_layout_init(f);
+    lf_lightfield_layout *f = &opt.flags;
+    lf_lightfield_layout_init(f);
     const struct {
         int given;
         unsigned have;
-    } given[] = {{fl.g_kind, LF_LF_HAVE_KIND},   {fl.g_cams, LF_LF_HAVE_CAMS | LF_LF_HAVE_KIND},
-                 {fl.g_griddim, LF_LF_HAVE_BOUNDS}, {fl.g_fov, LF_LF_HAVE_FOV},
-                 {fl.g_tile, LF_LF_HAVE_TILE},    {fl.g_grid, LF_LF_HAVE_GRID},
-                 {fl.g_pitch, LF_LF_HAVE_PITCH},  {fl.g_rot, LF_LF_HAVE_ROTATION},
-                 {fl.g_offset, LF_LF_HAVE_OFFSET}, {fl.g_lenses, LF_LF_HAVE_LENS_COUNT},
-                 {fl.g_main, LF_LF_HAVE_MAIN_LENS}};
+    } given[] = {{fl.g_kind, LF_LIGHTFIELD_HAVE_KIND},   {fl.g_cams, LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_KIND},
+                 {fl.g_griddim, LF_LIGHTFIELD_HAVE_BOUNDS}, {fl.g_fov, LF_LIGHTFIELD_HAVE_FOV},
+                 {fl.g_tile, LF_LIGHTFIELD_HAVE_TILE},    {fl.g_grid, LF_LIGHTFIELD_HAVE_GRID},
+                 {fl.g_pitch, LF_LIGHTFIELD_HAVE_PITCH},  {fl.g_rot, LF_LIGHTFIELD_HAVE_ROTATION},
+                 {fl.g_offset, LF_LIGHTFIELD_HAVE_OFFSET}, {fl.g_lenses, LF_LIGHTFIELD_HAVE_LENS_COUNT},
+                 {fl.g_main, LF_LIGHTFIELD_HAVE_MAIN_LENS}};
     for (size_t i = 0; i < LF_ARRAY_LEN(given); i++)
         if (given[i].given)
             f->have |= given[i].have;
-    f->kind = fl.g_cams || (fl.g_kind && strcmp(fl.kind, "plenoptic")) ? LF_LF_CAMERA_ARRAY : LF_LF_PLENOPTIC;
-    f->grid = fl.g_grid && !strcmp(fl.grid, "hex") ? LF_LF_GRID_HEX : LF_LF_GRID_SQUARE;
+    f->kind = fl.g_cams || (fl.g_kind && strcmp(fl.kind, "plenoptic")) ? LF_LIGHTFIELD_CAMERA_ARRAY : LF_LIGHTFIELD_PLENOPTIC;
+    f->grid = fl.g_grid && !strcmp(fl.grid, "hex") ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
     f->cams_x = fl.cams[0], f->cams_y = fl.cams[1];
     memcpy(f->grid_bounds, fl.griddim, sizeof f->grid_bounds);
     f->fov_deg = fl.fov, f->pitch_px = fl.pitch, f->rotation_rad = fl.rotation;
@@ -228,8 +228,8 @@ static void apply_flags(void)
     f->lens_x = fl.lenses[0], f->lens_y = fl.lenses[1];
     f->main_focal_mm = fl.mainlens[0], f->main_fstop = fl.mainlens[1];
     f->mla_distance_mm = fl.mainlens[2], f->pitch_um = fl.mainlens[3];
-    lf_lf_synth_opts *s = &opt.synth;
-    *s = lf_lf_synth_defaults();
+    lf_lightfield_synth_opts *s = &opt.synth;
+    *s = lf_lightfield_synth_defaults();
     s->threads = opt.threads;
     if (fl.g_spp)
         s->spp = fl.spp;
@@ -266,11 +266,11 @@ static int fail(const lf_error *err, const char *name)
 
 /* Reads the raw (or folder of views) and resolves its layout (attributes +
  * flags); decodes unless layout_only. */
-static int load(const opts *o, lf_lf_source *s, int layout_only)
+static int load(const opts *o, lf_lightfield_source *s, int layout_only)
 {
     lf_error err = {0};
-    lf_lf_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only};
-    if (lf_lf_open(o->input, &oo, s, &err))
+    lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only};
+    if (lf_lightfield_open(o->input, &oo, s, &err))
         return fail(&err, NULL);
     if (!s->folder.dir && s->lf.nonfinite)
         fprintf(stderr, "lftool: %s: warning: %zu non-finite pixel values excluded as missing samples\n", o->input,
@@ -290,30 +290,30 @@ static int write_image(const char *path, const lf_image *img, const lf_attrs *a)
 static int cmd_info(int n, char **pos)
 {
     const opts *o = begin("info", n, pos);
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 1);
     if (rc)
         return rc;
     char buf[4096];
-    lf_lf_source_describe(&s, buf, sizeof buf);
+    lf_lightfield_source_describe(&s, buf, sizeof buf);
     fputs(buf, stdout);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return EXIT_OK;
 }
 
 /* The HCI benchmark layout, with the centre view's ground truth when known. */
-static int decode_hci(const opts *o, const lf_lf_source *s)
+static int decode_hci(const opts *o, const lf_lightfield_source *s)
 {
     const lf_lightfield *lf = &s->lf;
     lf_image gt;
     lf_error err = {0};
     int no_centre;
-    if (lf_lf_source_gt_disparity(s, &gt, &no_centre, &err))
+    if (lf_lightfield_source_gt_disparity(s, &gt, &no_centre, &err))
         return fail(&err, NULL);
     if (no_centre)
         fprintf(stderr, "lftool: %s: note: %d x %d views have no centre view; gt_disp_lowres.pfm not written\n",
                 o->input, lf->nu, lf->nv);
-    int rc = lf_lf_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : EXIT_OK;
+    int rc = lf_lightfield_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : EXIT_OK;
     if (!rc)
         printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu, lf->nv,
                lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
@@ -324,7 +324,7 @@ static int decode_hci(const opts *o, const lf_lf_source *s)
 static int cmd_decode(int n, char **pos)
 {
     const opts *o = begin("decode", n, pos);
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
@@ -333,12 +333,12 @@ static int cmd_decode(int n, char **pos)
     lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
     if (o->hci)
         rc = decode_hci(o, &s);
-    else if (lf_lf_write_views(lf, o->output, o->format ? o->format : "exr", &wo, &err))
+    else if (lf_lightfield_write_views(lf, o->output, o->format ? o->format : "exr", &wo, &err))
         rc = fail(&err, NULL);
     else
         printf("%s: %d x %d views of %d x %d -> %s (%zu missing samples)\n", o->input, lf->nu, lf->nv, lf->ns, lf->nt,
                o->output, lf->missing);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -349,15 +349,15 @@ static int focus_disparity(const opts *o, const lf_lightfield *lf, double *d)
         return usage("%s", "give one of --alpha, --depth, --disparity");
     lf_error err = {0};
     *d = o->have_disp ? o->disp : 0;
-    if ((o->have_alpha && lf_lf_alpha_to_disparity(lf, o->alpha, d, &err)) ||
-        (o->have_depth && lf_lf_depth_to_disparity(lf, o->depth, d, &err)))
+    if ((o->have_alpha && lf_lightfield_alpha_to_disparity(lf, o->alpha, d, &err)) ||
+        (o->have_depth && lf_lightfield_depth_to_disparity(lf, o->depth, d, &err)))
         return fail(&err, o->input);
     return 0;
 }
 
-static lf_lf_refocus_opts aperture_opts(const opts *o)
+static lf_lightfield_refocus_opts aperture_opts(const opts *o)
 {
-    lf_lf_refocus_opts r = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts r = lf_lightfield_refocus_defaults();
     if (o->have_aperture)
         r.aperture_radius = o->aperture;
     if (o->have_views)
@@ -371,17 +371,17 @@ static int cmd_refocus(int n, char **pos)
     const opts *o = begin("refocus", n, pos);
     if (o->have_alpha + o->have_depth + o->have_disp != 1)
         return usage("%s", "refocus needs exactly one of --alpha A, --depth METRES, --disparity PX");
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    lf_lf_refocus_opts ro = aperture_opts(o);
+    lf_lightfield_refocus_opts ro = aperture_opts(o);
     lf_error err = {0};
     lf_image out = {0};
     char range[256], asked[96];
     if ((rc = focus_disparity(o, &s.lf, &ro.disparity_px)))
         goto done;
-    if (lf_lf_refocus_outside(&s.lf, ro.disparity_px, range, sizeof range)) { /* done, with a warning */
+    if (lf_lightfield_refocus_outside(&s.lf, ro.disparity_px, range, sizeof range)) { /* done, with a warning */
         if (o->have_depth)
             snprintf(asked, sizeof asked, "depth %g m", o->depth);
         else if (o->have_alpha)
@@ -395,25 +395,25 @@ static int cmd_refocus(int n, char **pos)
                 o->input, asked, ro.disparity_px, range);
     }
     if (o->method && !strcmp(o->method, "fourier")) {
-        lf_lf_fourier *f = NULL;
-        rc = lf_lf_fourier_new(&s.lf, &ro, o->oversample, &f, &err) ||
-             lf_lf_fourier_refocus(f, ro.disparity_px, &out, &err);
-        lf_lf_fourier_release(f);
+        lf_lightfield_fourier *f = NULL;
+        rc = lf_lightfield_fourier_new(&s.lf, &ro, o->oversample, &f, &err) ||
+             lf_lightfield_fourier_refocus(f, ro.disparity_px, &out, &err);
+        lf_lightfield_fourier_release(f);
     } else {
-        rc = lf_lf_refocus(&s.lf, &ro, &out, &err);
+        rc = lf_lightfield_refocus(&s.lf, &ro, &out, &err);
     }
     if (rc) {
         rc = fail(&err, o->input);
         goto done;
     }
     lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-    if (lf_lf_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
+    if (lf_lightfield_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
         rc = fail(&err, NULL);
     else
         printf("%s: refocused at disparity %.6g px/view -> %s\n", o->input, ro.disparity_px, o->output);
 done:
     lf_image_free(&out);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -427,7 +427,7 @@ static void stack_range(const opts *o, double *d0, double *d1)
 static int cmd_stack(int n, char **pos)
 {
     const opts *o = begin("stack", n, pos);
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
@@ -436,39 +436,39 @@ static int cmd_stack(int n, char **pos)
     lf_error err = {0};
     if (lf_dir_create(o->output, &err))
         rc = fail(&err, NULL);
-    lf_lf_refocus_opts ro = aperture_opts(o);
+    lf_lightfield_refocus_opts ro = aperture_opts(o);
     for (int k = 0; k < o->steps && !rc; k++) {
         ro.disparity_px = d0 + (d1 - d0) * k / (o->steps - 1);
         lf_image out;
-        if (lf_lf_refocus(&s.lf, &ro, &out, &err)) {
+        if (lf_lightfield_refocus(&s.lf, &ro, &out, &err)) {
             rc = fail(&err, o->input);
             break;
         }
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
         lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-        rc = lf_lf_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+        rc = lf_lightfield_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
         lf_image_free(&out);
     }
     if (!rc)
         printf("%s: %d slices, disparity %g .. %g -> %s\n", o->input, o->steps, d0, d1, o->output);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
 static int allfocus_depth(const opts *o, int want_depth)
 {
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
     double d0, d1;
     stack_range(o, &d0, &d1);
-    lf_lf_refocus_opts ro = aperture_opts(o);
+    lf_lightfield_refocus_opts ro = aperture_opts(o);
     lf_image af, dm;
     lf_error err = {0};
-    if (lf_lf_allfocus(&s.lf, &ro, d0, d1, o->steps, &af, &dm, &err)) {
-        lf_lf_close(&s);
+    if (lf_lightfield_allfocus(&s.lf, &ro, d0, d1, o->steps, &af, &dm, &err)) {
+        lf_lightfield_close(&s);
         return fail(&err, o->input);
     }
     rc = write_image(o->output, want_depth ? &dm : &af, NULL);
@@ -476,7 +476,7 @@ static int allfocus_depth(const opts *o, int want_depth)
         printf("%s: %s from %d slices (disparity %g .. %g) -> %s\n", o->input,
                want_depth ? "disparity map" : "all-in-focus", o->steps, d0, d1, o->output);
     lf_image_free(&af), lf_image_free(&dm);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -494,33 +494,33 @@ static int cmd_depth(int n, char **pos)
         return usage("%s", "depth: give both --from and --to, or neither (range from the file or the data)");
     if (o->have_from && !(o->from < o->to))
         return usage("%s", "depth: --from must be below --to");
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    lf_lf_depth_opts d = lf_lf_depth_defaults();
+    lf_lightfield_depth_opts d = lf_lightfield_depth_defaults();
     d.threads = o->threads;
     const char *src = "--from/--to";
     if (o->have_from)
         d.d0 = o->from, d.d1 = o->to;
-    else if (!(src = lf_lf_source_disparity_range(&s, &d.d0, &d.d1)))
+    else if (!(src = lf_lightfield_source_disparity_range(&s, &d.d0, &d.d1)))
         src = "estimated";
     lf_error err = {0};
     lf_image disp = {0}, conf = {0};
-    if (d.d0 >= d.d1 && lf_lf_depth_range(&s.lf, o->threads, &d.d0, &d.d1, &err))
+    if (d.d0 >= d.d1 && lf_lightfield_depth_range(&s.lf, o->threads, &d.d0, &d.d1, &err))
         goto failed;
     if (o->have_steps)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
     if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */
-        if (lf_lf_depth(&s.lf, &d, &disp, &conf, &err) ||
-            lf_lf_calibrate_views(&s.lf, &disp, &conf, o->threads, NULL, &err))
+        if (lf_lightfield_depth(&s.lf, &d, &disp, &conf, &err) ||
+            lf_lightfield_calibrate_views(&s.lf, &disp, &conf, o->threads, NULL, &err))
             goto failed;
         lf_image_free(&disp), lf_image_free(&conf);
     }
-    if (lf_lf_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
+    if (lf_lightfield_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
         goto failed;
     lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-    rc = lf_lf_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+    rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o->confidence, &conf, NULL);
     if (!rc)
@@ -533,7 +533,7 @@ failed:
     rc = fail(&err, o->input);
 done:
     lf_image_free(&disp), lf_image_free(&conf);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -542,11 +542,11 @@ done:
 static int calibrate_for_view(const opts *o, lf_lightfield *lf, const lf_image *dm, const lf_image *cm, lf_error *err)
 {
     if (o->dispmap)
-        return lf_lf_calibrate_views(lf, dm, o->confidence ? cm : NULL, o->threads, NULL, err);
+        return lf_lightfield_calibrate_views(lf, dm, o->confidence ? cm : NULL, o->threads, NULL, err);
     lf_image ed = {0}, ec = {0};
-    lf_lf_depth_opts dopt = lf_lf_depth_defaults();
+    lf_lightfield_depth_opts dopt = lf_lightfield_depth_defaults();
     dopt.threads = o->threads;
-    int rc = lf_lf_depth(lf, &dopt, &ed, &ec, err) || lf_lf_calibrate_views(lf, &ed, &ec, o->threads, NULL, err);
+    int rc = lf_lightfield_depth(lf, &dopt, &ed, &ec, err) || lf_lightfield_calibrate_views(lf, &ed, &ec, o->threads, NULL, err);
     lf_image_free(&ed), lf_image_free(&ec);
     return rc;
 }
@@ -559,7 +559,7 @@ static int cmd_view(int n, char **pos)
     int plane = o->geometry ? !strcmp(o->geometry, "plane") : (o->have_alpha + o->have_depth + o->have_disp) > 0;
     if (plane && o->dispmap)
         return usage("%s", "--disparity-map needs --geometry depth");
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
@@ -569,27 +569,27 @@ static int cmd_view(int n, char **pos)
     if ((rc = focus_disparity(o, &s.lf, &d)))
         goto done;
     if (!plane && o->dispmap &&
-        (lf_lf_read_map(o->dispmap, &s.lf, &dm, &err) ||
-         (o->confidence && lf_lf_read_map(o->confidence, &s.lf, &cm, &err)))) {
+        (lf_lightfield_read_map(o->dispmap, &s.lf, &dm, &err) ||
+         (o->confidence && lf_lightfield_read_map(o->confidence, &s.lf, &cm, &err)))) {
         rc = fail(&err, NULL);
         goto done;
     }
     if (!plane && o->calibrate_views && calibrate_for_view(o, &s.lf, &dm, &cm, &err))
         rc = EXIT_INPUT;
     else if (plane)
-        rc = lf_lf_view_at(&s.lf, o->u, o->v, d, &out, &err);
+        rc = lf_lightfield_view_at(&s.lf, o->u, o->v, d, &out, &err);
     else {
-        lf_lf_view_opts vo = lf_lf_view_defaults();
+        lf_lightfield_view_opts vo = lf_lightfield_view_defaults();
         vo.threads = o->threads;
         vo.plane_disparity = d;
         vo.disparity = o->dispmap ? &dm : NULL;
         vo.confidence = o->dispmap && o->confidence ? &cm : NULL;
-        rc = lf_lf_view_depth(&s.lf, o->u, o->v, &vo, &out, &err);
+        rc = lf_lightfield_view_depth(&s.lf, o->u, o->v, &vo, &out, &err);
     }
     rc = rc ? fail(&err, o->input) : write_image(o->output, &out, NULL);
 done:
     lf_image_free(&out), lf_image_free(&dm), lf_image_free(&cm);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -598,30 +598,30 @@ static int cmd_synth(int n, char **pos)
     const opts *o = begin("synth", n, pos);
     if (o->dispmap && !(o->geometry && !strcmp(o->geometry, "depth")))
         return usage("%s", "--disparity-map needs --geometry depth");
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
-    lf_lf_synth_opts so = o->synth;
-    unsigned set = (o->have_outfov ? LF_LF_SYNTH_SET_FOV : 0) | (o->have_outdim ? LF_LF_SYNTH_SET_SIZE : 0) |
-                   (o->have_pos ? LF_LF_SYNTH_SET_POS : 0) | (o->have_focal ? LF_LF_SYNTH_SET_FOCAL : 0);
+    lf_lightfield_synth_opts so = o->synth;
+    unsigned set = (o->have_outfov ? LF_LIGHTFIELD_SYNTH_SET_FOV : 0) | (o->have_outdim ? LF_LIGHTFIELD_SYNTH_SET_SIZE : 0) |
+                   (o->have_pos ? LF_LIGHTFIELD_SYNTH_SET_POS : 0) | (o->have_focal ? LF_LIGHTFIELD_SYNTH_SET_FOCAL : 0);
     lf_image out = {0}, cov = {0}, dm = {0};
     size_t uncovered = 0;
     lf_error err = {0};
-    if (lf_lf_synth_prepare(&s.lf, set, &so, &err))
+    if (lf_lightfield_synth_prepare(&s.lf, set, &so, &err))
         goto failed;
     if (o->geometry && !strcmp(o->geometry, "depth")) { /* per-pixel geometry (docs/depth.md) */
-        lf_lf_depth_opts dop = lf_lf_depth_defaults();
+        lf_lightfield_depth_opts dop = lf_lightfield_depth_defaults();
         dop.threads = o->threads;
-        if (o->dispmap && lf_lf_read_map(o->dispmap, &s.lf, &dm, &err)) {
+        if (o->dispmap && lf_lightfield_read_map(o->dispmap, &s.lf, &dm, &err)) {
             rc = fail(&err, NULL);
             goto done;
         }
-        if (!o->dispmap && lf_lf_depth(&s.lf, &dop, &dm, NULL, &err))
+        if (!o->dispmap && lf_lightfield_depth(&s.lf, &dop, &dm, NULL, &err))
             goto failed;
         so.disparity = &dm;
     }
-    if (lf_lf_synth(&s.lf, &so, &out, &cov, &uncovered, &err))
+    if (lf_lightfield_synth(&s.lf, &so, &out, &cov, &uncovered, &err))
         goto failed;
     rc = write_image(o->output, &out, NULL);
     if (!rc && o->coverage)
@@ -636,7 +636,7 @@ failed:
     rc = fail(&err, o->input);
 done:
     lf_image_free(&out), lf_image_free(&cov), lf_image_free(&dm);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return rc;
 }
 
@@ -648,21 +648,21 @@ static int cmd_calibrate(int n, char **pos)
     lf_error err = {0};
     if (lf_image_read(o->input, &white, NULL, &err))
         return fail(&err, NULL);
-    lf_lf_layout lay;
-    lf_lf_layout_init(&lay);
-    if (o->flags.have & LF_LF_HAVE_GRID)
-        lay.grid = o->flags.grid, lay.have |= LF_LF_HAVE_GRID;
+    lf_lightfield_layout lay;
+    lf_lightfield_layout_init(&lay);
+    if (o->flags.have & LF_LIGHTFIELD_HAVE_GRID)
+        lay.grid = o->flags.grid, lay.have |= LF_LIGHTFIELD_HAVE_GRID;
     int rc = EXIT_INPUT;
-    if (lf_lf_calibrate(&white, &lay, &err) || lf_lf_layout_to_attrs(&lay, &a, &err))
+    if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
     else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1))
         fprintf(stderr, "lftool: out of memory\n");
     else if (!(rc = write_image(o->output, &white, &a))) {
         char buf[1024];
-        lf_lf_layout_describe(&lay, buf, sizeof buf);
+        lf_lightfield_layout_describe(&lay, buf, sizeof buf);
         printf("%s: estimated layout -> %s\n%s", o->input, o->output, buf);
         printf("flags: --kind plenoptic --grid %s --pitch %.6g --rotation %.6g --offset %.6g %.6g --lenscount %d %d\n",
-               lay.grid == LF_LF_GRID_HEX ? "hex" : "square", lay.pitch_px, lay.rotation_rad, lay.offset_px[0],
+               lay.grid == LF_LIGHTFIELD_GRID_HEX ? "hex" : "square", lay.pitch_px, lay.rotation_rad, lay.offset_px[0],
                lay.offset_px[1], lay.lens_x, lay.lens_y);
     }
     lf_image_free(&white), lf_attrs_free(&a);
@@ -682,7 +682,7 @@ static int cmd_export_web(int n, char **pos)
     wo.have_range = o->have_from, wo.focus_min = o->from, wo.focus_max = o->to;
     wo.threads = o->threads;
     wo.source = o->input;
-    lf_lf_source s;
+    lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
@@ -691,14 +691,14 @@ static int cmd_export_web(int n, char **pos)
     lf_error err = {0};
     if (lf_web_export(&s.lf, o->output, &wo, &info, &err)) {
         fprintf(stderr, "lftool: export-web: %s: %s\n", o->input, err.msg);
-        lf_lf_close(&s);
+        lf_lightfield_close(&s);
         return EXIT_INPUT;
     }
     printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
            "(%.1f KiB, %.2f s CPU)\n",
            o->input, s.lf.nu, s.lf.nv, s.lf.ns, s.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
            info.page_bytes / 1024.0, (double)(clock() - c0) / CLOCKS_PER_SEC);
-    lf_lf_close(&s);
+    lf_lightfield_close(&s);
     return EXIT_OK;
 }
 

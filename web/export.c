@@ -181,7 +181,7 @@ static int put_views(lf_strbuf *js, const lf_lightfield *lf, const char *dir, co
     for (int a = 0; a < atlases && !rc; a++) {
         int n = nviews - a * per < per ? nviews - a * per : per;
         for (int k = 0; k < n; k++)
-            src[k] = lf_lf_view(lf, (a * per + k) % lf->nu, (a * per + k) / lf->nu);
+            src[k] = lf_lightfield_view(lf, (a * per + k) % lf->nu, (a * per + k) / lf->nu);
         lf_image atlas;
         if ((rc = atlas_of(src, n, lf->ns, lf->nt, cols, &atlas, err)))
             break;
@@ -206,12 +206,12 @@ static int put_stack(lf_strbuf *js, const lf_lightfield *lf, const char *dir, co
     const float **src = calloc((size_t)n, sizeof *src);
     int rc = slices && src ? LF_OK : lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     lf_strbuf_puts(js, "  \"stack\": {\"disparities\": [");
-    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
     ro.threads = o->threads;
     for (int k = 0; k < n && !rc; k++) {
         ro.disparity_px = q0 + (q1 - q0) * k / (n - 1);
         lf_strbuf_printf(js, "%s%.9g", k ? ", " : "", ro.disparity_px);
-        rc = lf_lf_refocus(lf, &ro, &slices[k], err);
+        rc = lf_lightfield_refocus(lf, &ro, &slices[k], err);
         src[k] = slices[k].data;
     }
     int cols = (int)ceil(sqrt((double)n));
@@ -282,23 +282,23 @@ int lf_web_export(const lf_lightfield *lf, const char *out_dir, const lf_web_exp
 
     /* focus range and per-pixel disparity (docs/lftool.md "Focal stack,
      * all-in-focus, depth"); the page maps a click to the median around it */
-    lf_lf_refocus_opts ro = lf_lf_refocus_defaults();
+    lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
     ro.threads = o->threads;
     lf_image af = {0}, dm = {0};
     double q0 = o->focus_min, q1 = o->focus_max;
     int rc = LF_OK;
     if (!o->have_range) {
         double d0 = -1, d1 = 1; /* plenoptic: d = 0 at the focus distance */
-        if (lf->layout.kind == LF_LF_CAMERA_ARRAY)
+        if (lf->layout.kind == LF_LIGHTFIELD_CAMERA_ARRAY)
             d0 = 0, d1 = lf->disp_per_inv_m > 0 ? lf->disp_per_inv_m / 0.5 : 4; /* infinity .. 0.5 m */
-        rc = lf_lf_allfocus(lf, &ro, d0, d1, SEARCH_STEPS, &af, &dm, err);
+        rc = lf_lightfield_allfocus(lf, &ro, d0, d1, SEARCH_STEPS, &af, &dm, err);
         if (!rc)
             lf_web_focus_range(dm.data, (size_t)dm.width * dm.height, d0, d1, SEARCH_STEPS, &q0, &q1);
         lf_image_free(&af);
         lf_image_free(&dm);
     }
     if (!rc)
-        rc = lf_lf_allfocus(lf, &ro, q0, q1, DEPTH_STEPS, &af, &dm, err);
+        rc = lf_lightfield_allfocus(lf, &ro, q0, q1, DEPTH_STEPS, &af, &dm, err);
     lf_image_free(&af);
     if (rc)
         return rc;

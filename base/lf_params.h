@@ -40,14 +40,6 @@ typedef enum lf_param_type {
     LF_PT_TEXTURE    /* strs[0]: texture name */
 } lf_param_type;
 
-/* Where something was written in a scene file.  `file` points into storage
- * owned by the scene description (or a string literal); it stays valid as
- * long as the owner does. */
-typedef struct lf_loc {
-    const char *file;
-    int line, col;
-} lf_loc;
-
 typedef struct lf_param {
     lf_param_type type;
     char *name;

@@ -25,7 +25,7 @@
 
 #include "image/lf_image.h"
 #include "render/lf_render.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 static double clock_s(clockid_t id)
 {

@@ -27,9 +27,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "../image/lf_image.h"
-#include "../lightfield/lf_depth.h"
-#include "../lightfield/lf_lightfield.h"
+#include "image/lf_image.h"
+#include "lightfield/lf_depth.h"
+#include "lightfield/lf_lightfield.h"
 #include "bench/bench_util.h"
 
 /* The views through the library's folder reader (lightfield/folder.c):

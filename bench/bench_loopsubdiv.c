@@ -19,7 +19,7 @@
 #include <time.h>
 
 #include "render/lf_render.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 #include "render/lf_subdiv.h"
 #include "bench/bench_util.h"
 

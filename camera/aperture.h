@@ -22,7 +22,7 @@
 
 #include <stddef.h>
 
-#include "../base/lf_distrib.h"
+#include "base/lf_distrib.h"
 #include "camera_internal.h"
 #include "lf_camera.h"
 

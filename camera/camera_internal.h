@@ -5,8 +5,8 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "../base/lf_error.h"
-#include "../base/lf_math.h"
+#include "base/lf_error.h"
+#include "base/lf_math.h"
 #include "lf_camera.h"
 
 #ifndef M_PI

@@ -27,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "camera_internal.h"
 
 typedef enum fisheye_mapping { FE_EQUIDISTANT, FE_EQUISOLID, FE_ORTHOGRAPHIC, FE_STEREOGRAPHIC } fisheye_mapping;

@@ -6,7 +6,7 @@
  * SampleExitPupil); W. Smith, Modern Lens Design (y-nu trace).
  */
 #include "lens.h"
-#include "../base/lf_file.h"
+#include "base/lf_file.h"
 
 #include <errno.h>
 #include <float.h>
@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_math.h"
+#include "base/lf_math.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846

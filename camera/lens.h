@@ -37,7 +37,7 @@
 
 #include <stddef.h>
 
-#include "../base/lf_error.h"
+#include "base/lf_error.h"
 
 #define LF_LENS_LAMBDA_D 587.56 /* helium d line, nm: n_d */
 #define LF_LENS_LAMBDA_F 486.13 /* hydrogen F line */

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_buf.h"
+#include "base/lf_buf.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846

@@ -15,7 +15,7 @@
 #ifndef LF_LENS_ANALYSIS_H
 #define LF_LENS_ANALYSIS_H
 
-#include "../base/lf_error.h"
+#include "base/lf_error.h"
 #include "lens.h"
 
 typedef struct lf_lens_report {

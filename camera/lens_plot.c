@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_buf.h"
+#include "base/lf_buf.h"
 #include "lens_analysis.h"
 
 #ifndef M_PI

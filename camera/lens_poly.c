@@ -4,7 +4,7 @@
 
 #include <math.h>
 
-#include "../base/lf_math.h"
+#include "base/lf_math.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "camera_internal.h"
 
 typedef struct lightfield {

@@ -62,7 +62,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "camera_internal.h"
 #include "lens.h"
 

@@ -29,8 +29,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "../base/lf_keys.h"
-#include "../base/lf_color.h"
+#include "base/lf_keys.h"
+#include "base/lf_color.h"
 #include "aperture.h"
 #include "camera_internal.h"
 #include "lens.h"

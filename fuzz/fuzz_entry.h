@@ -37,7 +37,7 @@
 #include "camera/lens.h"
 #include "image/lf_image.h"
 #include "lightfield/lf_lightfield.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 typedef enum lf_fuzz_target {
     LF_FUZZ_SCENE_PARSER,

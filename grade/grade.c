@@ -18,8 +18,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../lightfield/lf_lightfield.h"
-#include "../render/lf_render.h"
+#include "lightfield/lf_lightfield.h"
+#include "render/lf_render.h"
 #include "grade_internal.h"
 
 int lf_grade_report_student(const char *report_dir, const char *title, const lf_grade_result *r, lf_error *err);

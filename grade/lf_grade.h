@@ -22,8 +22,8 @@
 
 #include <stdint.h>
 
-#include "../base/lf_error.h"
-#include "../image/lf_image.h"
+#include "base/lf_error.h"
+#include "image/lf_image.h"
 
 #ifdef __cplusplus
 extern "C" {

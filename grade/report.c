@@ -5,7 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "../base/lf_buf.h"
+#include "base/lf_buf.h"
 #include "grade_internal.h"
 
 int lf_grade_report_student(const char *dir, const char *title, const lf_grade_result *r, lf_error *err);

@@ -3,7 +3,7 @@
  * non-finite checks, tonemapping to 8 bits and atomic replacement of the
  * target file.  Format codecs live in exr.c and oiio_adapter.cpp. */
 #include "lf_image.h"
-#include "../base/lf_file_write.h"
+#include "base/lf_file_write.h"
 
 #include <errno.h>
 #include <fcntl.h>

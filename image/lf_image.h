@@ -23,7 +23,7 @@
 
 #include <stddef.h>
 
-#include "../base/lf_error.h"
+#include "base/lf_error.h"
 
 #ifdef __cplusplus
 extern "C" {

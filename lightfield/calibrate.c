@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_math.h"
+#include "base/lf_math.h"
 #include "fft_internal.h"
 #include "lf_lightfield.h"
 

@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "lf_depth.h"
-#include "../base/lf_parallel.h"
+#include "base/lf_parallel.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "lf_lightfield.h"
 
 void lf_lightfield_layout_init(lf_lightfield_layout *lay)

@@ -34,8 +34,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "../base/lf_error.h"
-#include "../image/lf_image.h"
+#include "base/lf_error.h"
+#include "image/lf_image.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_math.h"
+#include "base/lf_math.h"
 #include "lf_lightfield.h"
 
 enum { CELLS = 16, NPAR = 6 };

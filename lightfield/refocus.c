@@ -7,7 +7,7 @@
 
 #include "half_internal.h"
 #include "lf_lightfield.h"
-#include "../base/lf_parallel.h"
+#include "base/lf_parallel.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>

@@ -7,9 +7,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "../base/lf_file.h"
-#include "../base/lf_file_write.h"
-#include "../base/lf_keys.h"
+#include "base/lf_file.h"
+#include "base/lf_file_write.h"
+#include "base/lf_keys.h"
 
 void lf_lightfield_close(lf_lightfield_source *src)
 {

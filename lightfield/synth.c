@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_parallel.h"
+#include "base/lf_parallel.h"
 #include "lf_lightfield.h"
 
 lf_lightfield_synth_opts lf_lightfield_synth_defaults(void)

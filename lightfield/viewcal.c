@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "lf_depth.h"
-#include "../base/lf_parallel.h"
+#include "base/lf_parallel.h"
 
 void lf_lightfield_view_shift(const lf_lightfield *lf, double fu, double fv, double s[4])
 {

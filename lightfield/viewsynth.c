@@ -27,9 +27,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_math.h"
+#include "base/lf_math.h"
 #include "lf_depth.h"
-#include "../base/lf_parallel.h"
+#include "base/lf_parallel.h"
 
 lf_lightfield_view_opts lf_lightfield_view_defaults(void)
 {

@@ -25,7 +25,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "render_internal.h"
 
 static int get_num(const lf_attrs *m, const char *name, double *v)

@@ -18,9 +18,9 @@
 
 #include <stdint.h>
 
-#include "../base/lf_error.h"
-#include "../image/lf_image.h"
-#include "lf_scene_desc.h"
+#include "base/lf_error.h"
+#include "image/lf_image.h"
+#include "scenefile/lf_scene_desc.h"
 
 #ifdef __cplusplus
 extern "C" {

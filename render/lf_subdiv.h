@@ -29,8 +29,8 @@
 
 #include <stddef.h>
 
-#include "../base/lf_error.h"
-#include "lf_scene_desc.h"
+#include "base/lf_error.h"
+#include "scenefile/lf_scene_desc.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/lf_keys.h"
+#include "base/lf_keys.h"
 #include "film.h"
 #include "lf_render.h"
 

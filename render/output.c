@@ -4,8 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "../base/lf_file.h"
-#include "../base/lf_keys.h"
+#include "base/lf_file.h"
+#include "base/lf_keys.h"
 #include "lf_render.h"
 
 int lf_render_write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, char *written, size_t written_size,

@@ -8,13 +8,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "../base/lf_distrib.h"
-#include "../base/lf_filter.h"
-#include "../base/lf_math.h"
-#include "../base/lf_sampler.h"
-#include "../camera/lf_camera.h"
+#include "base/lf_distrib.h"
+#include "base/lf_filter.h"
+#include "base/lf_math.h"
+#include "base/lf_sampler.h"
+#include "camera/lf_camera.h"
 #include "lf_render.h"
-#include "lf_shading.h"
+#include "shading/lf_shading.h"
 
 /* A triangle mesh (trianglemesh, plymesh, bilinearmesh, disk, and spheres
  * that Embree's sphere primitive cannot represent): world space, or the

@@ -16,11 +16,11 @@
 #include <xmmintrin.h>
 #endif
 
-#include "../base/lf_buf.h"
-#include "../base/lf_keys.h"
-#include "../base/lf_parallel.h"
-#include "../base/lf_progress.h"
-#include "../base/lf_color.h"
+#include "base/lf_buf.h"
+#include "base/lf_keys.h"
+#include "base/lf_parallel.h"
+#include "base/lf_progress.h"
+#include "base/lf_color.h"
 #include "film.h"
 #include "render_internal.h"
 

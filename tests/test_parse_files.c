@@ -1,5 +1,5 @@
 /* Files a scene names: gzip (base/lf_file.h), token-level Include, spectrum
- * files, collected errors and the unsupported rule (render/parser.c).
+ * files, collected errors and the unsupported rule (scenefile/parser.c).
  *
  * The gzip streams here are built by hand, independently of zlib: a gzip
  * header, deflate "stored" blocks (RFC 1951 3.2.4) and the CRC-32 / length
@@ -15,7 +15,7 @@
 #include "base/lf_color.h"
 #include "base/lf_file.h"
 #include "lf_test.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 static char tmpdir[256];
 

@@ -1,4 +1,4 @@
-/* PLY reading (render/ply.c): the same quad + triangle written as ascii,
+/* PLY reading (scenefile/ply.c): the same quad + triangle written as ascii,
  * binary little- and big-endian with different scalar types, read back. */
 #include <stdint.h>
 #include <stdio.h>
@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "lf_test.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 static char dir[256];
 static char paths[32][512];

@@ -1,4 +1,4 @@
-/* The pbrt-v4 scene parser (render/parser.c): every directive, and the
+/* The pbrt-v4 scene parser (scenefile/parser.c): every directive, and the
  * messages for malformed input.  Expected matrices are worked out by hand in
  * the comments. */
 #include <stdio.h>
@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "lf_test.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 static int parse(const char *text, lf_scene_desc *d, lf_error *err)
 {

@@ -19,7 +19,7 @@
 
 #include "lf_test.h"
 #include "render/lf_render.h"
-#include "render/lf_shading.h"
+#include "shading/lf_shading.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846

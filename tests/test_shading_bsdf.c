@@ -5,7 +5,7 @@
  * Monte Carlo checks use fixed seeds and a tolerance of 3 standard errors of
  * the difference of the two estimates (plus 2e-3 absolute for float
  * round-off and table interpolation), computed from the samples themselves. */
-#include "render/lf_shading.h"
+#include "shading/lf_shading.h"
 
 #include "lf_test.h"
 

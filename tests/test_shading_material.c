@@ -3,8 +3,8 @@
  * maps with pbrt's t flip, scale, mix), mix materials, warnings and errors
  * with file:line:col. */
 #include "image/lf_image.h"
-#include "render/lf_scene_desc.h"
-#include "render/lf_shading.h"
+#include "scenefile/lf_scene_desc.h"
+#include "shading/lf_shading.h"
 
 #include "lf_test.h"
 

@@ -25,7 +25,7 @@
 #include "cli.h"
 #include "image/lf_image.h"
 #include "render/lf_render.h"
-#include "render/lf_scene_desc.h"
+#include "scenefile/lf_scene_desc.h"
 
 enum { MAX_PLUGINS = 16 };
 static struct {

@@ -10,9 +10,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "../base/lf_buf.h"
-#include "../base/lf_file_write.h"
-#include "../image/lf_image.h"
+#include "base/lf_buf.h"
+#include "base/lf_file_write.h"
+#include "image/lf_image.h"
 #include "lf_web.h"
 
 enum { SEARCH_STEPS = 25, DEPTH_STEPS = 33 };

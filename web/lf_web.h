@@ -23,8 +23,8 @@
 
 #include <stddef.h>
 
-#include "../base/lf_error.h"
-#include "../lightfield/lf_lightfield.h"
+#include "base/lf_error.h"
+#include "lightfield/lf_lightfield.h"
 
 /* Atlases stay within 4096 px a side: the texture size every WebGL 2
  * implementation in use supports (the spec's minimum is 2048). */

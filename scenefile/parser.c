@@ -23,8 +23,8 @@
  * (docs/scene-format.md).
  */
 #include "lf_scene_desc.h"
-#include "../base/lf_color.h"
-#include "../base/lf_file.h"
+#include "base/lf_color.h"
+#include "base/lf_file.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -1,6 +1,6 @@
 /* lf_scene_desc.h - what a pbrt-v4 scene file says, before anything is built.
  *
- * The parser (render/parser.c) fills an lf_scene_desc from a .pbrt file,
+ * The parser (scenefile/parser.c) fills an lf_scene_desc from a .pbrt file,
  * following pbrt-v4's semantics: graphics state with AttributeBegin/End,
  * the current transformation matrix (two of them, for TransformTimes /
  * ActiveTransform), named coordinate systems, named materials and textures,
@@ -21,9 +21,9 @@
 
 #include <stddef.h>
 
-#include "../base/lf_error.h"
-#include "../base/lf_math.h"
-#include "../base/lf_params.h"
+#include "base/lf_error.h"
+#include "base/lf_math.h"
+#include "base/lf_params.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -28,9 +28,9 @@
 #ifndef LF_SHADING_H
 #define LF_SHADING_H
 
-#include "../base/lf_error.h"
-#include "../base/lf_math.h"
-#include "lf_scene_desc.h"
+#include "base/lf_error.h"
+#include "base/lf_math.h"
+#include "scenefile/lf_scene_desc.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -10,7 +10,7 @@
  * ignores them too).  Other elements are skipped.  The file may be gzipped.
  */
 #include "lf_scene_desc.h"
-#include "../base/lf_file.h"
+#include "base/lf_file.h"
 
 #include <errno.h>
 #include <stdint.h>

@@ -11,8 +11,8 @@
  */
 #include "lf_shading.h"
 
-#include "../base/lf_color.h"
-#include "../base/lf_params.h"
+#include "base/lf_color.h"
+#include "base/lf_params.h"
 
 #include <math.h>
 #include <stdint.h>

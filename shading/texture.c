@@ -10,8 +10,8 @@
  */
 #include "lf_shading.h"
 
-#include "../base/lf_params.h"
-#include "../image/lf_image.h"
+#include "base/lf_params.h"
+#include "image/lf_image.h"
 
 #include <math.h>
 #include <stdarg.h>

@@ -27,6 +27,53 @@
 
 enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
 
+/* Tuning constants the options do not expose (docs/depth.md, "Method",
+ * gives each one's measurements). */
+/* per-view L1 colour difference truncated here (units of the reference's
+ * mean channel sum): a view that sees an occluder costs no more than this */
+static const float COST_TRUNCATION = 0.5f;
+/* the defocus cue against correspondence: a tie-breaker, more costs
+ * sub-pixel precision on noisy texture (the ablation) */
+static const float DEFAULT_DEFOCUS_WEIGHT = 0.1f;
+/* guided-filter radius: the shorter side over this (4 px at 512), at least
+ * MIN_GUIDE_RADIUS so the window spans more than a pixel's neighbours */
+static const int GUIDE_RADIUS_DIVISOR = 128;
+static const int MIN_GUIDE_RADIUS = 2;
+/* guided-filter regulariser for a guide in [0, 1]: keeps colour edges of
+ * a few percent */
+static const float DEFAULT_GUIDE_EPS = 1e-3f;
+/* confidence 4 (c2 - c_min) / mean(c): c2 the lowest cost more than 2
+ * labels away (the minimum's own slope is not a second mode) */
+static const float CONFIDENCE_GAIN = 4.f;
+static const int CONFIDENCE_AWAY_LABELS = 2;
+/* weighted median over a 7 x 7 window: removes isolated outliers */
+static const int DEFAULT_MEDIAN_RADIUS = 3;
+/* a zero-confidence neighbour still votes a little, so a window never has
+ * no weight */
+static const float MEDIAN_CONFIDENCE_FLOOR = 1e-3f;
+/* colour weight exp(-|dI|^2 / sigma2) on the square-root encoded
+ * reference, the median's and the refinement's */
+static const float COLOUR_SIGMA2 = 0.02f;
+/* thin structures: a candidate is nearer than the map by more than this
+ * shift (px) at the widest view, and joins a neighbour within
+ * THIN_SAME_SHIFT_PX; about the label spacing's precision */
+static const double THIN_MIN_SHIFT_PX = 0.6;
+static const double THIN_SAME_SHIFT_PX = 0.3;
+/* the candidate's cost below this times the map's: fewest bad pixels on the
+ * tests' rendered structures (ratios 0.05 .. 0.5 in docs/depth.md) */
+static const float DEFAULT_THIN_RATIO = 0.2f;
+/* Cauchy scale of the refinement's residuals, in units of the mean channel
+ * sum: a few noise levels, so a view seeing an occluder drops out */
+static const float REFINE_CAUCHY_C = 0.003f;
+/* one Gauss-Newton step: a second changes nothing measurable at twice the cost */
+static const int DEFAULT_REFINE_STEPS = 1;
+/* the refinement sums a 5 x 5 window and moves at most 2 labels: further
+ * is the labels' job */
+static const int REFINE_RADIUS = 2;
+static const double REFINE_MAX_STEP_LABELS = 2.0;
+/* threads when the options say none */
+static const int DEFAULT_THREADS = 2;
+
 lf_lightfield_depth_opts lf_lightfield_depth_defaults(void)
 {
     lf_lightfield_depth_opts o;
@@ -510,11 +557,11 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
              * (more than 2 labels off), relative to the curve's mean */
             float c2 = FLT_MAX;
             for (int l = 0; l < L; l++)
-                if (abs(l - best) > 2 && c->cost[(size_t)l * np + i] < c2)
+                if (abs(l - best) > CONFIDENCE_AWAY_LABELS && c->cost[(size_t)l * np + i] < c2)
                     c2 = c->cost[(size_t)l * np + i];
             float mean = sum / L;
             float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
-            conf = conf * 4.f;
+            conf = conf * CONFIDENCE_GAIN;
             c->conf[i] = conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
         }
 }
@@ -817,7 +864,7 @@ static void wm_rows(void *vctx, int y0, int y1, int tid)
                     if (xx < 0 || xx >= c->w)
                         continue;
                     size_t j = (size_t)yy * c->w + xx;
-                    float wt = colour_affinity(p, c->ref + 3 * j, c->sigma2) * (c->conf[j] + 1e-3f);
+                    float wt = colour_affinity(p, c->ref + 3 * j, c->sigma2) * (c->conf[j] + MEDIAN_CONFIDENCE_FLOOR);
                     buf[n].d = c->disp[j], buf[n].w = wt;
                     wsum += wt, n++;
                 }
@@ -844,7 +891,7 @@ static void wm_rows(void *vctx, int y0, int y1, int tid)
         }
 }
 
-/* ---------- driver ---------- */
+/* ---------- driver: the method's stages in order (docs/depth.md) ---------- */
 
 /* The largest view offset from the reference, in view steps (v scaled). */
 static double widest_view(const lf_lightfield *lf)
@@ -856,43 +903,79 @@ static double widest_view(const lf_lightfield *lf)
     return m > mv ? m : mv;
 }
 
-static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double d0, double d1, double step,
-                      lf_image *disparity, lf_image *confidence, lf_error *err)
+/* What the stages share: the light field's shape, the labels, the views
+ * and the working buffers (allocated at once, so a big volume fails before
+ * any work). */
+typedef struct depth_work {
+    const lf_lightfield *lf;
+    const lf_lightfield_depth_opts *o;
+    int ns, nt, threads, nlabels, nviews;
+    size_t np;
+    double d0, step;
+    const float *ref;   /* reference view, RGB */
+    float scale;        /* colour scale: 1 / mean channel sum of the reference */
+    dview *views;       /* the other views */
+    float *cost;        /* [label][pixel]; scratch for the stages after the minimum */
+    float *scratch;     /* per thread: the larger of the cost rows' and the guided filter's needs */
+    size_t per_thread;
+    float *guide;       /* 14 planes: guide (3), its means (3), inverse covariances (6), 2 temporaries */
+    float *disp, *conf; /* winner-take-all disparity and confidence */
+    float *refs;        /* square-root encoded reference in the working scale (median, refinement) */
+    float *rawd;        /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
+    cost_ctx cc;
+} depth_work;
+
+static void depth_work_free(depth_work *w)
 {
-    int ns = lf->ns, nt = lf->nt, threads = o->threads > 0 ? o->threads : 2;
+    free(w->views), free(w->cost), free(w->scratch), free(w->guide), free(w->disp), free(w->refs), free(w->rawd);
+}
+
+static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lightfield_depth_opts *o, int nl,
+                            double d0, double step, lf_error *err)
+{
+    int ns = lf->ns, nt = lf->nt;
     size_t np = (size_t)ns * nt;
-    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
-    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
-    int nl = (int)floor((d1 - d0) / step + 0.5) + 1;
-    if (nl < 3)
-        nl = 3;
-    if (nl > MAX_LABELS)
-        return lf_error_set(err, LF_ERR_PARAM, "disparity range %g .. %g in steps of %g gives %d labels (at most %d)",
-                            d0, d1, step, nl, MAX_LABELS);
-    step = (d1 - d0) / (nl - 1);
-    const float *ref = lf_lightfield_view(lf, iu0, iv0);
-    dview *views = malloc(sizeof *views * (size_t)lf->nu * lf->nv);
-    float *cost = malloc(sizeof(float) * np * (size_t)nl);
     size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12;
     size_t gf_scratch = 10 * np;
-    size_t per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch;
-    float *scratch = malloc(sizeof(float) * per_thread * (size_t)threads);
-    float *guide = malloc(sizeof(float) * np * 14), *disp = malloc(sizeof(float) * np * 2);
-    float *refs = malloc(sizeof(float) * np * 3);
-    float *rawd = NULL; /* per pixel: the unaggregated winner and its confidence (thin structures) */
-    int rc = LF_OK;
-    if (!views || !cost || !scratch || !guide || !disp || !refs) {
-        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %d-label cost volume of %dx%d", nl, ns, nt);
-        goto done;
-    }
-    int nv = 0;
+    *w = (depth_work){
+        .lf = lf,
+        .o = o,
+        .ns = ns,
+        .nt = nt,
+        .threads = o->threads > 0 ? o->threads : DEFAULT_THREADS,
+        .nlabels = nl,
+        .np = np,
+        .d0 = d0,
+        .step = step,
+        .ref = lf_lightfield_view(lf, (lf->nu - 1) / 2, (lf->nv - 1) / 2),
+        .per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch,
+    };
+    w->views = malloc(sizeof *w->views * (size_t)lf->nu * lf->nv);
+    w->cost = malloc(sizeof(float) * np * (size_t)nl);
+    w->scratch = malloc(sizeof(float) * w->per_thread * (size_t)w->threads);
+    w->guide = malloc(sizeof(float) * np * 14), w->disp = malloc(sizeof(float) * np * 2);
+    w->conf = w->disp ? w->disp + np : NULL;
+    w->refs = malloc(sizeof(float) * np * 3);
+    if (!w->views || !w->cost || !w->scratch || !w->guide || !w->disp || !w->refs)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %d-label cost volume of %dx%d", nl, ns, nt);
+    return LF_OK;
+}
+
+/* Every view but the reference, with its offset in view steps (nominal, or
+ * calibrated: lf->view_shift) and its angular group. */
+static void collect_views(depth_work *w)
+{
+    const lf_lightfield *lf = w->lf;
+    int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    w->nviews = 0;
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
             if (iu == iu0 && iv == iv0)
                 continue;
-            dview *v = &views[nv++];
+            dview *v = &w->views[w->nviews++];
             v->data = lf_lightfield_view(lf, iu, iv);
-            v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
+            v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * w->np : NULL;
             v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
             /* the angular group from the grid: calibrated positions a little
              * off a row or diagonal still belong to it */
@@ -902,153 +985,272 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
                 v->du = p[0], v->dv = p[1], v->ox = p[2], v->oy = p[3];
             }
         }
-    /* colour scale: costs in units of the reference's mean channel sum */
+}
+
+/* Costs in units of the reference's mean channel sum, so the truncation and
+ * the colour weights do not depend on exposure. */
+static float reference_colour_scale(const float *ref, size_t np)
+{
     double msum = 0;
     for (size_t i = 0; i < np * 3; i++)
         msum += ref[i];
     msum /= (double)np;
-    float scale = msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
+    return msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
+}
 
-    if (o->thin >= 0 && !(rawd = malloc(sizeof(float) * np))) {
-        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    cost_ctx cc = {lf, views, nv, ref, NULL, nl, d0, step, 0.5f, scale,
-                   o->defocus_weight >= 0 ? (float)o->defocus_weight : 0.1f, o->occlusion, o->interp != 1, cost, rawd,
-                   scratch, per_thread};
+/* Stages 1-2: the cost volume with its occlusion-aware view subsets, and
+ * (thin structures on) the unaggregated full-aperture winner per pixel. */
+static int build_cost_volume(depth_work *w, lf_error *err)
+{
+    const lf_lightfield_depth_opts *o = w->o;
+    if (o->thin >= 0 && !(w->rawd = malloc(sizeof(float) * w->np)))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    w->cc = (cost_ctx){
+        .lf = w->lf,
+        .views = w->views,
+        .nviews = w->nviews,
+        .ref = w->ref,
+        .ref_valid = NULL,
+        .nlabels = w->nlabels,
+        .d0 = w->d0,
+        .step = w->step,
+        .tau = COST_TRUNCATION,
+        .scale = w->scale,
+        .alpha = o->defocus_weight >= 0 ? (float)o->defocus_weight : DEFAULT_DEFOCUS_WEIGHT,
+        .occlusion = o->occlusion,
+        .cubic = o->interp != 1,
+        .cost = w->cost,
+        .rawd = w->rawd,
+        .scratch = w->scratch,
+        .scratch_per_thread = w->per_thread,
+    };
+    const lf_lightfield *lf = w->lf;
     if (lf->valid)
-        cc.ref_valid = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
-    lf_parallel_for(nt, threads, 4, cost_rows, &cc);
+        w->cc.ref_valid = lf->valid + ((size_t)((lf->nv - 1) / 2) * lf->nu + (lf->nu - 1) / 2) * w->np;
+    lf_parallel_for(w->nt, w->threads, 4, cost_rows, &w->cc);
+    return LF_OK;
+}
 
+/* The guided filter's per-pixel (Sigma + eps U)^-1 of the guide in a
+ * (2r+1)^2 window, 6 planes xx xy xz yy yz zz, by the adjugate. */
+static void guide_inverse_covariance(float *I, float *mI, float *Sinv, float *tmp, float *t2, int ns, int nt, int r,
+                                     float eps)
+{
+    size_t np = (size_t)ns * nt;
+    static const int pa[6] = {0, 0, 0, 1, 1, 2}, pb[6] = {0, 1, 2, 1, 2, 2};
+    for (int k = 0; k < 6; k++) {
+        mul_arr(I + pa[k] * np, I + pb[k] * np, t2, np);
+        box_mean(t2, Sinv + k * np, tmp, ns, nt, r);
+    }
+    for (size_t i = 0; i < np; i++) {
+        double m0 = mI[i], m1 = mI[np + i], m2 = mI[2 * np + i];
+        double xx = Sinv[i] - m0 * m0 + eps, xy = Sinv[np + i] - m0 * m1, xz = Sinv[2 * np + i] - m0 * m2;
+        double yy = Sinv[3 * np + i] - m1 * m1 + eps, yz = Sinv[4 * np + i] - m1 * m2;
+        double zz = Sinv[5 * np + i] - m2 * m2 + eps;
+        double c00 = yy * zz - yz * yz, c01 = xz * yz - xy * zz, c02 = xy * yz - xz * yy;
+        double c11 = xx * zz - xz * xz, c12 = xy * xz - xx * yz, c22 = xx * yy - xy * xy;
+        double det = xx * c00 + xy * c01 + xz * c02;
+        double id = det > 1e-30 ? 1.0 / det : 0.0;
+        Sinv[i] = (float)(c00 * id), Sinv[np + i] = (float)(c01 * id), Sinv[2 * np + i] = (float)(c02 * id);
+        Sinv[3 * np + i] = (float)(c11 * id), Sinv[4 * np + i] = (float)(c12 * id);
+        Sinv[5 * np + i] = (float)(c22 * id);
+    }
+}
+
+/* Stage 3: edge-aware aggregation, every cost slice through a colour
+ * guided filter guided by the reference. */
+static void aggregate_cost_volume(depth_work *w)
+{
+    const lf_lightfield_depth_opts *o = w->o;
+    int ns = w->ns, nt = w->nt;
+    size_t np = w->np;
     /* guide: the reference colour, square-root encoded (closer to perceptual
      * steps than linear) and normalised to [0, 1] */
-    float *I = guide, *mI = guide + 3 * np, *Sinv = guide + 6 * np, *tmp = guide + 12 * np, *t2 = guide + 13 * np;
+    float *I = w->guide, *mI = w->guide + 3 * np, *Sinv = w->guide + 6 * np, *tmp = w->guide + 12 * np,
+          *t2 = w->guide + 13 * np;
     float gmax = 0;
     for (size_t i = 0; i < np; i++)
         for (int ch = 0; ch < 3; ch++) {
-            float v = ref[3 * i + ch];
+            float v = w->ref[3 * i + ch];
             v = v > 0 ? sqrtf(v) : 0.f;
             I[ch * np + i] = v;
             gmax = v > gmax ? v : gmax;
         }
     for (size_t i = 0; i < 3 * np; i++)
         I[i] = gmax > 0 ? I[i] / gmax : 0.f;
-    int r = o->radius > 0 ? o->radius : (ns < nt ? ns : nt) / 128;
-    if (r < 2)
-        r = 2;
-    float eps = o->eps > 0 ? (float)o->eps : 1e-3f;
+    int r = o->radius > 0 ? o->radius : (ns < nt ? ns : nt) / GUIDE_RADIUS_DIVISOR;
+    if (r < MIN_GUIDE_RADIUS)
+        r = MIN_GUIDE_RADIUS;
+    float eps = o->eps > 0 ? (float)o->eps : DEFAULT_GUIDE_EPS;
     for (int ch = 0; ch < 3; ch++)
         box_mean(I + ch * np, mI + ch * np, tmp, ns, nt, r);
-    {
-        static const int pa[6] = {0, 0, 0, 1, 1, 2}, pb[6] = {0, 1, 2, 1, 2, 2};
-        for (int k = 0; k < 6; k++) {
-            mul_arr(I + pa[k] * np, I + pb[k] * np, t2, np);
-            box_mean(t2, Sinv + k * np, tmp, ns, nt, r);
+    guide_inverse_covariance(I, mI, Sinv, tmp, t2, ns, nt, r, eps);
+    gf_ctx gc = {
+        .w = ns, .h = nt, .r = r, .I = I, .mI = mI, .Sinv = Sinv,
+        .cost = w->cost, .scratch = w->scratch, .per_thread = w->per_thread,
+    };
+    lf_parallel_for(w->nlabels, w->threads, 1, gf_slices, &gc);
+}
+
+/* Stages 4-5: winner-take-all, the parabola's sub-label offset, and the
+ * confidence of the aggregated cost curve. */
+static void winner_take_all(depth_work *w)
+{
+    wta_ctx wc = {
+        .w = w->ns, .h = w->nt, .nlabels = w->nlabels, .d0 = w->d0, .step = w->step,
+        .cost = w->cost, .disp = w->disp, .conf = w->conf,
+    };
+    lf_parallel_for(w->nt, w->threads, 8, wta_rows, &wc);
+}
+
+/* The reference colour the median and the refinement weigh neighbours by:
+ * square-root encoded in the working scale. */
+static void encode_reference(depth_work *w)
+{
+    for (size_t i = 0; i < w->np; i++)
+        for (int ch = 0; ch < 3; ch++) {
+            float v = w->ref[3 * i + ch] * w->scale;
+            w->refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
         }
-        for (size_t i = 0; i < np; i++) {
-            double m0 = mI[i], m1 = mI[np + i], m2 = mI[2 * np + i];
-            double xx = Sinv[i] - m0 * m0 + eps, xy = Sinv[np + i] - m0 * m1, xz = Sinv[2 * np + i] - m0 * m2;
-            double yy = Sinv[3 * np + i] - m1 * m1 + eps, yz = Sinv[4 * np + i] - m1 * m2;
-            double zz = Sinv[5 * np + i] - m2 * m2 + eps;
-            double c00 = yy * zz - yz * yz, c01 = xz * yz - xy * zz, c02 = xy * yz - xz * yy;
-            double c11 = xx * zz - xz * xz, c12 = xy * xz - xx * yz, c22 = xx * yy - xy * xy;
-            double det = xx * c00 + xy * c01 + xz * c02;
-            double id = det > 1e-30 ? 1.0 / det : 0.0;
-            Sinv[i] = (float)(c00 * id), Sinv[np + i] = (float)(c01 * id), Sinv[2 * np + i] = (float)(c02 * id);
-            Sinv[3 * np + i] = (float)(c11 * id), Sinv[4 * np + i] = (float)(c12 * id);
-            Sinv[5 * np + i] = (float)(c22 * id);
-        }
+}
+
+/* Stage 6: the confidence- and colour-weighted median of the
+ * winner-take-all map into out (a copy when the median is off). */
+static int weighted_median(depth_work *w, float *out, lf_error *err)
+{
+    int mr = w->o->median_radius < 0 ? DEFAULT_MEDIAN_RADIUS : w->o->median_radius;
+    if (mr <= 0) {
+        memcpy(out, w->disp, sizeof(float) * w->np);
+        return LF_OK;
     }
-    gf_ctx gc = {ns, nt, r, I, mI, Sinv, cost, scratch, per_thread};
-    lf_parallel_for(nl, threads, 1, gf_slices, &gc);
+    size_t wpt = 2 * (size_t)(2 * mr + 1) * (2 * mr + 1);
+    if (wpt * w->threads > w->per_thread * w->threads)
+        return lf_error_set(err, LF_ERR_NOMEM, "median radius %d too large", mr);
+    wm_ctx wm = {
+        .w = w->ns, .h = w->nt, .r = mr, .disp = w->disp, .conf = w->conf, .ref = w->refs,
+        .out = out, .sigma2 = COLOUR_SIGMA2, .scratch = w->scratch, .per_thread = wpt,
+    };
+    lf_parallel_for(w->nt, w->threads, 4, wm_rows, &wm);
+    return LF_OK;
+}
 
-    float *conf = disp + np;
-    wta_ctx wc = {ns, nt, nl, d0, step, cost, disp, conf};
-    lf_parallel_for(nt, threads, 8, wta_rows, &wc);
+/* Stage 7: thin structures (a wire, a wedge's tip) a pixel or two wide lose
+ * to the window of the aggregation; where the pixel's own costs are
+ * decisive (ratio) and a neighbour carries the same disparity, they come
+ * back (docs/depth.md).  map: the median's output, updated in place. */
+static int recover_thin_structures(depth_work *w, float *map, lf_error *err)
+{
+    if (!w->rawd)
+        return LF_OK;
+    double m = widest_view(w->lf);
+    m = m > 0 ? m : 1;
+    unsigned char *cand = malloc(w->np);
+    if (!cand)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    float *tout = w->cost; /* the cost volume is no longer needed */
+    thin_ctx tc = {
+        .cc = &w->cc,
+        .w = w->ns,
+        .h = w->nt,
+        .disp = map,
+        .rawd = w->rawd,
+        .cand = cand,
+        .out = tout,
+        .tol_d = (float)(THIN_MIN_SHIFT_PX / m),
+        .tol_s = (float)(THIN_SAME_SHIFT_PX / m),
+        .ratio = w->o->thin_ratio > 0 ? (float)w->o->thin_ratio : DEFAULT_THIN_RATIO,
+        .map_max = -FLT_MAX,
+    };
+    for (size_t i = 0; i < w->np; i++)
+        tc.map_max = map[i] > tc.map_max ? map[i] : tc.map_max;
+    lf_parallel_for(w->nt, w->threads, 8, thin_cand_rows, &tc);
+    lf_parallel_for(w->nt, w->threads, 8, thin_take_rows, &tc);
+    for (size_t i = 0; i < w->np; i++)
+        map[i] = tout[i];
+    free(cand);
+    return LF_OK;
+}
 
-    if (lf_image_alloc(disparity, ns, nt, 1, err)) {
+/* Stage 8: continuous sub-label refinement, Gauss-Newton steps on the
+ * views' photo-consistency around the labelled disparity (docs/depth.md).
+ * map: updated in place. */
+static void refine_disparity(depth_work *w, float *map)
+{
+    const lf_lightfield_depth_opts *o = w->o;
+    if (o->refine < 0)
+        return;
+    int iters = o->refine > 0 ? o->refine : DEFAULT_REFINE_STEPS;
+    size_t np = w->np;
+    float *A = w->cost, *B = w->cost + np, *tmpd = w->cost + 2 * np; /* the cost volume is no longer needed */
+    for (int it = 0; it < iters; it++) {
+        memset(A, 0, sizeof(float) * 2 * np);
+        for (int k = 0; k < w->nviews; k++) {
+            if (w->views[k].valid)
+                continue;
+            gn_ctx gc = {
+                .w = w->ns, .h = w->nt, .v = &w->views[k], .img = w->views[k].data, .ref = w->ref, .disp = map,
+                .A = A, .B = B, .scale = w->scale, .c2 = REFINE_CAUCHY_C * REFINE_CAUCHY_C,
+            };
+            lf_parallel_for(w->nt, w->threads, 8, gn_rows, &gc);
+        }
+        for (size_t i = 0; i < np; i++)
+            B[i] = A[i] * map[i] - B[i];
+        gnagg_ctx ga = {
+            .w = w->ns, .h = w->nt, .r = REFINE_RADIUS, .A = A, .B = B, .disp = map, .refs = w->refs,
+            .out = tmpd, .dmax = (float)(REFINE_MAX_STEP_LABELS * w->step), .sigma2 = COLOUR_SIGMA2,
+        };
+        lf_parallel_for(w->nt, w->threads, 4, gnagg_rows, &ga);
+        memcpy(map, tmpd, sizeof(float) * np);
+    }
+}
+
+/* Labels from d0 to d1 at about step apart: at least 3 (the parabola needs
+ * neighbours). */
+static int label_count(double d0, double d1, double step)
+{
+    int nl = (int)floor((d1 - d0) / step + 0.5) + 1;
+    return nl < 3 ? 3 : nl;
+}
+
+static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double d0, double d1, double step,
+                      lf_image *disparity, lf_image *confidence, lf_error *err)
+{
+    int nl = label_count(d0, d1, step);
+    if (nl > MAX_LABELS)
+        return lf_error_set(err, LF_ERR_PARAM, "disparity range %g .. %g in steps of %g gives %d labels (at most %d)",
+                            d0, d1, step, nl, MAX_LABELS);
+    step = (d1 - d0) / (nl - 1);
+    depth_work w;
+    int rc = depth_work_alloc(&w, lf, o, nl, d0, step, err);
+    if (rc)
+        goto done;
+    collect_views(&w);
+    w.scale = reference_colour_scale(w.ref, w.np);
+    if ((rc = build_cost_volume(&w, err)))
+        goto done;
+    aggregate_cost_volume(&w);
+    winner_take_all(&w);
+    if (lf_image_alloc(disparity, w.ns, w.nt, 1, err)) {
         rc = err ? err->code : LF_ERR_NOMEM;
         goto done;
     }
-    int mr = o->median_radius < 0 ? 3 : o->median_radius;
-    if (mr > 0) {
-        for (size_t i = 0; i < np; i++) {
-            for (int ch = 0; ch < 3; ch++) {
-                float v = ref[3 * i + ch] * scale;
-                refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
-            }
-        }
-        size_t wpt = 2 * (size_t)(2 * mr + 1) * (2 * mr + 1);
-        float *wscr = wpt * threads <= per_thread * threads ? scratch : NULL;
-        if (!wscr) {
-            rc = lf_error_set(err, LF_ERR_NOMEM, "median radius %d too large", mr);
-            lf_image_free(disparity);
-            goto done;
-        }
-        wm_ctx wm = {ns, nt, mr, disp, conf, refs, disparity->data, 0.02f, wscr, wpt};
-        lf_parallel_for(nt, threads, 4, wm_rows, &wm);
-    } else {
-        memcpy(disparity->data, disp, sizeof(float) * np);
+    if (o->median_radius != 0 || o->refine >= 0)
+        encode_reference(&w);
+    if ((rc = weighted_median(&w, disparity->data, err)) || (rc = recover_thin_structures(&w, disparity->data, err))) {
+        lf_image_free(disparity);
+        goto done;
     }
-    if (rawd) {
-        /* thin structures (a wire, a wedge's tip) a pixel or two wide lose
-         * to the window of the aggregation; where the pixel's own costs are
-         * decisive (ratio) and a neighbour carries the same disparity, they
-         * come back (docs/depth.md) */
-        double m = widest_view(lf);
-        m = m > 0 ? m : 1;
-        unsigned char *cand = malloc(np);
-        if (!cand) {
-            rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-            lf_image_free(disparity);
-            goto done;
-        }
-        float *tout = cost; /* the cost volume is no longer needed */
-        thin_ctx tc = {&cc, ns, nt, disparity->data, rawd, cand, tout, (float)(0.6 / m), (float)(0.3 / m),
-                       o->thin_ratio > 0 ? (float)o->thin_ratio : 0.2f, -FLT_MAX};
-        for (size_t i = 0; i < np; i++)
-            tc.map_max = disparity->data[i] > tc.map_max ? disparity->data[i] : tc.map_max;
-        lf_parallel_for(nt, threads, 8, thin_cand_rows, &tc);
-        lf_parallel_for(nt, threads, 8, thin_take_rows, &tc);
-        for (size_t i = 0; i < np; i++)
-            disparity->data[i] = tout[i];
-        free(cand);
-    }
-    if (o->refine >= 0) {
-        /* continuous sub-label refinement: Gauss-Newton steps on the views'
-         * photo-consistency around the labelled disparity (docs/depth.md) */
-        int iters = o->refine > 0 ? o->refine : 1;
-        float *A = cost, *B = cost + np, *tmpd = cost + 2 * np; /* the cost volume is no longer needed */
-        for (size_t i = 0; i < np; i++)
-            for (int ch = 0; ch < 3; ch++) {
-                float v = ref[3 * i + ch] * scale;
-                refs[3 * i + ch] = v > 0 ? sqrtf(v) : 0.f;
-            }
-        for (int it = 0; it < iters; it++) {
-            memset(A, 0, sizeof(float) * 2 * np);
-            for (int k = 0; k < nv; k++) {
-                if (views[k].valid)
-                    continue;
-                gn_ctx gc2 = {ns, nt, &views[k], views[k].data, ref, disparity->data, A, B, scale, 0.003f * 0.003f};
-                lf_parallel_for(nt, threads, 8, gn_rows, &gc2);
-            }
-            for (size_t i = 0; i < np; i++)
-                B[i] = A[i] * disparity->data[i] - B[i];
-            gnagg_ctx ga = {ns, nt, 2, A, B, disparity->data, refs, tmpd, (float)(2 * step), 0.02f};
-            lf_parallel_for(nt, threads, 4, gnagg_rows, &ga);
-            memcpy(disparity->data, tmpd, sizeof(float) * np);
-        }
-    }
+    refine_disparity(&w, disparity->data);
     if (confidence) {
-        if (lf_image_alloc(confidence, ns, nt, 1, err)) {
+        if (lf_image_alloc(confidence, w.ns, w.nt, 1, err)) {
             rc = err ? err->code : LF_ERR_NOMEM;
             lf_image_free(disparity);
             goto done;
         }
-        memcpy(confidence->data, conf, sizeof(float) * np);
+        memcpy(confidence->data, w.conf, sizeof(float) * w.np);
     }
 done:
-    free(views), free(cost), free(scratch), free(guide), free(disp), free(refs), free(rawd);
+    depth_work_free(&w);
     return rc;
 }
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "base/lf_keys.h"
+#include "image/lf_layout_attrs.h"
 #include "lf_lightfield.h"
 
 void lf_lightfield_layout_init(lf_lightfield_layout *lay)
@@ -12,34 +13,26 @@ void lf_lightfield_layout_init(lf_lightfield_layout *lay)
     memset(lay, 0, sizeof *lay);
 }
 
-static int attr_num(const lf_attrs *a, const char *name, double *v, lf_error *err)
+/* The readers of the decoded attributes (image/lf_layout_attrs.h), strict:
+ * 1 set (copied to v), 0 absent, -1 malformed (err says so). */
+static int take_num(const lf_layout_attr *at, double *v, lf_error *err)
 {
-    const lf_attr *at = lf_attrs_get(a, name);
-    if (!at)
+    if (at->state == LF_LAYOUT_ATTR_ABSENT)
         return 0;
-    switch (at->type) {
-    case LF_ATTR_INT: *v = at->i; return 1;
-    case LF_ATTR_FLOAT:
-    case LF_ATTR_DOUBLE: *v = at->d; return 1;
-    case LF_ATTR_FLOATS:
-        if (at->n == 1) {
-            *v = at->v[0];
-            return 1;
-        }
-        break;
-    default: break;
+    if (at->state == LF_LAYOUT_ATTR_SET) {
+        *v = at->v[0];
+        return 1;
     }
-    lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected a number", name);
+    lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected a number", at->name);
     return -1;
 }
 
-static int attr_vec(const lf_attrs *a, const char *name, int n, double *v, lf_error *err)
+static int take_vec(const lf_layout_attr *at, int n, double *v, lf_error *err)
 {
-    const lf_attr *at = lf_attrs_get(a, name);
-    if (!at)
+    if (at->state == LF_LAYOUT_ATTR_ABSENT)
         return 0;
-    if (at->type != LF_ATTR_FLOATS || at->n != n) {
-        lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected %d floats", name, n);
+    if (at->state != LF_LAYOUT_ATTR_SET) {
+        lf_error_set(err, LF_ERR_PARSE, "attribute %s: expected %d floats", at->name, n);
         return -1;
     }
     for (int i = 0; i < n; i++)
@@ -62,25 +55,26 @@ static int finite_within(const double *v, int n, double limit)
     return 1;
 }
 
-int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay, lf_error *err)
+static int kind_from_attrs(const lf_layout_attrs *la, lf_lightfield_layout *lay, lf_error *err)
 {
-    lf_lightfield_layout_init(lay);
-    const lf_attr *k = lf_attrs_get(a, LF_KEY_KIND);
-    if (k) {
-        if (k->type != LF_ATTR_STRING)
-            return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:kind: expected a string");
-        if (!strcmp(k->s, "camera-array"))
-            lay->kind = LF_LIGHTFIELD_CAMERA_ARRAY;
-        else if (!strcmp(k->s, "plenoptic"))
-            lay->kind = LF_LIGHTFIELD_PLENOPTIC;
-        else
-            return lf_error_set(err, LF_ERR_PARSE,
-                                "attribute lensfield:kind is \"%s\" (expected camera-array or plenoptic)", k->s);
-        lay->have |= LF_LIGHTFIELD_HAVE_KIND;
-    }
+    if (la->kind.state == LF_LAYOUT_ATTR_ABSENT)
+        return LF_OK;
+    if (la->kind.state != LF_LAYOUT_ATTR_SET)
+        return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:kind: expected a string");
+    if (la->kind_id == LF_LIGHTFIELD_KIND_UNKNOWN)
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "attribute lensfield:kind is \"%s\" (expected camera-array or plenoptic)", la->kind.s);
+    lay->kind = la->kind_id;
+    lay->have |= LF_LIGHTFIELD_HAVE_KIND;
+    return LF_OK;
+}
+
+/* The camera array's grid, bounds, field of view, tile and data-camera lens. */
+static int camera_array_from_attrs(const lf_layout_attrs *la, lf_lightfield_layout *lay, lf_error *err)
+{
     double v[4];
     int r;
-    if ((r = attr_vec(a, LF_KEY_CAMERAS_PER_DIM, 2, v, err)) < 0)
+    if ((r = take_vec(&la->cameras_per_dim, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 4096) || !whole_in(v[1], 1, 4096))
@@ -91,17 +85,17 @@ int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay
         lay->cams_y = (int)v[1];
         lay->have |= LF_LIGHTFIELD_HAVE_CAMS;
     }
-    if ((r = attr_vec(a, LF_KEY_CAMERA_GRID_BOUNDS, 4, lay->grid_bounds, err)) < 0)
+    if ((r = take_vec(&la->camera_grid_bounds, 4, lay->grid_bounds, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && !finite_within(lay->grid_bounds, 4, 1e12))
         return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:camera_grid_bounds: values must be finite");
     if (r)
         lay->have |= LF_LIGHTFIELD_HAVE_BOUNDS;
-    if ((r = attr_num(a, LF_KEY_FOV_DEG, &lay->fov_deg, err)) < 0)
+    if ((r = take_num(&la->fov_deg, &lay->fov_deg, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LIGHTFIELD_HAVE_FOV;
-    if ((r = attr_vec(a, LF_KEY_TILE_SIZE, 2, v, err)) < 0)
+    if ((r = take_vec(&la->tile_size, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
@@ -110,33 +104,39 @@ int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay
         lay->tile_h = (int)v[1];
         lay->have |= LF_LIGHTFIELD_HAVE_TILE;
     }
-    int lr = attr_num(a, LF_KEY_LENS_RADIUS, &lay->lens_radius, err);
-    int fd = attr_num(a, LF_KEY_FOCAL_DISTANCE, &lay->focal_distance, err);
+    int lr = take_num(&la->lens_radius, &lay->lens_radius, err);
+    int fd = take_num(&la->focal_distance, &lay->focal_distance, err);
     if (lr < 0 || fd < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (lr || fd)
         lay->have |= LF_LIGHTFIELD_HAVE_CAM_LENS;
+    return LF_OK;
+}
 
-    const lf_attr *g = lf_attrs_get(a, LF_KEY_GRID);
-    if (g) {
-        if (g->type != LF_ATTR_STRING || (strcmp(g->s, "square") && strcmp(g->s, "hex")))
+/* The microlens array: grid, pitch, rotation, offset and count. */
+static int microlenses_from_attrs(const lf_layout_attrs *la, lf_lightfield_layout *lay, lf_error *err)
+{
+    if (la->grid.state != LF_LAYOUT_ATTR_ABSENT) {
+        if (!la->grid_known)
             return lf_error_set(err, LF_ERR_PARSE, "attribute lensfield:grid: expected \"square\" or \"hex\"");
-        lay->grid = strcmp(g->s, "hex") ? LF_LIGHTFIELD_GRID_SQUARE : LF_LIGHTFIELD_GRID_HEX;
+        lay->grid = la->grid_id;
         lay->have |= LF_LIGHTFIELD_HAVE_GRID;
     }
-    if ((r = attr_num(a, LF_KEY_MICROLENS_PITCH_PX, &lay->pitch_px, err)) < 0)
+    double v[2];
+    int r;
+    if ((r = take_num(&la->microlens_pitch_px, &lay->pitch_px, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LIGHTFIELD_HAVE_PITCH;
-    if ((r = attr_num(a, LF_KEY_MICROLENS_ROTATION_RAD, &lay->rotation_rad, err)) < 0)
+    if ((r = take_num(&la->microlens_rotation_rad, &lay->rotation_rad, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LIGHTFIELD_HAVE_ROTATION;
-    if ((r = attr_vec(a, LF_KEY_MICROLENS_OFFSET_PX, 2, lay->offset_px, err)) < 0)
+    if ((r = take_vec(&la->microlens_offset_px, 2, lay->offset_px, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r)
         lay->have |= LF_LIGHTFIELD_HAVE_OFFSET;
-    if ((r = attr_vec(a, LF_KEY_MICROLENS_COUNT, 2, v, err)) < 0)
+    if ((r = take_vec(&la->microlens_count, 2, v, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r) {
         if (!whole_in(v[0], 1, 1 << 20) || !whole_in(v[1], 1, 1 << 20))
@@ -146,23 +146,31 @@ int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay
         lay->lens_y = (int)v[1];
         lay->have |= LF_LIGHTFIELD_HAVE_LENS_COUNT;
     }
-    int n = 0;
-    n += attr_num(a, LF_KEY_MAIN_FOCAL_MM, &lay->main_focal_mm, err) > 0;
-    n += attr_num(a, LF_KEY_MAIN_FSTOP, &lay->main_fstop, err) > 0;
-    n += attr_num(a, LF_KEY_MLA_DISTANCE_MM, &lay->mla_distance_mm, err) > 0;
-    n += attr_num(a, LF_KEY_MICROLENS_PITCH_UM, &lay->pitch_um, err) > 0;
-    attr_num(a, LF_KEY_FOCUS_DISTANCE_M, &lay->focus_distance_m, err);
-    attr_num(a, LF_KEY_MICROLENS_FOCAL_MM, &lay->microlens_focal_mm, err);
-    attr_num(a, LF_KEY_SENSOR_OFFSET_MM, &lay->sensor_offset_mm, err);
+    return LF_OK;
+}
+
+/* The main lens and the optional optics, the disparity range and the
+ * convergence distance: a malformed one among the optics is reported after
+ * the rest is read (the first message kept). */
+static int optics_from_attrs(const lf_layout_attrs *la, lf_lightfield_layout *lay, lf_error *err)
+{
+    int n = 0, r;
+    n += take_num(&la->main_focal_mm, &lay->main_focal_mm, err) > 0;
+    n += take_num(&la->main_fstop, &lay->main_fstop, err) > 0;
+    n += take_num(&la->mla_distance_mm, &lay->mla_distance_mm, err) > 0;
+    n += take_num(&la->microlens_pitch_um, &lay->pitch_um, err) > 0;
+    take_num(&la->focus_distance_m, &lay->focus_distance_m, err);
+    take_num(&la->microlens_focal_mm, &lay->microlens_focal_mm, err);
+    take_num(&la->sensor_offset_mm, &lay->sensor_offset_mm, err);
     if (!(isfinite(lay->microlens_focal_mm) && lay->microlens_focal_mm >= 0 && lay->microlens_focal_mm < 1e6 &&
           isfinite(lay->sensor_offset_mm) && fabs(lay->sensor_offset_mm) < 1e6))
         lay->microlens_focal_mm = 0, lay->sensor_offset_mm = 0;
     double rng[2];
-    if ((r = attr_vec(a, LF_KEY_DISPARITY_RANGE, 2, rng, err)) < 0)
+    if ((r = take_vec(&la->disparity_range, 2, rng, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && finite_within(rng, 2, 1e9) && rng[0] <= rng[1])
         lay->disp_min = rng[0], lay->disp_max = rng[1], lay->have |= LF_LIGHTFIELD_HAVE_DISP_RANGE;
-    if ((r = attr_num(a, LF_KEY_CONVERGENCE_DISTANCE, &lay->convergence_m, err)) < 0)
+    if ((r = take_num(&la->convergence_distance, &lay->convergence_m, err)) < 0)
         return err ? err->code : LF_ERR_PARSE;
     if (r && isfinite(lay->convergence_m) && lay->convergence_m > 0)
         lay->have |= LF_LIGHTFIELD_HAVE_CONVERGENCE;
@@ -170,6 +178,18 @@ int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay
         return err->code;
     if (n == 4)
         lay->have |= LF_LIGHTFIELD_HAVE_MAIN_LENS;
+    return LF_OK;
+}
+
+int lf_lightfield_layout_from_attrs(const lf_attrs *a, lf_lightfield_layout *lay, lf_error *err)
+{
+    lf_lightfield_layout_init(lay);
+    lf_layout_attrs la;
+    lf_layout_attrs_decode(a, &la);
+    int rc;
+    if ((rc = kind_from_attrs(&la, lay, err)) || (rc = camera_array_from_attrs(&la, lay, err)) ||
+        (rc = microlenses_from_attrs(&la, lay, err)) || (rc = optics_from_attrs(&la, lay, err)))
+        return rc;
     double scalars[] = {lay->fov_deg, lay->pitch_px, lay->rotation_rad, lay->lens_radius, lay->focal_distance};
     if (((lay->have & LF_LIGHTFIELD_HAVE_FOV) && !(isfinite(lay->fov_deg) && lay->fov_deg > 0 && lay->fov_deg < 180)) ||
         ((lay->have & LF_LIGHTFIELD_HAVE_PITCH) && !(isfinite(lay->pitch_px) && lay->pitch_px > 0 && lay->pitch_px <= 1e6)) ||
@@ -304,7 +324,7 @@ int lf_lightfield_layout_to_attrs(const lf_lightfield_layout *lay, lf_attrs *a, 
     int r = 0;
     float v[4];
     if (lay->kind == LF_LIGHTFIELD_CAMERA_ARRAY) {
-        r |= lf_attrs_set_string(a, LF_KEY_KIND, "camera-array");
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_CAMERA_ARRAY));
         v[0] = (float)lay->cams_x, v[1] = (float)lay->cams_y;
         r |= lf_attrs_set_floats(a, LF_KEY_CAMERAS_PER_DIM, v, 2);
         if (lay->have & LF_LIGHTFIELD_HAVE_BOUNDS) {
@@ -319,8 +339,8 @@ int lf_lightfield_layout_to_attrs(const lf_lightfield_layout *lay, lf_attrs *a, 
         if (lay->have & LF_LIGHTFIELD_HAVE_CONVERGENCE)
             r |= lf_attrs_set_double(a, LF_KEY_CONVERGENCE_DISTANCE, lay->convergence_m);
     } else if (lay->kind == LF_LIGHTFIELD_PLENOPTIC) {
-        r |= lf_attrs_set_string(a, LF_KEY_KIND, "plenoptic");
-        r |= lf_attrs_set_string(a, LF_KEY_GRID, lay->grid == LF_LIGHTFIELD_GRID_HEX ? "hex" : "square");
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_PLENOPTIC));
+        r |= lf_attrs_set_string(a, LF_KEY_GRID, lf_lightfield_grid_name(lay->grid));
         r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_PX, lay->pitch_px);
         r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_ROTATION_RAD, lay->rotation_rad);
         v[0] = (float)lay->offset_px[0], v[1] = (float)lay->offset_px[1];

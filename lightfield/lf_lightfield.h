@@ -36,13 +36,13 @@
 
 #include "base/lf_error.h"
 #include "image/lf_image.h"
+#include "image/lf_layout_attrs.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-typedef enum lf_lightfield_kind { LF_LIGHTFIELD_KIND_UNKNOWN = 0, LF_LIGHTFIELD_CAMERA_ARRAY, LF_LIGHTFIELD_PLENOPTIC } lf_lightfield_kind;
-typedef enum lf_lightfield_grid { LF_LIGHTFIELD_GRID_SQUARE = 0, LF_LIGHTFIELD_GRID_HEX } lf_lightfield_grid;
+/* lf_lightfield_kind, lf_lightfield_grid: image/lf_layout_attrs.h (the attributes name them). */
 
 /* Which fields of an lf_lightfield_layout are known. */
 enum {

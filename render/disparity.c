@@ -25,106 +25,101 @@
 #include <math.h>
 #include <string.h>
 
-#include "base/lf_keys.h"
+#include "image/lf_layout_attrs.h"
 #include "render_internal.h"
 
-static int get_num(const lf_attrs *m, const char *name, double *v)
+/* The decoded attributes (image/lf_layout_attrs.h), read leniently: a
+ * malformed one counts as missing; a number given as a list is its first. */
+static int get_num(const lf_layout_attr *at, double *v)
 {
-    const lf_attr *a = lf_attrs_get(m, name);
-    if (!a)
+    if (at->state != LF_LAYOUT_ATTR_SET && at->state != LF_LAYOUT_ATTR_LIST)
         return 0;
-    switch (a->type) {
-    case LF_ATTR_INT: *v = a->i; return 1;
-    case LF_ATTR_FLOAT:
-    case LF_ATTR_DOUBLE: *v = a->d; return 1;
-    case LF_ATTR_FLOATS:
-        if (a->n >= 1) {
-            *v = a->v[0];
-            return 1;
-        }
-        return 0;
-    default: return 0;
-    }
+    *v = at->v[0];
+    return 1;
 }
 
-static int get_vec(const lf_attrs *m, const char *name, int n, double *v)
+static int get_vec(const lf_layout_attr *at, int n, double *v)
 {
-    const lf_attr *a = lf_attrs_get(m, name);
-    if (!a || a->type != LF_ATTR_FLOATS || a->n != n)
+    if (at->state != LF_LAYOUT_ATTR_SET)
         return 0;
     for (int i = 0; i < n; i++)
-        v[i] = a->v[i];
+        v[i] = at->v[i];
     return 1;
+}
+
+static int camera_array_geom(const lf_layout_attrs *la, lf_disparity_geom *g, lf_error *err)
+{
+    double dims[2], tile[2], fov;
+    if (!get_vec(&la->cameras_per_dim, 2, dims) || !get_vec(&la->tile_size, 2, tile) ||
+        !get_vec(&la->camera_grid_bounds, 4, g->bounds) || !get_num(&la->fov_deg, &fov))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "disparity AOV: the camera array's attributes are incomplete (cameras_per_dim, "
+                            "tile_size, camera_grid_bounds, fov_deg)");
+    g->kind = LF_LIGHTFIELD_CAMERA_ARRAY;
+    g->nx = (int)dims[0], g->ny = (int)dims[1], g->tw = (int)tile[0], g->th = (int)tile[1];
+    if (g->nx < 1 || g->ny < 1 || g->tw < 1 || g->th < 1 || !(fov > 0 && fov < 180))
+        return lf_error_set(err, LF_ERR_PARAM, "disparity AOV: bad camera-array attributes");
+    g->tan_half = tan(fov * M_PI / 360);
+    double aspect = (double)g->tw / g->th;
+    if (aspect > 1.0)
+        g->screen[0] = -aspect, g->screen[1] = aspect, g->screen[2] = -1.0, g->screen[3] = 1.0;
+    else
+        g->screen[0] = -1.0, g->screen[1] = 1.0, g->screen[2] = -1.0 / aspect, g->screen[3] = 1.0 / aspect;
+    g->sx = (g->screen[1] - g->screen[0]) / g->tw;
+    g->sy = (g->screen[3] - g->screen[2]) / g->th;
+    double fpx = 0.5 * (g->tw < g->th ? g->tw : g->th) / g->tan_half;
+    double bx = g->nx > 1 ? (g->bounds[1] - g->bounds[0]) / (g->nx - 1) : 0;
+    double by = g->ny > 1 ? (g->bounds[3] - g->bounds[2]) / (g->ny - 1) : 0;
+    g->a = 0;
+    g->b = fpx * (bx > 0 ? bx : by);
+    return LF_OK;
+}
+
+static int plenoptic_geom(const lf_layout_attrs *la, int xres, lf_disparity_geom *g, lf_error *err)
+{
+    double sensor[2], off[2], count[2], rot = 0;
+    if (!get_num(&la->microlens_pitch_px, &g->pitch_px) || !get_vec(&la->microlens_offset_px, 2, off) ||
+        !get_vec(&la->microlens_count, 2, count) || !get_vec(&la->sensor_size_mm, 2, sensor) ||
+        !get_num(&la->microlens_focal_mm, &g->fmla_mm) || !get_num(&la->mla_distance_mm, &g->zi_mm) ||
+        !get_num(&la->main_focal_mm, &g->f_mm))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "disparity AOV: the plenoptic camera's attributes are incomplete (microlens pitch, "
+                            "offset, count and focal length, sensor size, main lens)");
+    get_num(&la->microlens_rotation_rad, &rot);
+    get_num(&la->sensor_offset_mm, &g->sensor_offset_mm);
+    g->kind = LF_LIGHTFIELD_PLENOPTIC;
+    g->hex = la->grid_known && la->grid_id == LF_LIGHTFIELD_GRID_HEX;
+    g->cos_r = cos(rot), g->sin_r = sin(rot);
+    g->origin[0] = off[0], g->origin[1] = off[1];
+    g->lx = (int)count[0], g->ly = (int)count[1];
+    g->row_px = g->pitch_px * (g->hex ? sqrt(3.0) / 2 : 1.0);
+    double d = g->fmla_mm + g->sensor_offset_mm, zi = g->zi_mm;
+    double pixel = sensor[0] / xres; /* mm */
+    if (!(g->pitch_px > 0) || !(d > 0) || !(zi > 0) || !(g->f_mm > 0) || !(pixel > 0) || g->lx < 1 || g->ly < 1)
+        return lf_error_set(err, LF_ERR_PARAM, "disparity AOV: bad plenoptic attributes");
+    g->slope_per_px = pixel / (zi + d);
+    double kk = (zi + d) / (d * g->pitch_px);
+    g->a = kk * (1 - zi / g->f_mm);
+    g->b = kk * zi * 1e-3; /* Z in metres (camera space) */
+    return LF_OK;
 }
 
 int lf_disparity_geom_init(const lf_attrs *meta, int xres, int yres, lf_disparity_geom *g, lf_error *err)
 {
     memset(g, 0, sizeof *g);
-    const lf_attr *k = lf_attrs_get(meta, LF_KEY_KIND);
-    if (!k || k->type != LF_ATTR_STRING)
+    lf_layout_attrs la;
+    lf_layout_attrs_decode(meta, &la);
+    if (la.kind.state != LF_LAYOUT_ATTR_SET)
         return lf_error_set(err, LF_ERR_PARAM,
                             "the disparity AOV needs a light-field camera (Camera \"lightfield\" or \"plenoptic\", or a "
                             "camera writing lensfield:kind)");
     g->xres = xres, g->yres = yres;
-    if (!strcmp(k->s, "camera-array")) {
-        double dims[2], tile[2], fov;
-        if (!get_vec(meta, LF_KEY_CAMERAS_PER_DIM, 2, dims) || !get_vec(meta, LF_KEY_TILE_SIZE, 2, tile) ||
-            !get_vec(meta, LF_KEY_CAMERA_GRID_BOUNDS, 4, g->bounds) || !get_num(meta, LF_KEY_FOV_DEG, &fov))
-            return lf_error_set(err, LF_ERR_PARAM,
-                                "disparity AOV: the camera array's attributes are incomplete (cameras_per_dim, "
-                                "tile_size, camera_grid_bounds, fov_deg)");
-        g->kind = LF_LIGHTFIELD_CAMERA_ARRAY_KIND;
-        g->nx = (int)dims[0], g->ny = (int)dims[1], g->tw = (int)tile[0], g->th = (int)tile[1];
-        if (g->nx < 1 || g->ny < 1 || g->tw < 1 || g->th < 1 || !(fov > 0 && fov < 180))
-            return lf_error_set(err, LF_ERR_PARAM, "disparity AOV: bad camera-array attributes");
-        g->tan_half = tan(fov * M_PI / 360);
-        double aspect = (double)g->tw / g->th;
-        if (aspect > 1.0)
-            g->screen[0] = -aspect, g->screen[1] = aspect, g->screen[2] = -1.0, g->screen[3] = 1.0;
-        else
-            g->screen[0] = -1.0, g->screen[1] = 1.0, g->screen[2] = -1.0 / aspect, g->screen[3] = 1.0 / aspect;
-        g->sx = (g->screen[1] - g->screen[0]) / g->tw;
-        g->sy = (g->screen[3] - g->screen[2]) / g->th;
-        double fpx = 0.5 * (g->tw < g->th ? g->tw : g->th) / g->tan_half;
-        double bx = g->nx > 1 ? (g->bounds[1] - g->bounds[0]) / (g->nx - 1) : 0;
-        double by = g->ny > 1 ? (g->bounds[3] - g->bounds[2]) / (g->ny - 1) : 0;
-        g->a = 0;
-        g->b = fpx * (bx > 0 ? bx : by);
-        return LF_OK;
-    }
-    if (!strcmp(k->s, "plenoptic")) {
-        double sensor[2], off[2], count[2], rot = 0;
-        const lf_attr *grid = lf_attrs_get(meta, LF_KEY_GRID);
-        if (!get_num(meta, LF_KEY_MICROLENS_PITCH_PX, &g->pitch_px) ||
-            !get_vec(meta, LF_KEY_MICROLENS_OFFSET_PX, 2, off) ||
-            !get_vec(meta, LF_KEY_MICROLENS_COUNT, 2, count) ||
-            !get_vec(meta, LF_KEY_SENSOR_SIZE_MM, 2, sensor) ||
-            !get_num(meta, LF_KEY_MICROLENS_FOCAL_MM, &g->fmla_mm) ||
-            !get_num(meta, LF_KEY_MLA_DISTANCE_MM, &g->zi_mm) ||
-            !get_num(meta, LF_KEY_MAIN_FOCAL_MM, &g->f_mm))
-            return lf_error_set(err, LF_ERR_PARAM,
-                                "disparity AOV: the plenoptic camera's attributes are incomplete (microlens pitch, "
-                                "offset, count and focal length, sensor size, main lens)");
-        get_num(meta, LF_KEY_MICROLENS_ROTATION_RAD, &rot);
-        get_num(meta, LF_KEY_SENSOR_OFFSET_MM, &g->sensor_offset_mm);
-        g->kind = LF_LIGHTFIELD_PLENOPTIC_KIND;
-        g->hex = grid && grid->type == LF_ATTR_STRING && !strcmp(grid->s, "hex");
-        g->cos_r = cos(rot), g->sin_r = sin(rot);
-        g->origin[0] = off[0], g->origin[1] = off[1];
-        g->lx = (int)count[0], g->ly = (int)count[1];
-        g->row_px = g->pitch_px * (g->hex ? sqrt(3.0) / 2 : 1.0);
-        double d = g->fmla_mm + g->sensor_offset_mm, zi = g->zi_mm;
-        double pixel = sensor[0] / xres; /* mm */
-        if (!(g->pitch_px > 0) || !(d > 0) || !(zi > 0) || !(g->f_mm > 0) || !(pixel > 0) || g->lx < 1 || g->ly < 1)
-            return lf_error_set(err, LF_ERR_PARAM, "disparity AOV: bad plenoptic attributes");
-        g->slope_per_px = pixel / (zi + d);
-        double kk = (zi + d) / (d * g->pitch_px);
-        g->a = kk * (1 - zi / g->f_mm);
-        g->b = kk * zi * 1e-3; /* Z in metres (camera space) */
-        return LF_OK;
-    }
+    if (la.kind_id == LF_LIGHTFIELD_CAMERA_ARRAY)
+        return camera_array_geom(&la, g, err);
+    if (la.kind_id == LF_LIGHTFIELD_PLENOPTIC)
+        return plenoptic_geom(&la, xres, g, err);
     return lf_error_set(err, LF_ERR_PARAM, "the disparity AOV needs a camera array or a plenoptic camera, not \"%s\"",
-                        k->s);
+                        la.kind.s);
 }
 
 static double grid_position(double lo, double hi, int k, int n)
@@ -134,7 +129,7 @@ static double grid_position(double lo, double hi, int k, int n)
 
 void lf_disparity_centre_ray(const lf_disparity_geom *g, double fx, double fy, double o[3], double d[3])
 {
-    if (g->kind == LF_LIGHTFIELD_CAMERA_ARRAY_KIND) {
+    if (g->kind == LF_LIGHTFIELD_CAMERA_ARRAY) {
         int i = (int)floor(fx / g->tw), j = (int)floor(fy / g->th);
         i = i < 0 ? 0 : i >= g->nx ? g->nx - 1 : i;
         j = j < 0 ? 0 : j >= g->ny ? g->ny - 1 : j;

@@ -128,50 +128,12 @@ void lf_lightfield_fft2d(float *a, int w, int h, int sign)
         lf_lightfield_fft1d(a + 2 * (size_t)x, h, w, sign);
 }
 
-int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refocus_opts *ap, double oversample, lf_lightfield_fourier **out,
-                      lf_error *err)
+/* The synthetic aperture's weight of each view, divided by the Kaiser-Bessel
+ * window's transform at the view's integer offset (iu - ou, iv - ov) (the
+ * gridding's deapodisation); f->wsum the weights' sum. */
+static void aperture_weights(lf_lightfield_fourier *f, const lf_lightfield *lf, const lf_lightfield_refocus_opts *ap,
+                             int ou, int ov, double *au)
 {
-    *out = NULL;
-    if (lf->valid)
-        return lf_error_set(err, LF_ERR_UNSUPPORTED,
-                            "Fourier slice refocusing needs a light field without missing samples (%zu missing)",
-                            lf->missing);
-    if (!(oversample >= 1))
-        oversample = 2;
-    lf_lightfield_refocus_opts def = lf_lightfield_refocus_defaults();
-    if (!ap)
-        ap = &def;
-    lf_lightfield_fourier *f = calloc(1, sizeof *f);
-    if (!f)
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-    f->ns = lf->ns, f->nt = lf->nt, f->nu = lf->nu, f->nv = lf->nv;
-    f->Ps = next_pow2(lf->ns), f->Pt = next_pow2(lf->nt);
-    f->Pu = (int)ceil(oversample * lf->nu), f->Pv = (int)ceil(oversample * lf->nv);
-    f->disp_v_per_u = lf->disp_v_per_u;
-    double sigma = oversample;
-    double b2 = (KB_WIDTH / sigma) * (KB_WIDTH / sigma) * (sigma - 0.5) * (sigma - 0.5) - 0.8;
-    f->beta = M_PI * sqrt(b2 > 0.1 ? b2 : 0.1);
-    for (int i = 0; i <= KB_TABLE; i++)
-        f->kb_tab[i] = (float)kb_exact(i * (KB_WIDTH / 2.0) / KB_TABLE, f->beta);
-    int hs = f->Ps / 2 + 1;
-    size_t nfreq = (size_t)hs * f->Pt, cell = (size_t)f->Pu * f->Pv * 3;
-    int nviews = lf->nu * lf->nv;
-    float *Lhat = malloc(sizeof(float) * 2 * nfreq * 3 * (size_t)nviews);
-    float *buf = malloc(sizeof(float) * 2 * (size_t)f->Ps * f->Pt);
-    f->S = malloc(sizeof(float) * 2 * nfreq * cell);
-    if (!Lhat || !buf || !f->S) {
-        free(Lhat), free(buf), lf_lightfield_fourier_release(f);
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the 4D spectrum (%.0f MB)",
-                            sizeof(float) * 2.0 * nfreq * cell / 1e6);
-    }
-    /* integer view offsets u_i (centred, rounded down) and their weights a_u */
-    int ou = lf->nu / 2, ov = lf->nv / 2;
-    f->cu = (lf->nu - 1) / 2.0 - ou, f->cv = (lf->nv - 1) / 2.0 - ov; /* u_c = u_i - cu... see slice */
-    double *au = malloc(sizeof(double) * (size_t)nviews);
-    if (!au) {
-        free(Lhat), free(buf), lf_lightfield_fourier_release(f);
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-    }
     f->wsum = 0;
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
@@ -189,12 +151,14 @@ int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refoc
             f->wsum += w;
             au[iv * lf->nu + iu] = w / (kb_hat((double)(iu - ou) / f->Pu, f->beta) * kb_hat((double)(iv - ov) / f->Pv, f->beta));
         }
-    if (f->wsum == 0) {
-        free(au), free(Lhat), free(buf), lf_lightfield_fourier_release(f);
-        return lf_error_set(err, LF_ERR_PARAM, "the synthetic aperture selects no view");
-    }
-    /* per-view 2D FFTs, half spectrum kept */
-    for (int vi = 0; vi < nviews; vi++) {
+}
+
+/* Per view and channel the 2D FFT over (s, t), zero-padded to Ps x Pt, half
+ * spectrum (hs columns) kept in Lhat; buf: Ps * Pt complex scratch. */
+static void view_spectra(const lf_lightfield_fourier *f, const lf_lightfield *lf, float *buf, float *Lhat, size_t nfreq,
+                         int hs)
+{
+    for (int vi = 0; vi < lf->nu * lf->nv; vi++) {
         const float *view = lf->data + (size_t)vi * lf->ns * lf->nt * 3;
         for (int ch = 0; ch < 3; ch++) {
             memset(buf, 0, sizeof(float) * 2 * (size_t)f->Ps * f->Pt);
@@ -207,11 +171,17 @@ int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refoc
                 memcpy(dst + 2 * (size_t)kt * hs, buf + 2 * (size_t)kt * f->Ps, sizeof(float) * 2 * hs);
         }
     }
-    /* DFT over (u, v) per frequency, separable */
+}
+
+/* The weighted DFT over (u, v) of every (s, t) frequency into f->S,
+ * separable: u first into tmp, then v. */
+static int angular_dft(lf_lightfield_fourier *f, const lf_lightfield *lf, const double *au, const float *Lhat,
+                       size_t nfreq, size_t cell, int ou, int ov, lf_error *err)
+{
     double *tw_u = malloc(sizeof(double) * 2 * f->Pu * lf->nu), *tw_v = malloc(sizeof(double) * 2 * f->Pv * lf->nv);
     double *tmp = malloc(sizeof(double) * 2 * f->Pu * lf->nv);
     if (!tw_u || !tw_v || !tmp) {
-        free(tw_u), free(tw_v), free(tmp), free(au), free(Lhat), free(buf), lf_lightfield_fourier_release(f);
+        free(tw_u), free(tw_v), free(tmp);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     for (int m = 0; m < f->Pu; m++)
@@ -251,9 +221,69 @@ int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refoc
                     d[0] = (float)re, d[1] = (float)im;
                 }
         }
-    free(tw_u), free(tw_v), free(tmp), free(au), free(Lhat), free(buf);
-    *out = f;
+    free(tw_u), free(tw_v), free(tmp);
     return LF_OK;
+}
+
+int lf_lightfield_fourier_new(const lf_lightfield *lf, const lf_lightfield_refocus_opts *ap, double oversample, lf_lightfield_fourier **out,
+                      lf_error *err)
+{
+    *out = NULL;
+    if (lf->valid)
+        return lf_error_set(err, LF_ERR_UNSUPPORTED,
+                            "Fourier slice refocusing needs a light field without missing samples (%zu missing)",
+                            lf->missing);
+    if (!(oversample >= 1))
+        oversample = 2;
+    lf_lightfield_refocus_opts def = lf_lightfield_refocus_defaults();
+    if (!ap)
+        ap = &def;
+    lf_lightfield_fourier *f = calloc(1, sizeof *f);
+    if (!f)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    f->ns = lf->ns, f->nt = lf->nt, f->nu = lf->nu, f->nv = lf->nv;
+    f->Ps = next_pow2(lf->ns), f->Pt = next_pow2(lf->nt);
+    f->Pu = (int)ceil(oversample * lf->nu), f->Pv = (int)ceil(oversample * lf->nv);
+    f->disp_v_per_u = lf->disp_v_per_u;
+    double sigma = oversample;
+    double b2 = (KB_WIDTH / sigma) * (KB_WIDTH / sigma) * (sigma - 0.5) * (sigma - 0.5) - 0.8;
+    f->beta = M_PI * sqrt(b2 > 0.1 ? b2 : 0.1);
+    for (int i = 0; i <= KB_TABLE; i++)
+        f->kb_tab[i] = (float)kb_exact(i * (KB_WIDTH / 2.0) / KB_TABLE, f->beta);
+    int hs = f->Ps / 2 + 1;
+    size_t nfreq = (size_t)hs * f->Pt, cell = (size_t)f->Pu * f->Pv * 3;
+    int nviews = lf->nu * lf->nv;
+    float *Lhat = malloc(sizeof(float) * 2 * nfreq * 3 * (size_t)nviews);
+    float *buf = malloc(sizeof(float) * 2 * (size_t)f->Ps * f->Pt);
+    f->S = malloc(sizeof(float) * 2 * nfreq * cell);
+    double *au = NULL;
+    int rc = LF_OK;
+    if (!Lhat || !buf || !f->S) {
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the 4D spectrum (%.0f MB)",
+                          sizeof(float) * 2.0 * nfreq * cell / 1e6);
+        goto done;
+    }
+    /* integer view offsets u_i (centred, rounded down) and their weights a_u */
+    int ou = lf->nu / 2, ov = lf->nv / 2;
+    f->cu = (lf->nu - 1) / 2.0 - ou, f->cv = (lf->nv - 1) / 2.0 - ov; /* u_c = u_i - cu... see slice */
+    if (!(au = malloc(sizeof(double) * (size_t)nviews))) {
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    aperture_weights(f, lf, ap, ou, ov, au);
+    if (f->wsum == 0) {
+        rc = lf_error_set(err, LF_ERR_PARAM, "the synthetic aperture selects no view");
+        goto done;
+    }
+    view_spectra(f, lf, buf, Lhat, nfreq, hs);
+    rc = angular_dft(f, lf, au, Lhat, nfreq, cell, ou, ov, err);
+done:
+    free(au), free(Lhat), free(buf);
+    if (rc)
+        lf_lightfield_fourier_release(f);
+    else
+        *out = f;
+    return rc;
 }
 
 static int wrap(int j, int n)

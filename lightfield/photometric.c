@@ -161,6 +161,211 @@ static double ratio_spread(const double *cm, const double *vm, size_t ncell, dou
     return tmp[n / 2];
 }
 
+/* What the per-view stages share: the cell grid, its buffers and the
+ * centre view's integral image. */
+typedef struct eq_work {
+    int ns, nt, nc;
+    size_t ncell;
+    double *cm, *vm; /* per cell: r g b sums and the valid count; centre view, this view */
+    double *cx, *cy; /* per cell: the view window's centre in [-1, 1] */
+    double *ly, *tmp;
+    int *use;
+    double *ir, *iv; /* integral images of the centre view and of this view */
+} eq_work;
+
+/* One view's gain against the centre: its parallax shift, dark cells and
+ * fitted log-gain fields, and how far the fields stray from 1. */
+typedef struct view_fit {
+    int bsx, bsy;
+    int dark[CELLS * CELLS], ndark, ncells;
+    double par[3][NPAR];
+    int fitted;
+    double dev, devsum, glo, ghi, gsum;
+    int ngain;
+} view_fit;
+
+/* The parallax first: the whole-pixel shift of one disparity d,
+ * (-d du, -d dv), that makes the cells' brightness ratios most alike, d
+ * searched so the shift moves a pixel at a time, up to an eighth of the
+ * view; leaves w's cell sums at that shift. */
+static void parallax_shift(eq_work *w, double du, double dv, view_fit *f)
+{
+    double m = fmax(fabs(du), fabs(dv));
+    int K = (w->ns < w->nt ? w->ns : w->nt) / 8, bsx = 0, bsy = 0;
+    double best = HUGE_VAL;
+    for (int q = 0; q <= 2 * K; q++) {
+        int kk = (q + 1) / 2 * (q % 2 ? 1 : -1); /* 0, 1, -1, 2, -2, ...: ties keep the smaller shift */
+        double d = kk / m;
+        int sx = (int)lround(-d * du), sy = (int)lround(-d * dv);
+        cell_sums(w->ir, w->iv, w->ns, w->nt, w->nc, sx, sy, w->cm, w->vm, w->cx, w->cy);
+        double sp = ratio_spread(w->cm, w->vm, w->ncell, w->tmp);
+        if (sp < best)
+            best = sp, bsx = sx, bsy = sy;
+    }
+    cell_sums(w->ir, w->iv, w->ns, w->nt, w->nc, bsx, bsy, w->cm, w->vm, w->cx, w->cy);
+    f->bsx = bsx, f->bsy = bsy;
+}
+
+/* Dark cells: the view keeps under a tenth of the centre's brightness.  A
+ * few dark cells are the scene (a bright thing in the centre view, a dark
+ * one where parallax puts the view's cell): they stay, and the robust fit
+ * leaves them out; vignetting darkens a quarter of the view or more. */
+static void find_dark_cells(const eq_work *w, view_fit *f)
+{
+    const double *cm = w->cm, *vm = w->vm;
+    f->ndark = 0, f->ncells = 0;
+    for (size_t c = 0; c < w->ncell; c++) {
+        double rl = cm[4 * c] + cm[4 * c + 1] + cm[4 * c + 2], vl = vm[4 * c] + vm[4 * c + 1] + vm[4 * c + 2];
+        f->dark[c] = cm[4 * c + 3] > 0 && rl > 0 && (vm[4 * c + 3] == 0 || vl / vm[4 * c + 3] < DARK_RATIO * rl / cm[4 * c + 3]);
+        f->ndark += f->dark[c];
+        f->ncells += cm[4 * c + 3] > 0;
+    }
+    if (f->ndark < f->ncells / 4)
+        f->ndark = 0, memset(f->dark, 0, sizeof f->dark);
+}
+
+/* Per channel the log-gain field, fitted robustly to the cells' log
+ * ratios; f->fitted = 0 when a channel has too few usable cells or no fit. */
+static void fit_gain_fields(eq_work *w, view_fit *f)
+{
+    const double *cm = w->cm, *vm = w->vm;
+    f->fitted = 1;
+    for (int ch = 0; ch < 3 && f->fitted; ch++) {
+        int nuse = 0;
+        for (size_t c = 0; c < w->ncell; c++) {
+            /* a ratio of cell means needs both means well above the data's noise floor */
+            w->use[c] = !f->dark[c] && cm[4 * c + 3] >= 16 && vm[4 * c + 3] >= 16 &&
+                        cm[4 * c + ch] > 1e-3 * cm[4 * c + 3] && vm[4 * c + ch] > 1e-3 * vm[4 * c + 3];
+            w->ly[c] = w->use[c] ? log((vm[4 * c + ch] / vm[4 * c + 3]) / (cm[4 * c + ch] / cm[4 * c + 3])) : 0;
+            nuse += w->use[c];
+        }
+        if (nuse < NPAR * 2 || fit_field(w->cx, w->cy, w->ly, w->use, (int)w->ncell, f->par[ch]))
+            f->fitted = 0;
+    }
+}
+
+/* The fields' largest and mean deviation from 1 over the cells that are
+ * not dark, and the range and sum of the luminance gain there. */
+static void gain_deviation(const eq_work *w, view_fit *f)
+{
+    f->dev = 0, f->devsum = 0, f->glo = INFINITY, f->ghi = 0, f->gsum = 0, f->ngain = 0;
+    if (!f->fitted)
+        return;
+    for (size_t c = 0; c < w->ncell; c++) {
+        if (f->dark[c])
+            continue;
+        double b[NPAR], lum = 0;
+        basis(w->cx[c], w->cy[c], b);
+        for (int ch = 0; ch < 3; ch++) {
+            double e = 0;
+            for (int j = 0; j < NPAR; j++)
+                e += f->par[ch][j] * b[j];
+            double g = exp(e);
+            f->dev = fmax(f->dev, fabs(g - 1)), f->devsum += fabs(g - 1) / 3;
+            lum += g / 3;
+        }
+        f->glo = fmin(f->glo, lum), f->ghi = fmax(f->ghi, lum);
+        f->gsum += lum, f->ngain++;
+    }
+}
+
+/* Sample p of a view marked missing (counted once) and zeroed. */
+static void mark_missing(lf_lightfield *lf, float *view, float *valid, size_t p)
+{
+    if (valid[p] != 0.f)
+        lf->missing++;
+    valid[p] = 0.f;
+    view[p * 3] = view[p * 3 + 1] = view[p * 3 + 2] = 0.f;
+}
+
+/* The view's pixels in dark cells (of the centre cell each shows, through
+ * the parallax shift) marked missing; the rest divided by the gain fields
+ * when rescale. */
+static void correct_view(lf_lightfield *lf, float *view, float *valid, const eq_work *w, const view_fit *f,
+                         int rescale)
+{
+    int ns = w->ns, nt = w->nt, nc = w->nc;
+    for (int y = 0; y < nt; y++) {
+        double yy = (y + 0.5) / nt * 2 - 1;
+        int yc = y - f->bsy < 0 ? 0 : (y - f->bsy >= nt ? nt - 1 : y - f->bsy), cj = yc * nc / nt;
+        for (int x = 0; x < ns; x++) {
+            size_t p = (size_t)y * ns + x;
+            int xc = x - f->bsx < 0 ? 0 : (x - f->bsx >= ns ? ns - 1 : x - f->bsx); /* the centre's cell it shows */
+            if (f->ndark && f->dark[(size_t)cj * nc + (size_t)(xc * nc / ns)]) {
+                mark_missing(lf, view, valid, p);
+                continue;
+            }
+            if (!rescale)
+                continue;
+            double xx = (x + 0.5) / ns * 2 - 1, b[NPAR];
+            basis(xx, yy, b);
+            for (int ch = 0; ch < 3; ch++) {
+                double e = 0;
+                for (int j = 0; j < NPAR; j++)
+                    e += f->par[ch][j] * b[j];
+                view[p * 3 + ch] = (float)(view[p * 3 + ch] / exp(e));
+            }
+        }
+    }
+}
+
+/* The rescaled view's mean gain and the light field's gain range. */
+static int record_gain(lf_lightfield *lf, int k, const view_fit *f, lf_error *err)
+{
+    if (!lf->view_gain) {
+        if (!(lf->view_gain = malloc(sizeof(float) * (size_t)lf->nu * lf->nv)))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
+        for (int i = 0; i < lf->nu * lf->nv; i++)
+            lf->view_gain[i] = 1.f;
+    }
+    lf->view_gain[k] = (float)(f->gsum / f->ngain);
+    if (lf->views_rescaled == 0)
+        lf->gain_lo = (float)f->glo, lf->gain_hi = (float)f->ghi;
+    else
+        lf->gain_lo = fminf(lf->gain_lo, (float)f->glo), lf->gain_hi = fmaxf(lf->gain_hi, (float)f->ghi);
+    lf->views_rescaled++;
+    return LF_OK;
+}
+
+/* View k (not the centre) against the centre view: fitted, then left
+ * alone, rescaled, or marked missing in its dark cells or whole. */
+static int equalize_view(lf_lightfield *lf, eq_work *w, int k, lf_error *err)
+{
+    size_t np = (size_t)w->ns * w->nt;
+    int iu = k % lf->nu, iv = k / lf->nu, iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    float *view = lf_lightfield_view(lf, iu, iv);
+    integral(view, lf->valid ? lf->valid + (size_t)k * np : NULL, w->ns, w->nt, w->iv);
+    view_fit f;
+    parallax_shift(w, iu - iu0, (iv - iv0) * rv, &f);
+    find_dark_cells(w, &f);
+    fit_gain_fields(w, &f);
+    if (!f.fitted && f.ndark == 0)
+        return LF_OK; /* too little texture to say anything: leave the view */
+    if (!f.fitted && f.ndark < f.ncells / 2)
+        return LF_OK;
+    gain_deviation(w, &f);
+    int whole_dark = !f.fitted || f.ndark == f.ncells;
+    int rescale = f.ngain > 0 && (f.devsum / f.ngain > APPLY_MEAN || f.dev > APPLY_MAX);
+    if (!whole_dark && !rescale && f.ndark == 0)
+        return LF_OK;
+    if ((f.ndark || whole_dark) && !lf->valid) {
+        if (!(lf->valid = malloc(sizeof(float) * np * (size_t)lf->nu * lf->nv)))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
+        for (size_t i = 0; i < np * (size_t)lf->nu * lf->nv; i++)
+            lf->valid[i] = 1.f;
+    }
+    float *valid = lf->valid ? lf->valid + (size_t)k * np : NULL;
+    if (whole_dark) {
+        for (size_t p = 0; p < np; p++)
+            mark_missing(lf, view, valid, p);
+        lf->views_dark++;
+        return LF_OK;
+    }
+    correct_view(lf, view, valid, w, &f, rescale);
+    return rescale ? record_gain(lf, k, &f, err) : LF_OK;
+}
+
 int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err)
 {
     lf->views_rescaled = lf->views_dark = 0;
@@ -183,153 +388,18 @@ int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err)
         free(means), free(cx), free(use), free(ir), free(iv_);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
     }
-    double *cy = cx + ncell, *ly = cy + ncell, *tmp = ly + ncell;
-    double *cm = means, *vm = means + 4 * ncell; /* per cell: r g b sums and the valid count */
-    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    eq_work w = {
+        .ns = ns, .nt = nt, .nc = nc, .ncell = ncell,
+        .cm = means, .vm = means + 4 * ncell,
+        .cx = cx, .cy = cx + ncell, .ly = cx + 2 * ncell, .tmp = cx + 3 * ncell,
+        .use = use, .ir = ir, .iv = iv_,
+    };
     const float *refv = lf->valid ? lf->valid + ((size_t)iv0 * lf->nu + iu0) * np : NULL;
     integral(lf_lightfield_view(lf, iu0, iv0), refv, ns, nt, ir);
     int rc = LF_OK;
-    for (int k = 0; k < lf->nu * lf->nv && !rc; k++) {
-        int iu = k % lf->nu, iv = k / lf->nu;
-        if (iu == iu0 && iv == iv0)
-            continue;
-        float *view = lf_lightfield_view(lf, iu, iv);
-        integral(view, lf->valid ? lf->valid + (size_t)k * np : NULL, ns, nt, iv_);
-        /* the parallax first: the whole-pixel shift of one disparity d,
-         * (-d du, -d dv), that makes the cells' brightness ratios most alike,
-         * d searched so the shift moves a pixel at a time, up to an eighth of
-         * the view */
-        double du = iu - iu0, dv = (iv - iv0) * rv, m = fmax(fabs(du), fabs(dv));
-        int K = (ns < nt ? ns : nt) / 8, bsx = 0, bsy = 0;
-        double best = HUGE_VAL;
-        for (int q = 0; q <= 2 * K; q++) {
-            int kk = (q + 1) / 2 * (q % 2 ? 1 : -1); /* 0, 1, -1, 2, -2, ...: ties keep the smaller shift */
-            double d = kk / m;
-            int sx = (int)lround(-d * du), sy = (int)lround(-d * dv);
-            cell_sums(ir, iv_, ns, nt, nc, sx, sy, cm, vm, cx, cy);
-            double sp = ratio_spread(cm, vm, ncell, tmp);
-            if (sp < best)
-                best = sp, bsx = sx, bsy = sy;
-        }
-        cell_sums(ir, iv_, ns, nt, nc, bsx, bsy, cm, vm, cx, cy);
-        /* dark cells: the view keeps under a tenth of the centre's brightness */
-        int dark[CELLS * CELLS], ndark = 0, nuse = 0, ncells = 0;
-        for (size_t c = 0; c < ncell; c++) {
-            double rl = cm[4 * c] + cm[4 * c + 1] + cm[4 * c + 2], vl = vm[4 * c] + vm[4 * c + 1] + vm[4 * c + 2];
-            dark[c] = cm[4 * c + 3] > 0 && rl > 0 && (vm[4 * c + 3] == 0 || vl / vm[4 * c + 3] < DARK_RATIO * rl / cm[4 * c + 3]);
-            ndark += dark[c];
-            ncells += cm[4 * c + 3] > 0;
-        }
-        /* a few dark cells are the scene (a bright thing in the centre view,
-         * a dark one where parallax puts the view's cell): they stay, and the
-         * robust fit leaves them out; vignetting darkens a quarter of the
-         * view or more */
-        if (ndark < ncells / 4)
-            ndark = 0, memset(dark, 0, sizeof dark);
-        double par[3][NPAR];
-        int fitted = 1;
-        for (int ch = 0; ch < 3 && fitted; ch++) {
-            nuse = 0;
-            for (size_t c = 0; c < ncell; c++) {
-                /* a ratio of cell means needs both means well above the data's noise floor */
-                use[c] = !dark[c] && cm[4 * c + 3] >= 16 && vm[4 * c + 3] >= 16 &&
-                         cm[4 * c + ch] > 1e-3 * cm[4 * c + 3] && vm[4 * c + ch] > 1e-3 * vm[4 * c + 3];
-                ly[c] = use[c] ? log((vm[4 * c + ch] / vm[4 * c + 3]) / (cm[4 * c + ch] / cm[4 * c + 3])) : 0;
-                nuse += use[c];
-            }
-            if (nuse < NPAR * 2 || fit_field(cx, cy, ly, use, (int)ncell, par[ch]))
-                fitted = 0;
-        }
-        if (!fitted && ndark == 0)
-            continue; /* too little texture to say anything: leave the view */
-        if (!fitted && ndark < ncells / 2)
-            continue;
-        /* the field's largest deviation from 1 over the cells that are not dark */
-        double dev = 0, devsum = 0, glo = INFINITY, ghi = 0, gsum = 0;
-        int ngain = 0;
-        if (fitted)
-            for (size_t c = 0; c < ncell; c++) {
-                if (dark[c])
-                    continue;
-                double b[NPAR], lum = 0;
-                basis(cx[c], cy[c], b);
-                for (int ch = 0; ch < 3; ch++) {
-                    double e = 0;
-                    for (int j = 0; j < NPAR; j++)
-                        e += par[ch][j] * b[j];
-                    double g = exp(e);
-                    dev = fmax(dev, fabs(g - 1)), devsum += fabs(g - 1) / 3;
-                    lum += g / 3;
-                }
-                glo = fmin(glo, lum), ghi = fmax(ghi, lum);
-                gsum += lum, ngain++;
-            }
-        int whole_dark = !fitted || ndark == ncells;
-        int rescale = ngain > 0 && (devsum / ngain > APPLY_MEAN || dev > APPLY_MAX);
-        if (!whole_dark && !rescale && ndark == 0)
-            continue;
-        if ((ndark || whole_dark) && !lf->valid) {
-            if (!(lf->valid = malloc(sizeof(float) * np * (size_t)lf->nu * lf->nv))) {
-                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
-                break;
-            }
-            for (size_t i = 0; i < np * (size_t)lf->nu * lf->nv; i++)
-                lf->valid[i] = 1.f;
-            refv = lf->valid + ((size_t)iv0 * lf->nu + iu0) * np;
-        }
-        float *valid = lf->valid ? lf->valid + (size_t)k * np : NULL;
-        if (whole_dark) {
-            for (size_t p = 0; p < np; p++) {
-                if (valid[p] != 0.f)
-                    lf->missing++;
-                valid[p] = 0.f;
-                view[p * 3] = view[p * 3 + 1] = view[p * 3 + 2] = 0.f;
-            }
-            lf->views_dark++;
-            continue;
-        }
-        for (int y = 0; y < nt; y++) {
-            double yy = (y + 0.5) / nt * 2 - 1;
-            int yc = y - bsy < 0 ? 0 : (y - bsy >= nt ? nt - 1 : y - bsy), cj = yc * nc / nt;
-            for (int x = 0; x < ns; x++) {
-                size_t p = (size_t)y * ns + x;
-                int xc = x - bsx < 0 ? 0 : (x - bsx >= ns ? ns - 1 : x - bsx); /* the centre's cell it shows */
-                if (ndark && dark[(size_t)cj * nc + (size_t)(xc * nc / ns)]) {
-                    if (valid[p] != 0.f)
-                        lf->missing++;
-                    valid[p] = 0.f;
-                    view[p * 3] = view[p * 3 + 1] = view[p * 3 + 2] = 0.f;
-                    continue;
-                }
-                if (!rescale)
-                    continue;
-                double xx = (x + 0.5) / ns * 2 - 1, b[NPAR];
-                basis(xx, yy, b);
-                for (int ch = 0; ch < 3; ch++) {
-                    double e = 0;
-                    for (int j = 0; j < NPAR; j++)
-                        e += par[ch][j] * b[j];
-                    view[p * 3 + ch] = (float)(view[p * 3 + ch] / exp(e));
-                }
-            }
-        }
-        if (!rescale)
-            continue;
-        if (!lf->view_gain) {
-            if (!(lf->view_gain = malloc(sizeof(float) * (size_t)lf->nu * lf->nv))) {
-                rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
-                break;
-            }
-            for (int i = 0; i < lf->nu * lf->nv; i++)
-                lf->view_gain[i] = 1.f;
-        }
-        lf->view_gain[k] = (float)(gsum / ngain);
-        if (lf->views_rescaled == 0)
-            lf->gain_lo = (float)glo, lf->gain_hi = (float)ghi;
-        else
-            lf->gain_lo = fminf(lf->gain_lo, (float)glo), lf->gain_hi = fmaxf(lf->gain_hi, (float)ghi);
-        lf->views_rescaled++;
-    }
+    for (int k = 0; k < lf->nu * lf->nv && !rc; k++)
+        if (k != iv0 * lf->nu + iu0)
+            rc = equalize_view(lf, &w, k, err);
     free(means), free(cx), free(use), free(ir), free(iv_);
     return rc;
 }

@@ -494,8 +494,7 @@ static void synth_rows(void *arg, int y0, int y1, int tid)
     }
 }
 
-int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts *o, lf_image *out, lf_image *coverage,
-                size_t *uncovered, lf_error *err)
+static int check_synth_inputs(const lf_lightfield *lf, const lf_lightfield_synth_opts *o, lf_error *err)
 {
     const lf_lightfield_layout *l = &lf->layout;
     if (l->kind != LF_LIGHTFIELD_CAMERA_ARRAY)
@@ -509,6 +508,93 @@ int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts 
                             o->height, o->fov_deg, l->fov_deg);
     if (o->lens_radius < 0 || (o->lens_radius > 0 && !(o->focal_distance > 0)))
         return lf_error_set(err, LF_ERR_PARAM, "synth: a lens radius needs a focal distance > 0");
+    return LF_OK;
+}
+
+/* The virtual camera's rotation R = Rz Ry Rx from its Euler angles (degrees). */
+static void camera_rotation(const double rot_deg[3], double R[9])
+{
+    double ax = rot_deg[0] * M_PI / 180, ay = rot_deg[1] * M_PI / 180, az = rot_deg[2] * M_PI / 180;
+    double Rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
+    double Ry[9] = {cos(ay), 0, sin(ay), 0, 1, 0, -sin(ay), 0, cos(ay)};
+    double Rz[9] = {cos(az), -sin(az), 0, sin(az), cos(az), 0, 0, 0, 1};
+    double T[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            T[i * 3 + j] = 0;
+            for (int k = 0; k < 3; k++)
+                T[i * 3 + j] += Ry[i * 3 + k] * Rx[k * 3 + j];
+        }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            R[i * 3 + j] = 0;
+            for (int k = 0; k < 3; k++)
+                R[i * 3 + j] += Rz[i * 3 + k] * T[k * 3 + j];
+        }
+}
+
+/* The data cameras' projection and grid (spacing, top-left camera). */
+static void setup_camera_grid(synth_ctx *c, const lf_lightfield *lf, const lf_lightfield_synth_opts *o)
+{
+    const lf_lightfield_layout *l = &lf->layout;
+    c->in_tan = tan(l->fov_deg * M_PI / 360), c->in_half = 0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt);
+    c->in_scale = c->in_half / c->in_tan;
+    c->out_tan = tan(o->fov_deg * M_PI / 360), c->out_half = 0.5 * (o->width < o->height ? o->width : o->height);
+    c->minx = l->grid_bounds[0], c->maxy = l->grid_bounds[3];
+    c->bx = lf->nu > 1 ? (l->grid_bounds[1] - l->grid_bounds[0]) / (lf->nu - 1) : 1;
+    c->by = lf->nv > 1 ? (l->grid_bounds[3] - l->grid_bounds[2]) / (lf->nv - 1) : 1;
+    c->inv_bx = 1 / c->bx, c->inv_by = 1 / c->by;
+    if (lf->nu == 1)
+        c->minx = 0.5 * (l->grid_bounds[0] + l->grid_bounds[1]);
+    if (lf->nv == 1)
+        c->maxy = 0.5 * (l->grid_bounds[2] + l->grid_bounds[3]);
+}
+
+/* Film and lens positions to grid-relative space (synth_ctx). */
+static void setup_film(synth_ctx *c, const lf_lightfield *lf, const lf_lightfield_synth_opts *o)
+{
+    const double k = c->out_tan / c->out_half, fd = o->focal_distance > 0 ? o->focal_distance : 1;
+    const double origin[3] = {c->minx, c->maxy, 0}, flip[3] = {1, -1, 1};
+    for (int a = 0; a < 3; a++) {
+        const double r0 = flip[a] * c->R[a * 3], r1 = flip[a] * c->R[a * 3 + 1], r2 = flip[a] * c->R[a * 3 + 2];
+        c->pos[a] = flip[a] * (o->pos[a] - origin[a]);
+        c->F0[a] = fd * (r2 - o->width * 0.5 * k * r0 + o->height * 0.5 * k * r1) + (o->focal_distance > 0 ? c->pos[a] : 0);
+        c->FX[a] = fd * k * r0, c->FY[a] = -fd * k * r1;
+        c->fFX[a] = (float)c->FX[a], c->fFY[a] = (float)c->FY[a], c->fpos[a] = (float)c->pos[a];
+        c->fLX[a] = (float)(o->lens_radius * r0), c->fLY[a] = (float)(o->lens_radius * r1);
+    }
+    c->fns = (float)lf->ns, c->fnt = (float)lf->nt, c->fbx = (float)c->bx, c->fby = (float)c->by;
+}
+
+/* The reference view's disparity map (synth --geometry depth): its range
+ * and the reference camera's grid position. */
+static int setup_disparity(synth_ctx *c, const lf_lightfield *lf, const lf_image *dm, lf_error *err)
+{
+    if (dm->width != lf->ns || dm->height != lf->nt || dm->channels != 1 || !dm->data)
+        return lf_error_set(err, LF_ERR_PARAM, "synth: the disparity map must be 1 channel, %dx%d like the views", lf->ns,
+                            lf->nt);
+    c->disp = dm->data;
+    c->dmin = FLT_MAX, c->dmax = -FLT_MAX;
+    for (size_t i = 0; i < (size_t)lf->ns * lf->nt; i++) {
+        if (!isfinite(dm->data[i]))
+            return lf_error_set(err, LF_ERR_NUMERIC, "synth: non-finite value in the disparity map");
+        c->dmin = fminf(c->dmin, dm->data[i]), c->dmax = fmaxf(c->dmax, dm->data[i]);
+    }
+    c->ref_x = ((lf->nu - 1) / 2) * c->bx, c->ref_y = ((lf->nv - 1) / 2) * c->by;
+    if (lf->nu == 1)
+        c->ref_x = 0;
+    if (lf->nv == 1)
+        c->ref_y = 0;
+    return LF_OK;
+}
+
+int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts *o, lf_image *out, lf_image *coverage,
+                size_t *uncovered, lf_error *err)
+{
+    const lf_lightfield_layout *l = &lf->layout;
+    int rc = check_synth_inputs(lf, o, err);
+    if (rc)
+        return rc;
     synth_ctx c;
     memset(&c, 0, sizeof c);
     c.lf = lf, c.o = o;
@@ -528,34 +614,8 @@ int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts 
             c.o = o = &centred;
         }
     }
-    double ax = o->rot_deg[0] * M_PI / 180, ay = o->rot_deg[1] * M_PI / 180, az = o->rot_deg[2] * M_PI / 180;
-    double Rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
-    double Ry[9] = {cos(ay), 0, sin(ay), 0, 1, 0, -sin(ay), 0, cos(ay)};
-    double Rz[9] = {cos(az), -sin(az), 0, sin(az), cos(az), 0, 0, 0, 1};
-    double T[9];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            T[i * 3 + j] = 0;
-            for (int k = 0; k < 3; k++)
-                T[i * 3 + j] += Ry[i * 3 + k] * Rx[k * 3 + j];
-        }
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            c.R[i * 3 + j] = 0;
-            for (int k = 0; k < 3; k++)
-                c.R[i * 3 + j] += Rz[i * 3 + k] * T[k * 3 + j];
-        }
-    c.in_tan = tan(l->fov_deg * M_PI / 360), c.in_half = 0.5 * (lf->ns < lf->nt ? lf->ns : lf->nt);
-    c.in_scale = c.in_half / c.in_tan;
-    c.out_tan = tan(o->fov_deg * M_PI / 360), c.out_half = 0.5 * (o->width < o->height ? o->width : o->height);
-    c.minx = l->grid_bounds[0], c.maxy = l->grid_bounds[3];
-    c.bx = lf->nu > 1 ? (l->grid_bounds[1] - l->grid_bounds[0]) / (lf->nu - 1) : 1;
-    c.by = lf->nv > 1 ? (l->grid_bounds[3] - l->grid_bounds[2]) / (lf->nv - 1) : 1;
-    c.inv_bx = 1 / c.bx, c.inv_by = 1 / c.by;
-    if (lf->nu == 1)
-        c.minx = 0.5 * (l->grid_bounds[0] + l->grid_bounds[1]);
-    if (lf->nv == 1)
-        c.maxy = 0.5 * (l->grid_bounds[2] + l->grid_bounds[3]);
+    camera_rotation(o->rot_deg, c.R);
+    setup_camera_grid(&c, lf, o);
     if (lf_image_alloc(out, o->width, o->height, 3, err))
         return err ? err->code : LF_ERR_NOMEM;
     if (coverage && lf_image_alloc(coverage, o->width, o->height, 1, err)) {
@@ -563,44 +623,9 @@ int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts 
         return err ? err->code : LF_ERR_NOMEM;
     }
     c.out = out, c.cov = coverage;
-    /* film and lens positions to grid-relative space (synth_ctx) */
-    const double k = c.out_tan / c.out_half, fd = o->focal_distance > 0 ? o->focal_distance : 1;
-    const double origin[3] = {c.minx, c.maxy, 0}, flip[3] = {1, -1, 1};
-    for (int a = 0; a < 3; a++) {
-        const double r0 = flip[a] * c.R[a * 3], r1 = flip[a] * c.R[a * 3 + 1], r2 = flip[a] * c.R[a * 3 + 2];
-        c.pos[a] = flip[a] * (o->pos[a] - origin[a]);
-        c.F0[a] = fd * (r2 - o->width * 0.5 * k * r0 + o->height * 0.5 * k * r1) + (o->focal_distance > 0 ? c.pos[a] : 0);
-        c.FX[a] = fd * k * r0, c.FY[a] = -fd * k * r1;
-        c.fFX[a] = (float)c.FX[a], c.fFY[a] = (float)c.FY[a], c.fpos[a] = (float)c.pos[a];
-        c.fLX[a] = (float)(o->lens_radius * r0), c.fLY[a] = (float)(o->lens_radius * r1);
-    }
-    c.fns = (float)lf->ns, c.fnt = (float)lf->nt, c.fbx = (float)c.bx, c.fby = (float)c.by;
-    if (o->disparity) {
-        const lf_image *dm = o->disparity;
-        if (dm->width != lf->ns || dm->height != lf->nt || dm->channels != 1 || !dm->data) {
-            lf_image_free(out);
-            if (coverage)
-                lf_image_free(coverage);
-            return lf_error_set(err, LF_ERR_PARAM, "synth: the disparity map must be 1 channel, %dx%d like the views",
-                                lf->ns, lf->nt);
-        }
-        c.disp = dm->data;
-        c.dmin = FLT_MAX, c.dmax = -FLT_MAX;
-        for (size_t i = 0; i < (size_t)lf->ns * lf->nt; i++) {
-            if (!isfinite(dm->data[i])) {
-                lf_image_free(out);
-                if (coverage)
-                    lf_image_free(coverage);
-                return lf_error_set(err, LF_ERR_NUMERIC, "synth: non-finite value in the disparity map");
-            }
-            c.dmin = fminf(c.dmin, dm->data[i]), c.dmax = fmaxf(c.dmax, dm->data[i]);
-        }
-        c.ref_x = ((lf->nu - 1) / 2) * c.bx, c.ref_y = ((lf->nv - 1) / 2) * c.by;
-        if (lf->nu == 1)
-            c.ref_x = 0;
-        if (lf->nv == 1)
-            c.ref_y = 0;
-    }
+    setup_film(&c, lf, o);
+    if (o->disparity && (rc = setup_disparity(&c, lf, o->disparity, err)))
+        goto fail;
     c.finv_bx = (float)c.inv_bx, c.finv_by = (float)c.inv_by, c.fscale = (float)c.in_scale;
     c.view_texels = (size_t)lf->ns * lf->nt;
     c.last_texel = (size_t)lf->nu * lf->nv * c.view_texels - 1;
@@ -616,10 +641,8 @@ int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts 
         if (!(c.strata[t] = strata_new(o->spp > 0 ? o->spp : 1))) {
             for (int q = 0; q < t; q++)
                 free(c.strata[q]);
-            lf_image_free(out);
-            if (coverage)
-                lf_image_free(coverage);
-            return lf_error_set(err, LF_ERR_NOMEM, "synth: out of memory for %d samples per pixel", o->spp);
+            rc = lf_error_set(err, LF_ERR_NOMEM, "synth: out of memory for %d samples per pixel", o->spp);
+            goto fail;
         }
     lf_parallel_for(o->height, nth, 1, synth_rows, &c);
     size_t unc = 0;
@@ -630,4 +653,9 @@ int lf_lightfield_synth(const lf_lightfield *lf, const lf_lightfield_synth_opts 
     if (uncovered)
         *uncovered = unc;
     return LF_OK;
+fail:
+    lf_image_free(out);
+    if (coverage)
+        lf_image_free(coverage);
+    return rc;
 }

@@ -93,6 +93,116 @@ static void fit(const double *td, const double *ts, const int *use, int n, doubl
     *b = (sdd * ss - sd * sds) / det;
 }
 
+/* Lucas-Kanade on the translation (sx, sy) of the T x T tile at (x0, y0)
+ * of the reference into img; 0 when the tile lacks texture in both
+ * directions (np: the tile's pixel count). */
+static int track_translation(const float *img, const float *ref, int w, int h, int x0, int y0, int T, double np,
+                             double *sx, double *sy)
+{
+    for (int it = 0; it < 15; it++) {
+        double a = 0, b = 0, cc = 0, ex = 0, ey = 0;
+        for (int y = y0; y < y0 + T; y++)
+            for (int x = x0; x < x0 + T; x++) {
+                double X = x + *sx, Y = y + *sy;
+                double gx = bil(img, w, h, X + 0.5, Y) - bil(img, w, h, X - 0.5, Y);
+                double gy = bil(img, w, h, X, Y + 0.5) - bil(img, w, h, X, Y - 0.5);
+                double r = bil(img, w, h, X, Y) - ref[(size_t)y * w + x];
+                a += gx * gx, b += gx * gy, cc += gy * gy, ex += gx * r, ey += gy * r;
+            }
+        double det = a * cc - b * b;
+        /* texture in both directions: the smaller eigenvalue of the structure tensor */
+        double lmin = (a + cc) / 2 - sqrt((a - cc) * (a - cc) / 4 + b * b);
+        if (det <= 0 || lmin < 1e-6 * np)
+            return 0;
+        double ux = -(cc * ex - b * ey) / det, uy = -(a * ey - b * ex) / det;
+        *sx += ux, *sy += uy;
+        if (fabs(ux) + fabs(uy) < 1e-4)
+            break;
+    }
+    return 1;
+}
+
+/* The shift (sx, sy) of the tile at (x0, y0) in view img against the
+ * reference and the tile's mean disparity md; 0 when the tile is not of
+ * near-constant, confident disparity or its shift cannot be measured. */
+static int tile_shift(const cal_ctx *c, const float *img, const float *ref, int x0, int y0, double nsu, double nsv,
+                      double *md_out, double *sx_out, double *sy_out)
+{
+    int w = c->lf->ns, h = c->lf->nt, T = c->tile;
+    double md = 0, m2 = 0, mc = 0;
+    for (int y = y0; y < y0 + T; y++)
+        for (int x = x0; x < x0 + T; x++) {
+            double d = c->disp[(size_t)y * w + x];
+            md += d, m2 += d * d, mc += c->conf ? c->conf[(size_t)y * w + x] : 1;
+        }
+    double np = (double)T * T;
+    md /= np, m2 = m2 / np - md * md, mc /= np;
+    if (m2 > 0.05 * 0.05 || mc < 0.3)
+        return 0;
+    /* integer search within 3 px of the nominal prediction */
+    double px = -md * nsu, py = -md * nsv;
+    int cx = (int)lrint(px), cy = (int)lrint(py);
+    double best = INFINITY;
+    int bxs = cx, bys = cy;
+    for (int dy = cy - 3; dy <= cy + 3; dy++)
+        for (int dx = cx - 3; dx <= cx + 3; dx++) {
+            if (x0 + dx < 0 || y0 + dy < 0 || x0 + T + dx > w || y0 + T + dy > h)
+                continue;
+            double s = 0;
+            for (int y = y0; y < y0 + T; y++)
+                for (int x = x0; x < x0 + T; x++) {
+                    double r = img[(size_t)(y + dy) * w + x + dx] - ref[(size_t)y * w + x];
+                    s += r * r;
+                }
+            if (s < best)
+                best = s, bxs = dx, bys = dy;
+        }
+    if (!isfinite(best))
+        return 0;
+    double sx = bxs, sy = bys;
+    if (!track_translation(img, ref, w, h, x0, y0, T, np, &sx, &sy) || fabs(sx - bxs) > 1 || fabs(sy - bys) > 1)
+        return 0;
+    *md_out = md, *sx_out = sx, *sy_out = sy;
+    return 1;
+}
+
+/* (su, ox), (sv, oy) fitted to the n tiles' shifts (tx, ty) against their
+ * -disparity td, refitted on the inliers (within 1 px, then 0.25 px); o:
+ * su, sv, ox, oy, tiles used, rms.  0 when fewer than 8 tiles remain. */
+static int fit_view_shift(const double *td, const double *tx, const double *ty, int *use, int n, double nsu, double nsv,
+                          double *o)
+{
+    double su = nsu, ox = 0, sv = nsv, oy = 0;
+    for (int i = 0; i < n; i++)
+        use[i] = 1;
+    for (int pass = 0; pass < 3; pass++) {
+        if (pass) {
+            double lim = pass == 1 ? 1.0 : 0.25;
+            int m = 0;
+            for (int i = 0; i < n; i++) {
+                double ex = tx[i] - (su * td[i] + ox), ey = ty[i] - (sv * td[i] + oy);
+                use[i] = ex * ex + ey * ey <= lim * lim;
+                m += use[i];
+            }
+            if (m < 8)
+                break;
+        }
+        fit(td, tx, use, n, &su, &ox);
+        fit(td, ty, use, n, &sv, &oy);
+    }
+    int m = 0;
+    double se = 0;
+    for (int i = 0; i < n; i++)
+        if (use[i]) {
+            double ex = tx[i] - (su * td[i] + ox), ey = ty[i] - (sv * td[i] + oy);
+            se += ex * ex + ey * ey, m++;
+        }
+    if (m < 8)
+        return 0;
+    o[0] = su, o[1] = sv, o[2] = ox, o[3] = oy, o[4] = m, o[5] = sqrt(se / m);
+    return 1;
+}
+
 static void cal_views(void *vctx, int k0, int k1, int tid)
 {
     (void)tid;
@@ -124,98 +234,14 @@ static void cal_views(void *vctx, int k0, int k1, int tid)
         int margin = T / 2;
         for (int by = 0; by < c->nty; by++)
             for (int bx = 0; bx < c->ntx; bx++) {
-                int x0 = margin + bx * T, y0 = margin + by * T;
-                double md = 0, m2 = 0, mc = 0;
-                for (int y = y0; y < y0 + T; y++)
-                    for (int x = x0; x < x0 + T; x++) {
-                        double d = c->disp[(size_t)y * w + x];
-                        md += d, m2 += d * d, mc += c->conf ? c->conf[(size_t)y * w + x] : 1;
-                    }
-                double np = (double)T * T;
-                md /= np, m2 = m2 / np - md * md, mc /= np;
-                if (m2 > 0.05 * 0.05 || mc < 0.3)
-                    continue;
-                /* integer search within 3 px of the nominal prediction */
-                double px = -md * nsu, py = -md * nsv;
-                int cx = (int)lrint(px), cy = (int)lrint(py);
-                double best = INFINITY;
-                int bxs = cx, bys = cy;
-                for (int dy = cy - 3; dy <= cy + 3; dy++)
-                    for (int dx = cx - 3; dx <= cx + 3; dx++) {
-                        if (x0 + dx < 0 || y0 + dy < 0 || x0 + T + dx > w || y0 + T + dy > h)
-                            continue;
-                        double s = 0;
-                        for (int y = y0; y < y0 + T; y++)
-                            for (int x = x0; x < x0 + T; x++) {
-                                double r = img[(size_t)(y + dy) * w + x + dx] - ref[(size_t)y * w + x];
-                                s += r * r;
-                            }
-                        if (s < best)
-                            best = s, bxs = dx, bys = dy;
-                    }
-                if (!isfinite(best))
-                    continue;
-                /* Lucas-Kanade on the translation */
-                double sx = bxs, sy = bys;
-                int good = 1;
-                for (int it = 0; it < 15; it++) {
-                    double a = 0, b = 0, cc = 0, ex = 0, ey = 0;
-                    for (int y = y0; y < y0 + T; y++)
-                        for (int x = x0; x < x0 + T; x++) {
-                            double X = x + sx, Y = y + sy;
-                            double gx = bil(img, w, h, X + 0.5, Y) - bil(img, w, h, X - 0.5, Y);
-                            double gy = bil(img, w, h, X, Y + 0.5) - bil(img, w, h, X, Y - 0.5);
-                            double r = bil(img, w, h, X, Y) - ref[(size_t)y * w + x];
-                            a += gx * gx, b += gx * gy, cc += gy * gy, ex += gx * r, ey += gy * r;
-                        }
-                    double det = a * cc - b * b;
-                    /* texture in both directions: the smaller eigenvalue of the structure tensor */
-                    double lmin = (a + cc) / 2 - sqrt((a - cc) * (a - cc) / 4 + b * b);
-                    if (det <= 0 || lmin < 1e-6 * np) {
-                        good = 0;
-                        break;
-                    }
-                    double ux = -(cc * ex - b * ey) / det, uy = -(a * ey - b * ex) / det;
-                    sx += ux, sy += uy;
-                    if (fabs(ux) + fabs(uy) < 1e-4)
-                        break;
-                }
-                if (!good || fabs(sx - bxs) > 1 || fabs(sy - bys) > 1)
+                double md, sx, sy;
+                if (!tile_shift(c, img, ref, margin + bx * T, margin + by * T, nsu, nsv, &md, &sx, &sy))
                     continue;
                 /* shift s = -d su + o */
                 td[n] = -md, tx[n] = sx, ty[n] = sy, n++;
             }
-        if (n < 8)
-            continue;
-        double su = nsu, ox = 0, sv = nsv, oy = 0;
-        for (int i = 0; i < n; i++)
-            use[i] = 1;
-        for (int pass = 0; pass < 3; pass++) {
-            if (pass) {
-                double lim = pass == 1 ? 1.0 : 0.25;
-                int m = 0;
-                for (int i = 0; i < n; i++) {
-                    double ex = tx[i] - (su * td[i] + ox), ey = ty[i] - (sv * td[i] + oy);
-                    use[i] = ex * ex + ey * ey <= lim * lim;
-                    m += use[i];
-                }
-                if (m < 8)
-                    break;
-            }
-            fit(td, tx, use, n, &su, &ox);
-            fit(td, ty, use, n, &sv, &oy);
-        }
-        int m = 0;
-        double se = 0;
-        for (int i = 0; i < n; i++)
-            if (use[i]) {
-                double ex = tx[i] - (su * td[i] + ox), ey = ty[i] - (sv * td[i] + oy);
-                se += ex * ex + ey * ey, m++;
-            }
-        if (m < 8)
-            continue;
-        o[0] = su, o[1] = sv, o[2] = ox, o[3] = oy, o[4] = m, o[5] = sqrt(se / m);
-        c->ok[k] = 1;
+        if (n >= 8 && fit_view_shift(td, tx, ty, use, n, nsu, nsv, o))
+            c->ok[k] = 1;
     }
     free(td), free(use);
 }

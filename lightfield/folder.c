@@ -145,9 +145,9 @@ static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
     int lineno = 0, rc = LF_OK;
     while (!rc && fgets(line, sizeof line, in)) {
         lineno++;
+        lf_loc at = {.file = path, .line = lineno};
         if (!strchr(line, '\n') && !feof(in)) {
-            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: line longer than %zu characters", path, lineno,
-                              sizeof line - 2);
+            rc = lf_error_at(err, LF_ERR_PARSE, &at, "line longer than %zu characters", sizeof line - 2);
             break;
         }
         char *s = trim(line);
@@ -156,8 +156,7 @@ static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
         if (*s == '[') {
             char *close = strchr(s, ']');
             if (!close || close[1] || close - s - 1 >= (long)sizeof section || close == s + 1) {
-                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected a section header like [intrinsics], got \"%s\"",
-                                  path, lineno, s);
+                rc = lf_error_at(err, LF_ERR_PARSE, &at, "expected a section header like [intrinsics], got \"%s\"", s);
                 break;
             }
             *close = '\0';
@@ -166,14 +165,13 @@ static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
         }
         char *eq = strchr(s, '=');
         if (!eq) {
-            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected \"key = value\" or a [section], got \"%s\"", path,
-                              lineno, s);
+            rc = lf_error_at(err, LF_ERR_PARSE, &at, "expected \"key = value\" or a [section], got \"%s\"", s);
             break;
         }
         *eq = '\0';
         char *key = trim(s), *val = trim(eq + 1);
         if (!*key) {
-            rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected \"key = value\", the key is empty", path, lineno);
+            rc = lf_error_at(err, LF_ERR_PARSE, &at, "expected \"key = value\", the key is empty");
             break;
         }
         for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++) {
@@ -183,8 +181,7 @@ static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
             errno = 0;
             double v = strtod(val, &end);
             if (!*val || *end || errno || !isfinite(v)) {
-                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s: expected a number, got \"%s\"", path, lineno, key,
-                                  val);
+                rc = lf_error_at(err, LF_ERR_PARSE, &at, "%s: expected a number, got \"%s\"", key, val);
                 break;
             }
             *keys[k].dst = v;
@@ -196,20 +193,21 @@ static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
     fclose(in);
     if (rc)
         return rc;
+    const lf_loc file = {.file = path}; /* the whole file: "path: message" */
 #define WHOLE(v, lo, hi) ((v) >= (lo) && (v) <= (hi) && (v) == floor(v))
     if ((s_cx && !WHOLE(camsx, 1, MAX_SIDE)) || (s_cy && !WHOLE(camsy, 1, MAX_SIDE)))
-        return lf_error_set(err, LF_ERR_PARSE, "%s: num_cams_x / num_cams_y must be whole numbers in 1..%d (got %g, %g)",
-                            path, MAX_SIDE, camsx, camsy);
+        return lf_error_at(err, LF_ERR_PARSE, &file, "num_cams_x / num_cams_y must be whole numbers in 1..%d (got %g, %g)",
+                           MAX_SIDE, camsx, camsy);
     if (s_cx != s_cy)
-        return lf_error_set(err, LF_ERR_PARSE, "%s: give both num_cams_x and num_cams_y", path);
+        return lf_error_at(err, LF_ERR_PARSE, &file, "give both num_cams_x and num_cams_y");
     if ((s_resx && !WHOLE(resx, 1, 1 << 20)) || (s_resy && !WHOLE(resy, 1, 1 << 20)))
-        return lf_error_set(err, LF_ERR_PARSE, "%s: image_resolution_x_px / _y_px must be whole numbers >= 1", path);
+        return lf_error_at(err, LF_ERR_PARSE, &file, "image_resolution_x_px / _y_px must be whole numbers >= 1");
     if ((s_focal && !(focal > 0)) || (s_sensor && !(sensor > 0)) || (s_base && !(base > 0)) ||
         (s_focus && !(focus > 0)))
-        return lf_error_set(err, LF_ERR_PARSE,
-                            "%s: focal_length_mm, sensor_size_mm, baseline_mm and focus_distance_m must be > 0", path);
+        return lf_error_at(err, LF_ERR_PARSE, &file,
+                           "focal_length_mm, sensor_size_mm, baseline_mm and focus_distance_m must be > 0");
     if (s_dmin != s_dmax || (s_dmin && !(dmin <= dmax)))
-        return lf_error_set(err, LF_ERR_PARSE, "%s: give both disp_min and disp_max, disp_min <= disp_max", path);
+        return lf_error_at(err, LF_ERR_PARSE, &file, "give both disp_min and disp_max, disp_min <= disp_max");
 #undef WHOLE
     lf_lightfield_layout *L = &f->layout;
     if (s_cx) {

@@ -43,7 +43,8 @@ typedef struct lf_lightfield_depth_opts {
     double step;         /* label spacing (px per view); <= 0: auto (about 0.05 px shift at the widest view) */
     int radius;          /* guided-filter radius (px); <= 0: auto (shorter side / 128, at least 2) */
     double eps;          /* guided-filter regulariser (colour guide in [0,1]); <= 0: 1e-3 */
-    int occlusion;       /* 0: full aperture only; 1 (default): best of 8 half apertures too */
+    int occlusion;       /* 0: full aperture only; 1: best of 8 half apertures too; 2 (default): and of
+                          * the 4 lines through the reference */
     double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
     int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */

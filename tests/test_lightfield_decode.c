@@ -341,9 +341,62 @@ static void test_layouts(void)
     lf_image_free(&raw);
 }
 
+/* The layout attributes are decoded once (image/lf_layout_attrs.h) for a
+ * strict reader (lf_lightfield_layout_from_attrs: a malformed attribute is
+ * an error) and a lenient one (the renderer's disparity AOV: missing). */
+static void test_layout_attr_decoding(void)
+{
+    lf_attrs a = {0};
+    lf_layout_attrs la;
+    lf_layout_attrs_decode(&a, &la);
+    CHECK(la.kind.state == LF_LAYOUT_ATTR_ABSENT && la.fov_deg.state == LF_LAYOUT_ATTR_ABSENT);
+    CHECK(la.kind_id == LF_LIGHTFIELD_KIND_UNKNOWN && !la.grid_known);
+    float two[2] = {35, 40}, three[3] = {1, 2, 3};
+    lf_attrs_set_int(&a, "lensfield:kind", 1);
+    lf_attrs_set_int(&a, "lensfield:microlens_pitch_px", 9);
+    lf_attrs_set_floats(&a, "lensfield:fov_deg", two, 2);
+    lf_attrs_set_floats(&a, "lensfield:tile_size", three, 3);
+    lf_attrs_set_string(&a, "lensfield:grid", "triangle");
+    lf_layout_attrs_decode(&a, &la);
+    CHECK(la.kind.state == LF_LAYOUT_ATTR_MALFORMED);
+    CHECK(la.microlens_pitch_px.state == LF_LAYOUT_ATTR_SET && la.microlens_pitch_px.v[0] == 9);
+    CHECK(la.fov_deg.state == LF_LAYOUT_ATTR_LIST && la.fov_deg.v[0] == 35);
+    CHECK(la.tile_size.state == LF_LAYOUT_ATTR_MALFORMED);
+    CHECK(la.grid.state == LF_LAYOUT_ATTR_SET && !la.grid_known && !strcmp(la.grid.s, "triangle"));
+    CHECK(!strcmp(la.fov_deg.name, "lensfield:fov_deg"));
+    /* strict: each of those is an error naming the attribute */
+    lf_lightfield_layout lay;
+    lf_error err = {0};
+    CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE && strstr(err.msg, "lensfield:kind"));
+    lf_error_clear(&err);
+    lf_attrs_set_string(&a, "lensfield:kind", "plenoptic");
+    CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE);
+    CHECK(!strcmp(err.msg, "attribute lensfield:fov_deg: expected a number"));
+    lf_error_clear(&err);
+    lf_attrs_set_double(&a, "lensfield:fov_deg", 35);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE);
+    CHECK(!strcmp(err.msg, "attribute lensfield:tile_size: expected 2 floats"));
+    lf_error_clear(&err);
+    lf_attrs_set_floats(&a, "lensfield:tile_size", two, 2);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE && strstr(err.msg, "lensfield:grid"));
+    lf_error_clear(&err);
+    lf_attrs_set_string(&a, "lensfield:grid", "hex");
+    lf_layout_attrs_decode(&a, &la);
+    CHECK(la.kind_id == LF_LIGHTFIELD_PLENOPTIC && la.grid_known && la.grid_id == LF_LIGHTFIELD_GRID_HEX);
+    CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == 0);
+    CHECK(lay.kind == LF_LIGHTFIELD_PLENOPTIC && lay.grid == LF_LIGHTFIELD_GRID_HEX && lay.pitch_px == 9);
+    CHECK(lay.fov_deg == 35 && lay.tile_w == 35 && lay.tile_h == 40);
+    /* the names round-trip */
+    CHECK(!strcmp(lf_lightfield_kind_name(LF_LIGHTFIELD_CAMERA_ARRAY), "camera-array"));
+    CHECK(lf_lightfield_kind_name(LF_LIGHTFIELD_KIND_UNKNOWN) == NULL);
+    CHECK(!strcmp(lf_lightfield_grid_name(LF_LIGHTFIELD_GRID_SQUARE), "square"));
+    lf_attrs_free(&a);
+}
+
 int main(void)
 {
     test_layouts();
+    test_layout_attr_decoding();
     test_square();
     test_hex();
     test_white_and_nonfinite();

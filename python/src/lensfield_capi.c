@@ -76,8 +76,10 @@ typedef struct lfpy_lightfield {
     int borrowed;
     char *path;
     /* --calibrate-views replaces lf.view_shift for one call (the CLI starts
-     * from a fresh light field each time): calls that touch it take turns */
-    pthread_mutex_t lock;
+     * from a fresh light field each time): such a call holds the lock for
+     * writing, every other call for reading, so Python threads may share a
+     * light field */
+    pthread_rwlock_t lock;
 } lfpy_lightfield;
 
 typedef struct lfpy_info {
@@ -108,7 +110,7 @@ LFPY_API int lfpy_open(const char *path, const lfpy_layout *keywords, const char
         return rc;
     }
     h->path = p;
-    pthread_mutex_init(&h->lock, NULL);
+    pthread_rwlock_init(&h->lock, NULL);
     *out = h;
     return LF_OK;
 }
@@ -130,7 +132,7 @@ LFPY_API int lfpy_wrap(float *data, int nu, int nv, int ns, int nt, double disp_
     lf->disp_v_per_u = disp_v_per_u > 0 ? disp_v_per_u : 1.0;
     lf_lightfield_layout_init(&lf->layout);
     h->borrowed = 1;
-    pthread_mutex_init(&h->lock, NULL);
+    pthread_rwlock_init(&h->lock, NULL);
     *out = h;
     return LF_OK;
 }
@@ -146,7 +148,7 @@ LFPY_API void lfpy_close(lfpy_lightfield *h)
     } else {
         lf_lightfield_close(&h->src);
     }
-    pthread_mutex_destroy(&h->lock);
+    pthread_rwlock_destroy(&h->lock);
     free(h->path);
     free(h);
 }
@@ -270,8 +272,8 @@ static lf_lightfield_refocus_opts aperture_opts(int have_aperture, double apertu
 
 /* range_out: the disparity range searched; range_source: where it came from
  * ("--from/--to", the source's statement, "estimated"), as lftool prints. */
-LFPY_API int lfpy_depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *disp, lf_image *conf,
-                        double range_out[2], const char **range_source, lf_error *err)
+static int depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *disp, lf_image *conf, double range_out[2],
+                 const char **range_source, lf_error *err)
 {
     lf_lightfield *lf = &h->src.lf;
     *range_source = "--from/--to";
@@ -300,7 +302,6 @@ LFPY_API int lfpy_depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *
         return lf_lightfield_depth(lf, &d, disp, a->confidence ? conf : NULL, err);
     /* depth on the nominal grid, view positions fitted to it, depth again;
      * the fitted positions last for this call only, as in the CLI */
-    pthread_mutex_lock(&h->lock);
     double *saved = lf->view_shift;
     lf->view_shift = NULL;
     int rc = lf_lightfield_depth(lf, &d, disp, conf, err) ||
@@ -310,7 +311,6 @@ LFPY_API int lfpy_depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *
         rc = lf_lightfield_depth(lf, &d, disp, a->confidence ? conf : NULL, err);
     free(lf->view_shift);
     lf->view_shift = saved;
-    pthread_mutex_unlock(&h->lock);
     return rc ? (err->code ? err->code : LF_ERR_INTERNAL) : LF_OK;
 }
 
@@ -346,8 +346,8 @@ typedef struct lfpy_refocus_args {
 } lfpy_refocus_args;
 
 /* warning (n bytes) gets lftool's outside-the-refocusable-range text, or "". */
-LFPY_API int lfpy_refocus(lfpy_lightfield *h, const lfpy_refocus_args *a, lf_image *out, double *disparity,
-                          char *warning, size_t n, lf_error *err)
+static int refocus(lfpy_lightfield *h, const lfpy_refocus_args *a, lf_image *out, double *disparity, char *warning,
+                   size_t n, lf_error *err)
 {
     const lf_lightfield *lf = &h->src.lf;
     const lfpy_focus *f = &a->focus;
@@ -401,7 +401,7 @@ static int check_map(const lf_image *m, const lf_lightfield *lf, const char *wha
     return LF_OK;
 }
 
-LFPY_API int lfpy_view(lfpy_lightfield *h, const lfpy_view_args *a, lf_image *out, lf_error *err)
+static int view(lfpy_lightfield *h, const lfpy_view_args *a, lf_image *out, lf_error *err)
 {
     lf_lightfield *lf = &h->src.lf;
     const lfpy_focus *f = &a->focus;
@@ -427,7 +427,6 @@ LFPY_API int lfpy_view(lfpy_lightfield *h, const lfpy_view_args *a, lf_image *ou
     if (!a->calibrate_views)
         return lf_lightfield_view_depth(lf, a->u, a->v, &vo, out, err);
     /* calibrate_for_view, the fitted positions for this call only */
-    pthread_mutex_lock(&h->lock);
     double *saved = lf->view_shift;
     lf->view_shift = NULL;
     if (a->disparity_map) {
@@ -444,8 +443,43 @@ LFPY_API int lfpy_view(lfpy_lightfield *h, const lfpy_view_args *a, lf_image *ou
         rc = lf_lightfield_view_depth(lf, a->u, a->v, &vo, out, err);
     free(lf->view_shift);
     lf->view_shift = saved;
-    pthread_mutex_unlock(&h->lock);
     return rc ? (err->code ? err->code : LF_ERR_INTERNAL) : LF_OK;
+}
+
+/* ---------- the light-field calls, under the light field's lock ---------- */
+
+static void lock(lfpy_lightfield *h, int calibrate)
+{
+    if (calibrate)
+        pthread_rwlock_wrlock(&h->lock);
+    else
+        pthread_rwlock_rdlock(&h->lock);
+}
+
+LFPY_API int lfpy_depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *disp, lf_image *conf,
+                        double range_out[2], const char **range_source, lf_error *err)
+{
+    lock(h, a->calibrate_views && !a->stack);
+    int rc = depth(h, a, disp, conf, range_out, range_source, err);
+    pthread_rwlock_unlock(&h->lock);
+    return rc;
+}
+
+LFPY_API int lfpy_refocus(lfpy_lightfield *h, const lfpy_refocus_args *a, lf_image *out, double *disparity,
+                          char *warning, size_t n, lf_error *err)
+{
+    lock(h, 0);
+    int rc = refocus(h, a, out, disparity, warning, n, err);
+    pthread_rwlock_unlock(&h->lock);
+    return rc;
+}
+
+LFPY_API int lfpy_view(lfpy_lightfield *h, const lfpy_view_args *a, lf_image *out, lf_error *err)
+{
+    lock(h, a->calibrate_views);
+    int rc = view(h, a, out, err);
+    pthread_rwlock_unlock(&h->lock);
+    return rc;
 }
 
 /* ---------- render: lfrender SCENE (run_render) ---------- */

@@ -153,3 +153,12 @@ def test_refocus_outside_range_warns(lf, raw):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         lf.open(raw).refocus(disparity=5)
+
+
+def test_calibrate_views_equals_lftool_and_lasts_one_call(lf, raw, tmp_path):
+    run("lftool", "depth", raw, "-o", tmp_path / "cal.pfm", "--calibrate-views", "--from", 0, "--to", 2)
+    run("lftool", "depth", raw, "-o", tmp_path / "plain.pfm", "--from", 0, "--to", 2)
+    L = lf.open(raw)
+    assert np.array_equal(L.depth(from_=0, to=2, calibrate_views=True), read_pfm(tmp_path / "cal.pfm"))
+    # the fitted positions were for that call: the next is on the nominal grid, as a new lftool run
+    assert np.array_equal(L.depth(from_=0, to=2), read_pfm(tmp_path / "plain.pfm"))

@@ -87,8 +87,9 @@ def test_gil_released_during_a_call(lf):
     took = time.perf_counter() - t0
     done.set()
     t.join()
-    # the other Python thread ran all along (at most ~1 tick per ms)
-    assert took > 0.05 and ticks[0] > 0.3 * took / 0.0011, (took, ticks[0])
+    # the other Python thread ran during the call (a call holding the GIL
+    # would allow it one tick or two); loose, for loaded machines
+    assert took > 0.05 and ticks[0] >= 10, (took, ticks[0])
 
 
 INTERRUPTED = """

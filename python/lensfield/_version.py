@@ -1,0 +1,1 @@
+__version__ = "0.1"  # the CMake project's VERSION (CMakeLists.txt)

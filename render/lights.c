@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render_internal.h"
+#include "image/lf_image.h"
+#include "render/lights.h"
 
 /* Clarberg's equal-area mapping between the unit square and the sphere, as
  * pbrt-v4 uses for environment maps (octahedral layout). */
@@ -470,6 +471,20 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
     if (!isfinite(lf_maxc(l->L)) || lf_maxc(l->L) < 0)
         return lf_error_set(err, LF_ERR_NUMERIC, "%s: light emission is negative or not finite", where);
     return 0;
+}
+
+double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
+{
+    if (s->lights[light].kind == LF_LIGHT_INFINITE_UNIFORM)
+        return 0.0; /* never sampled by NEE (lf_scene.nee_lights) */
+    switch (ls) {
+    case LF_LIGHTS_ALL:
+        return 1.0;
+    case LF_LIGHTS_UNIFORM:
+        return 1.0 / s->n_nee_lights;
+    default:
+        return lf_distrib1d_pmf(&s->light_distrib, light);
+    }
 }
 
 int lf_scene_build_lights(lf_scene_desc *d, lf_scene *s, lf_error *err)

@@ -32,7 +32,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render_internal.h"
+#include "render/integrator.h"
+#include "render/media.h"
 
 /* ------------------------------------------------------------------ build */
 

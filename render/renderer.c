@@ -21,10 +21,10 @@
 #include "base/lf_parallel.h"
 #include "base/lf_progress.h"
 #include "base/lf_color.h"
-#include "film.h"
-#include "render_internal.h"
+#include "render/film.h"
+#include "render/render_internal.h"
 
-#define LF_VERSION_STRING "lensfield 0.1"
+#define LF_VERSION_STRING "lensfield " LF_VERSION /* LF_VERSION: CMake's project version (lf_base) */
 
 struct lf_renderer {
     lf_scene scene;

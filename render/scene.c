@@ -22,8 +22,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "lf_subdiv.h"
-#include "render_internal.h"
+#include "render/lf_subdiv.h"
+#include "render/lights.h"
+#include "render/media.h"
+#include "render/scene.h"
 
 void lf_warn_append(char **buf, const char *fmt, ...)
 {
@@ -729,8 +731,6 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
         sh->e.params.items[i].used = 1;
     return 0;
 }
-
-int lf_scene_build_lights(lf_scene_desc *d, lf_scene *s, lf_error *err); /* lights.c */
 
 /* ---- analytic spheres as Embree user geometry ----
  * Measured cheaper per ray than Embree's sphere-point primitive (callgrind:

@@ -352,8 +352,7 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
 {
     lf_paramset *ps = &ld->e.params;
     char where[512];
-    snprintf(where, sizeof where, "%s:%d:%d", ld->e.loc.file ? ld->e.loc.file : "<scene>", ld->e.loc.line,
-             ld->e.loc.col);
+    lf_loc_format(where, sizeof where, &ld->e.loc);
     const lf_transform *xf = &ld->light_to_world.xf[0];
     memset(l, 0, sizeof *l);
     l->mesh = l->sphere = -1;
@@ -406,7 +405,7 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
         lf_params_rgb(ps, "L", LF_SPECTRUM_ILLUMINANT, lf_v3(1, 1, 1), &L);
         double E = lf_params_float(ps, "illuminance", -1);
         if (lf_params_find(ps, "portal"))
-            lf_warn_append(&s->warnings, "%s: warning: infinite light \"portal\" is ignored (no portal sampling)", where);
+            lf_warn_at(&s->warnings, &ld->e.loc, "infinite light \"portal\" is ignored (no portal sampling)");
         if (fn && has_L)
             return lf_error_set(err, LF_ERR_PARAM, "%s: infinite light: give either \"L\" or \"filename\", not both",
                                 where);
@@ -458,7 +457,7 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
                                 "%s: LightSource \"%s\" is not supported (--allow-unsupported renders the scene "
                                 "without it)",
                                 where, type);
-        lf_warn_append(&s->warnings, "%s: warning: LightSource \"%s\" is not supported; it is left out", where, type);
+        lf_warn_at(&s->warnings, &ld->e.loc, "LightSource \"%s\" is not supported; it is left out", type);
         for (size_t i = 0; i < ps->count; i++)
             ps->items[i].used = 1;
         *skip = 1;

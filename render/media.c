@@ -48,9 +48,7 @@ int lf_media_lookup(const lf_scene_desc *d, const char *name, const lf_loc *loc,
             *index = (int)i;
             return 0;
         }
-    return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: %s: no medium named \"%s\" (MakeNamedMedium)",
-                        loc && loc->file ? loc->file : "<scene>", loc ? loc->line : 0, loc ? loc->col : 0, what,
-                        name);
+    return lf_error_at(err, LF_ERR_PARAM, loc, "%s: no medium named \"%s\" (MakeNamedMedium)", what, name);
 }
 
 int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
@@ -68,20 +66,20 @@ int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         const char *type = lf_params_string(ps, "type", "");
         if (!strcmp(type, "uniformgrid") || !strcmp(type, "rgbgrid") || !strcmp(type, "cloud") ||
             !strcmp(type, "nanovdb"))
-            return lf_error_set(err, LF_ERR_UNSUPPORTED,
-                                "%s:%d:%d: MakeNamedMedium \"%s\": medium type \"%s\" is not supported (lensfield "
-                                "renders \"homogeneous\" media only)",
-                                l->file, l->line, l->col, md->name, type);
+            return lf_error_at(err, LF_ERR_UNSUPPORTED, l,
+                               "MakeNamedMedium \"%s\": medium type \"%s\" is not supported (lensfield "
+                               "renders \"homogeneous\" media only)",
+                               md->name, type);
         if (strcmp(type, "homogeneous"))
-            return lf_error_set(err, LF_ERR_PARAM,
-                                "%s:%d:%d: MakeNamedMedium \"%s\": unknown or missing \"string type\" \"%s\" (pbrt-v4 "
-                                "has \"homogeneous\", \"uniformgrid\", \"rgbgrid\", \"cloud\", \"nanovdb\")",
-                                l->file, l->line, l->col, md->name, type);
+            return lf_error_at(err, LF_ERR_PARAM, l,
+                               "MakeNamedMedium \"%s\": unknown or missing \"string type\" \"%s\" (pbrt-v4 "
+                               "has \"homogeneous\", \"uniformgrid\", \"rgbgrid\", \"cloud\", \"nanovdb\")",
+                               md->name, type);
         if (lf_params_peek(ps, "preset"))
-            return lf_error_set(err, LF_ERR_UNSUPPORTED,
-                                "%s:%d:%d: MakeNamedMedium \"%s\": \"string preset\" (measured scattering tables) is "
-                                "not supported; give \"sigma_a\" and \"sigma_s\"",
-                                l->file, l->line, l->col, md->name);
+            return lf_error_at(err, LF_ERR_UNSUPPORTED, l,
+                               "MakeNamedMedium \"%s\": \"string preset\" (measured scattering tables) is "
+                               "not supported; give \"sigma_a\" and \"sigma_s\"",
+                               md->name);
         lf_medium *m = &s->media[i];
         lf_vec3 sa, ss, Le;
         lf_params_rgb(ps, "sigma_a", LF_SPECTRUM_UNBOUNDED, lf_v3(1, 1, 1), &sa);
@@ -98,13 +96,13 @@ int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
                       m->sigma_s.z, m->Le.x,      m->Le.y,      m->Le.z};
         for (int k = 0; k < 9; k++)
             if (!(v[k] >= 0) || !isfinite(v[k]))
-                return lf_error_set(err, LF_ERR_PARAM,
-                                    "%s:%d:%d: MakeNamedMedium \"%s\": sigma_a, sigma_s (times scale) and Le must be "
-                                    "finite and >= 0",
-                                    l->file, l->line, l->col, md->name);
+                return lf_error_at(err, LF_ERR_PARAM, l,
+                                   "MakeNamedMedium \"%s\": sigma_a, sigma_s (times scale) and Le must be "
+                                   "finite and >= 0",
+                                   md->name);
         if (!(m->g > -1 && m->g < 1))
-            return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: MakeNamedMedium \"%s\": \"g\" must be in (-1, 1), got %g",
-                                l->file, l->line, l->col, md->name, m->g);
+            return lf_error_at(err, LF_ERR_PARAM, l, "MakeNamedMedium \"%s\": \"g\" must be in (-1, 1), got %g",
+                               md->name, m->g);
         m->scatters = lf_maxc(m->sigma_s) > 0;
         m->emits = lf_maxc(lf_mul(m->sigma_a, m->Le)) > 0;
         char ctx[300];

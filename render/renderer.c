@@ -49,7 +49,7 @@ struct lf_renderer {
     char *filter_name;
     char *integrator_name;
     char *scene_path;
-    char *warnings;
+    lf_warnings warnings;
     lf_render_opts opts;
     int threads;
     lf_render_stats stats;
@@ -92,11 +92,6 @@ static char *dupstr(const char *s)
     return d;
 }
 
-static void where_of(char *buf, size_t n, const lf_loc *loc)
-{
-    snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
-}
-
 /* An options-block directive (Film, Sampler, PixelFilter, Integrator,
  * Camera) as the readers take it: its parameters (an empty list when the
  * scene leaves the directive out), its type or pbrt's default, and
@@ -104,6 +99,7 @@ static void where_of(char *buf, size_t n, const lf_loc *loc)
 typedef struct option_entity {
     lf_paramset *ps, empty;
     const char *type;
+    const lf_loc *loc;
     char where[512];
 } option_entity;
 
@@ -112,7 +108,8 @@ static void option_entity_init(option_entity *o, lf_entity *e, const char *defau
     memset(&o->empty, 0, sizeof o->empty);
     o->ps = e->type ? &e->params : &o->empty;
     o->type = e->type ? e->type : default_type;
-    where_of(o->where, sizeof o->where, &e->loc);
+    o->loc = &e->loc;
+    lf_loc_format(o->where, sizeof o->where, &e->loc);
 }
 
 /* Reports the directive's unused or mistyped parameters ("Sampler \"halton\""). */
@@ -202,7 +199,7 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     lf_paramset *ps = oe.ps;
     const char *where = oe.where;
     if (f->type && strcmp(f->type, "rgb") != 0)
-        lf_warn_append(&r->warnings, "%s: warning: Film \"%s\" is rendered as Film \"rgb\"", where, f->type);
+        lf_warn_at(&r->warnings, oe.loc, "Film \"%s\" is rendered as Film \"rgb\"", f->type);
     r->xres = lf_params_int(ps, "xresolution", 1280);
     r->yres = lf_params_int(ps, "yresolution", 720);
     r->film_filename = dupstr(lf_params_string(ps, "filename", "pbrt.exr"));
@@ -213,8 +210,10 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     const char *sensor = lf_params_string(ps, "sensor", "cie1931");
     double wb = lf_params_float(ps, "whitebalance", 0.0);
     if (strcmp(sensor, "cie1931") != 0 || wb != 0.0)
-        lf_warn_append(&r->warnings, "%s: warning: Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
-                       "modelled; no white balance applied", where, sensor, wb);
+        lf_warn_at(&r->warnings, oe.loc,
+                   "Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
+                   "modelled; no white balance applied",
+                   sensor, wb);
     if (r->xres <= 0 || r->yres <= 0 || r->xres > 65536 || r->yres > 65536)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Film resolution %dx%d is out of range (1..65536)", where, r->xres,
                             r->yres);
@@ -310,11 +309,15 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         if (r->sampler.spp > LF_PMJ_MAX)
             return lf_error_set(err, LF_ERR_PARAM, "%s: Sampler \"pmj02bn\" takes at most %d samples per pixel, got %d",
                                 where, LF_PMJ_MAX, r->sampler.spp);
-        if (n != r->sampler.spp)
-            lf_warn_append(&r->warnings,
-                           "%s: note: Sampler \"pmj02bn\": %d samples per pixel is not a power of 4; rounded up to %d "
-                           "(as pbrt-v4)",
-                           where, r->sampler.spp, n);
+        if (n != r->sampler.spp) {
+            /* a note, not a warning: pbrt-v4 does the same */
+            char note[1024];
+            snprintf(note, sizeof note,
+                     "%s: note: Sampler \"pmj02bn\": %d samples per pixel is not a power of 4; rounded up to %d "
+                     "(as pbrt-v4)",
+                     where, r->sampler.spp, n);
+            lf_warn_text(&r->warnings, note);
+        }
         r->sampler.spp = n;
     }
     if (lf_sampler_prepare(&r->sampler, r->xres, r->yres))
@@ -370,10 +373,10 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                             "%s: Integrator \"%s\" is not supported (it computes something other than radiance)", where,
                             type);
     if (strcmp(type, "path") && strcmp(type, "volpath"))
-        lf_warn_append(&r->warnings,
-                       "%s: warning: Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
-                       "image",
-                       where, type);
+        lf_warn_at(&r->warnings, oe.loc,
+                   "Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
+                   "image",
+                   type);
     r->integrator.volumetric = strcmp(type, "path") != 0;
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
@@ -430,7 +433,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     r->shutter_open = lf_params_float(ps, "shutteropen", 0.0);
     r->shutter_close = lf_params_float(ps, "shutterclose", 1.0);
     if (r->shutter_close < r->shutter_open) {
-        lf_warn_append(&r->warnings, "%s: warning: shutterclose < shutteropen; swapping them (as pbrt does)", where);
+        lf_warn_at(&r->warnings, oe.loc, "shutterclose < shutteropen; swapping them (as pbrt does)");
         double t = r->shutter_open;
         r->shutter_open = r->shutter_close;
         r->shutter_close = t;
@@ -457,7 +460,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (!(r->readout >= 0) || !isfinite(r->readout))
         return lf_error_set(err, LF_ERR_PARAM, "%s: \"readouttime\" must be >= 0", where);
     if (r->readout > 0 && !r->rolling)
-        lf_warn_append(&r->warnings, "%s: warning: \"readouttime\" only matters with \"shutter\" \"rolling\"", where);
+        lf_warn_at(&r->warnings, oe.loc, "\"readouttime\" only matters with \"shutter\" \"rolling\"");
     size_t ncurve = 0;
     const double *curve = lf_params_nums(ps, "shuttercurve", LF_PT_FLOAT, &ncurve);
     r->curve_mean = 1.0;
@@ -517,7 +520,7 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Camera \"%s\": %s", where, type, cerr[0] ? cerr : "cannot create");
     }
     if (cwarn[0])
-        lf_warn_append(&r->warnings, "%s: warning: Camera \"%s\": %s", where, type, cwarn);
+        lf_warn_at(&r->warnings, oe.loc, "Camera \"%s\": %s", type, cwarn);
     r->camera_needs = r->camera_type->needs(r->camera);
     r->camera_name = dupstr(type);
     r->world_to_camera = cd->world_to_camera.xf[0];
@@ -553,8 +556,7 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     r->opts = *opts;
     r->scene_path = dupstr(opts->scene_path);
-    if (d->warnings)
-        lf_warn_append(&r->warnings, "%s", d->warnings);
+    lf_warn_block(&r->warnings, d->warnings);
     if (read_film(r, d, err) || read_sampler(r, d, err) || read_filter(r, d, err) || read_integrator(r, d, err) ||
         make_camera(r, d, err))
         goto fail;
@@ -616,15 +618,11 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     } else if (lf_scene_build(d, &r->scene, err)) {
         goto fail;
     }
-    if (r->scene.warnings)
-        lf_warn_append(&r->warnings, "%s", r->scene.warnings);
+    lf_warn_block(&r->warnings, lf_warnings_text(&r->scene.warnings));
     if (r->scene.has_media && !r->integrator.volumetric) {
-        char where[512];
-        where_of(where, sizeof where, &d->integrator.loc);
-        lf_warn_append(&r->warnings,
-                       "%s: warning: Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
-                       "renders them",
-                       where);
+        lf_warn_at(&r->warnings, &d->integrator.loc,
+                   "Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
+                   "renders them");
     }
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
@@ -651,10 +649,7 @@ void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts)
     r->opts.progress_ctx = opts->progress_ctx;
 }
 
-const char *lf_renderer_warnings(const lf_renderer *r)
-{
-    return r->warnings;
-}
+const char *lf_renderer_warnings(const lf_renderer *r) { return lf_warnings_text(&r->warnings); }
 
 const char *lf_renderer_film_filename(const lf_renderer *r)
 {
@@ -690,7 +685,7 @@ void lf_renderer_free(lf_renderer *r)
     free(r->filter_name);
     free(r->integrator_name);
     free(r->scene_path);
-    free(r->warnings);
+    lf_warnings_free(&r->warnings);
     free(r);
 }
 

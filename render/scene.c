@@ -27,23 +27,6 @@
 #include "render/media.h"
 #include "render/scene.h"
 
-void lf_warn_append(char **buf, const char *fmt, ...)
-{
-    char line[1200];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
-    size_t old = *buf ? strlen(*buf) : 0, add = strlen(line);
-    char *n = realloc(*buf, old + add + 2);
-    if (!n)
-        return;
-    memcpy(n + old, line, add);
-    n[old + add] = '\n';
-    n[old + add + 1] = '\0';
-    *buf = n;
-}
-
 /* The keyframes of a shape's motion over the TransformTimes interval (Embree
  * time 0..1), evenly spaced; n == 1 for a static shape. */
 typedef struct motion {
@@ -104,11 +87,6 @@ static int push_light(builder *b, const lf_light *l)
     return 0;
 }
 
-static void loc_prefix(char *buf, size_t n, const lf_loc *loc)
-{
-    snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
-}
-
 /* Area light parameters shared by every emissive shape (AreaLightSource "diffuse"). */
 typedef struct area_emission {
     lf_vec3 L;
@@ -120,7 +98,7 @@ static int read_area_light(builder *b, int index, area_emission *ae)
 {
     lf_entity *e = &b->d->area_lights[index];
     char where[512];
-    loc_prefix(where, sizeof where, &e->loc);
+    lf_loc_format(where, sizeof where, &e->loc);
     if (strcmp(e->type, "diffuse") != 0)
         return lf_error_set(b->err, LF_ERR_UNSUPPORTED, "%s: unknown area light \"%s\" (expected \"diffuse\")", where,
                             e->type);
@@ -251,7 +229,7 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, fl
     for (int i = 0; i < 3 * nt; i++)
         if (idx[i] < 0 || idx[i] >= nv) {
             char where[512];
-            loc_prefix(where, sizeof where, &sh->e.loc);
+            lf_loc_format(where, sizeof where, &sh->e.loc);
             int bad = idx[i];
             free(P), free(N), free(uv), free(idx);
             return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"%s\": vertex index %d out of range (%d vertices)",
@@ -272,7 +250,7 @@ static int finish_mesh(builder *b, const lf_shape_desc *sh, const motion *mo, fl
             lf_vec3 p = lf_xform_point(&mo->keys[k], lf_v3(P[3 * i], P[3 * i + 1], P[3 * i + 2]));
             if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) {
                 char where[512];
-                loc_prefix(where, sizeof where, &sh->e.loc);
+                lf_loc_format(where, sizeof where, &sh->e.loc);
                 free(PW), free(NW), free(P), free(N), free(uv), free(idx);
                 return lf_error_set(b->err, LF_ERR_NUMERIC, "%s: Shape \"%s\": vertex %d is not finite", where,
                                     sh->e.type, i);
@@ -338,7 +316,7 @@ static int shape_trianglemesh(builder *b, lf_shape_desc *sh, const motion *mo)
     lf_params_find(ps, "S");
     lf_params_find(ps, "faceIndices");
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (!P || np < 9 || np % 3)
         return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"trianglemesh\" needs \"point3 P\" with at least 3 points",
                             where);
@@ -376,12 +354,11 @@ static int shape_plymesh(builder *b, lf_shape_desc *sh, const motion *mo)
     const char *fn = lf_params_string(ps, "filename", NULL);
     lf_params_find(ps, "displacement.edgelength");
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (!fn)
         return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"plymesh\" needs \"string filename\"", where);
     if (lf_params_find(ps, "displacement"))
-        lf_warn_append(&b->s->warnings, "%s: warning: plymesh displacement is not supported; rendering undisplaced",
-                       where);
+        lf_warn_at(&b->s->warnings, &sh->e.loc, "plymesh displacement is not supported; rendering undisplaced");
     char path[4096];
     if (fn[0] == '/' || !sh->base_dir || !sh->base_dir[0])
         snprintf(path, sizeof path, "%s", fn);
@@ -413,7 +390,7 @@ static int shape_loopsubdiv(builder *b, lf_shape_desc *sh, const motion *mo)
     const double *P = lf_params_nums(ps, "P", LF_PT_POINT3, &np);
     const double *I = lf_params_nums(ps, "indices", LF_PT_INTEGER, &ni);
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (ps->error.code)
         return lf_params_finish(ps, "Shape \"loopsubdiv\"", b->err);
     if (!P || np < 9)
@@ -530,7 +507,7 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
     double zmin = lf_params_float(ps, "zmin", -r), zmax = lf_params_float(ps, "zmax", r);
     double phimax = lf_params_float(ps, "phimax", 360.0);
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (!(r > 0) || !isfinite(r))
         return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"sphere\": radius must be positive and finite, got %g",
                             where, r);
@@ -566,10 +543,9 @@ static int shape_sphere(builder *b, lf_shape_desc *sh, const motion *mo)
             sp.n_keys = mo->n;
             double s1 = similarity_scale(&mo->keys[mo->n - 1]);
             if (fabs(s1 - scale) > 1e-6 * scale) {
-                char where[512];
-                loc_prefix(where, sizeof where, &sh->e.loc);
-                lf_warn_append(&b->s->warnings, "%s: warning: a sphere whose scale changes during the shutter keeps its "
-                               "starting radius", where);
+                lf_warn_at(&b->s->warnings, &sh->e.loc,
+                           "a sphere whose scale changes during the shutter keeps its "
+                           "starting radius");
             }
         }
         sp.object_to_world = *xf;
@@ -614,7 +590,7 @@ static int shape_disk(builder *b, lf_shape_desc *sh, const motion *mo)
     double prm[4] = {lf_params_float(ps, "height", 0.0), lf_params_float(ps, "radius", 1.0),
                      lf_params_float(ps, "innerradius", 0.0), lf_params_float(ps, "phimax", 360.0)};
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (!(prm[1] > 0) || !(prm[2] >= 0) || prm[2] >= prm[1])
         return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"disk\": need 0 <= innerradius < radius", where);
     prm[3] = lf_clampd(prm[3], 0, 360) * LF_PI / 180;
@@ -650,7 +626,7 @@ static int shape_bilinearmesh(builder *b, lf_shape_desc *sh, const motion *mo)
     lf_params_find(ps, "N");
     lf_params_find(ps, "faceIndices");
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (!P || np % 3 || np < 12)
         return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"bilinearmesh\" needs \"point3 P\" with at least 4 points",
                             where);
@@ -694,7 +670,7 @@ static const struct {
 static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
 {
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     const lf_param *alpha = sh->e.params.count ? lf_params_peek(&sh->e.params, "alpha") : NULL;
     if (alpha) {
         /* "float alpha" 1 changes nothing; anything else cuts the shape,
@@ -708,8 +684,7 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
                                 "the shape opaque)",
                                 where, sh->e.type);
         if (!opaque)
-            lf_warn_append(&b->s->warnings, "%s: warning: \"alpha\" cut-outs are not supported; the shape is opaque",
-                           where);
+            lf_warn_at(&b->s->warnings, &sh->e.loc, "\"alpha\" cut-outs are not supported; the shape is opaque");
     }
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {
@@ -725,8 +700,7 @@ static int build_shape(builder *b, lf_shape_desc *sh, const motion *mo)
         return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
                             "%s: Shape \"%s\" is not supported (--allow-unsupported renders the scene without it)",
                             where, sh->e.type);
-    lf_warn_append(&b->s->warnings, "%s: warning: Shape \"%s\" is not supported; it is left out of the render", where,
-                   sh->e.type);
+    lf_warn_at(&b->s->warnings, &sh->e.loc, "Shape \"%s\" is not supported; it is left out of the render", sh->e.type);
     for (size_t i = 0; i < sh->e.params.count; i++)
         sh->e.params.items[i].used = 1;
     return 0;
@@ -849,7 +823,7 @@ static int motion_keys(builder *b, lf_shape_desc *sh, const lf_anim_xform *inst,
     int animated = ax->animated || (inst && inst->animated);
     int requested = lf_params_int(&sh->e.params, "motionsegments", 0);
     char where[512];
-    loc_prefix(where, sizeof where, &sh->e.loc);
+    lf_loc_format(where, sizeof where, &sh->e.loc);
     if (requested < 0 || requested > MAX_MOTION_SEGMENTS)
         return lf_error_set(b->err, LF_ERR_PARAM,
                             "%s: \"motionsegments\" must be in 1..%d (Embree's limit of %d time steps), got %d", where,
@@ -1258,8 +1232,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         goto fail;
     if (lf_media_lookup(d, d->camera.medium, &d->camera.e.loc, "the camera's medium", &s->camera_medium, err))
         goto fail;
-    if (lf_materials_warnings(s->materials))
-        lf_warn_append(&s->warnings, "%s", lf_materials_warnings(s->materials));
+    lf_warn_block(&s->warnings, lf_materials_warnings(s->materials));
     for (size_t i = 0; i < d->n_shapes; i++) {
         lf_shape_desc *sh = &d->shapes[i];
         if (sh->object >= 0)
@@ -1505,7 +1478,7 @@ void lf_scene_free(lf_scene *s)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);
     free(s->media);
-    free(s->warnings);
+    lf_warnings_free(&s->warnings);
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;
 }

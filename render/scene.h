@@ -166,7 +166,7 @@ typedef struct lf_scene {
     int camera_medium;       /* medium camera rays start in (-1: vacuum) */
     int has_media;           /* some medium is reachable (the camera or a shape's MediumInterface):
                                 the volumetric integrator runs; otherwise the surface-only one */
-    char *warnings;
+    lf_warnings warnings;
 } lf_scene;
 
 int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err);
@@ -175,12 +175,16 @@ int lf_scene_build_white(lf_scene *s, lf_error *err);
 void lf_scene_free(lf_scene *s);
 /* How the moving shapes move, for --explain (one clause, no newline). */
 void lf_scene_motion_summary(const lf_scene *s, char *buf, size_t n);
-/* Appends a warning line to a malloc'ed buffer. */
-void lf_warn_append(char **buf, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
+/* Passes on a block of warnings gathered below (the scene description's,
+ * the materials'): a blank line closes each block, as lfrender has always
+ * printed them.  block may be NULL (none). */
+static inline void lf_warn_block(lf_warnings *w, const char *block)
+{
+    if (!block)
+        return;
+    lf_warn_text(w, block);
+    lf_warn_text(w, "\n");
+}
 
 /* A surface hit, everything the integrator needs. */
 typedef struct lf_hit {

@@ -70,8 +70,10 @@ typedef struct ply_reader {
  * offset) for binary data. */
 static int ply_fail(ply_reader *r, int in_header, const char *msg, const char *detail)
 {
-    if (in_header || r->format == PLY_ASCII)
-        return lf_error_set(r->err, LF_ERR_PARSE, "%s:%d: %s%s", r->path, r->line, msg, detail ? detail : "");
+    if (in_header || r->format == PLY_ASCII) {
+        lf_loc at = {r->path, r->line, 0};
+        return lf_error_at(r->err, LF_ERR_PARSE, &at, "%s%s", msg, detail ? detail : "");
+    }
     return lf_error_set(r->err, LF_ERR_PARSE, "%s: %s%s (at byte %zu)", r->path, msg, detail ? detail : "", r->pos);
 }
 

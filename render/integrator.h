@@ -1,5 +1,5 @@
 /* integrator.h - the integrators (render/ only): their settings, the path
- * (render/integrator.c) and volumetric path (render/media.c) estimators,
+ * (render/path.c) and volumetric path (render/volpath.c) estimators,
  * and the steps both take at a vertex (MIS weights, BSDF continuation,
  * roulette) as inlines so each stays one loop. */
 #ifndef LF_RENDER_INTEGRATOR_H

@@ -6,7 +6,7 @@
 #include "render/scene.h"
 
 /* A homogeneous participating medium (pbrt-v4 "homogeneous"), per RGB
- * channel, "scale" applied (render/media.c). */
+ * channel, "scale" applied. */
 struct lf_medium {
     lf_vec3 sigma_a, sigma_s, sigma_t;
     lf_vec3 Le;          /* emitted radiance, Lescale applied; emission is sigma_a Le per unit length */

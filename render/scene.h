@@ -1,7 +1,7 @@
 /* scene.h - the renderer's built scene (render/ only): world-space meshes
  * and analytic spheres on Embree, rigidly moving prototypes placed by
  * Embree instances, the lights and media it holds, and the ray queries on
- * it.  Built by render/scene.c from an lf_scene_desc. */
+ * it.  Built by render/scene_build.c from an lf_scene_desc. */
 #ifndef LF_RENDER_SCENE_H
 #define LF_RENDER_SCENE_H
 
@@ -107,7 +107,7 @@ typedef struct lf_proto {
  * time steps given as quaternion decompositions, so Embree slerps the
  * rotation (pbrt's decomposed interpolation) instead of moving vertices
  * along chords.  Hits go to the world by the same interpolation at the
- * ray's time, evaluated from the fields below (render/scene.c,
+ * ray's time, evaluated from the fields below (render/intersect.c,
  * instance_motion_at; rtcGetGeometryTransform agrees to ~2e-6 but costs
  * ~470 instructions a hit). */
 typedef struct lf_instance {
@@ -197,7 +197,7 @@ typedef struct lf_hit {
     int medium_in, medium_out; /* the shape's MediumInterface; medium_in LF_MEDIUM_SAME: no transition */
 } lf_hit;
 
-/* ---- intersection (render/scene.c) ---- */
+/* ---- intersection (render/intersect.c) ---- */
 /* tau: Embree ray time in [0,1] (scene time mapped over TransformTimes). */
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit);
 int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau);

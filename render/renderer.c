@@ -21,10 +21,10 @@
 #include "base/lf_parallel.h"
 #include "base/lf_progress.h"
 #include "base/lf_color.h"
-#include "film.h"
-#include "render_internal.h"
+#include "render/film.h"
+#include "render/render_internal.h"
 
-#define LF_VERSION_STRING "lensfield 0.1"
+#define LF_VERSION_STRING "lensfield " LF_VERSION /* LF_VERSION: CMake's project version (lf_base) */
 
 struct lf_renderer {
     lf_scene scene;
@@ -49,7 +49,7 @@ struct lf_renderer {
     char *filter_name;
     char *integrator_name;
     char *scene_path;
-    char *warnings;
+    lf_warnings warnings;
     lf_render_opts opts;
     int threads;
     lf_render_stats stats;
@@ -92,11 +92,6 @@ static char *dupstr(const char *s)
     return d;
 }
 
-static void where_of(char *buf, size_t n, const lf_loc *loc)
-{
-    snprintf(buf, n, "%s:%d:%d", loc->file ? loc->file : "<scene>", loc->line, loc->col);
-}
-
 /* An options-block directive (Film, Sampler, PixelFilter, Integrator,
  * Camera) as the readers take it: its parameters (an empty list when the
  * scene leaves the directive out), its type or pbrt's default, and
@@ -104,6 +99,7 @@ static void where_of(char *buf, size_t n, const lf_loc *loc)
 typedef struct option_entity {
     lf_paramset *ps, empty;
     const char *type;
+    const lf_loc *loc;
     char where[512];
 } option_entity;
 
@@ -112,7 +108,8 @@ static void option_entity_init(option_entity *o, lf_entity *e, const char *defau
     memset(&o->empty, 0, sizeof o->empty);
     o->ps = e->type ? &e->params : &o->empty;
     o->type = e->type ? e->type : default_type;
-    where_of(o->where, sizeof o->where, &e->loc);
+    o->loc = &e->loc;
+    lf_loc_format(o->where, sizeof o->where, &e->loc);
 }
 
 /* Reports the directive's unused or mistyped parameters ("Sampler \"halton\""). */
@@ -202,7 +199,7 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     lf_paramset *ps = oe.ps;
     const char *where = oe.where;
     if (f->type && strcmp(f->type, "rgb") != 0)
-        lf_warn_append(&r->warnings, "%s: warning: Film \"%s\" is rendered as Film \"rgb\"", where, f->type);
+        lf_warn_at(&r->warnings, oe.loc, "Film \"%s\" is rendered as Film \"rgb\"", f->type);
     r->xres = lf_params_int(ps, "xresolution", 1280);
     r->yres = lf_params_int(ps, "yresolution", 720);
     r->film_filename = dupstr(lf_params_string(ps, "filename", "pbrt.exr"));
@@ -213,8 +210,10 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     const char *sensor = lf_params_string(ps, "sensor", "cie1931");
     double wb = lf_params_float(ps, "whitebalance", 0.0);
     if (strcmp(sensor, "cie1931") != 0 || wb != 0.0)
-        lf_warn_append(&r->warnings, "%s: warning: Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
-                       "modelled; no white balance applied", where, sensor, wb);
+        lf_warn_at(&r->warnings, oe.loc,
+                   "Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
+                   "modelled; no white balance applied",
+                   sensor, wb);
     if (r->xres <= 0 || r->yres <= 0 || r->xres > 65536 || r->yres > 65536)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Film resolution %dx%d is out of range (1..65536)", where, r->xres,
                             r->yres);
@@ -310,11 +309,15 @@ static int read_sampler(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         if (r->sampler.spp > LF_PMJ_MAX)
             return lf_error_set(err, LF_ERR_PARAM, "%s: Sampler \"pmj02bn\" takes at most %d samples per pixel, got %d",
                                 where, LF_PMJ_MAX, r->sampler.spp);
-        if (n != r->sampler.spp)
-            lf_warn_append(&r->warnings,
-                           "%s: note: Sampler \"pmj02bn\": %d samples per pixel is not a power of 4; rounded up to %d "
-                           "(as pbrt-v4)",
-                           where, r->sampler.spp, n);
+        if (n != r->sampler.spp) {
+            /* a note, not a warning: pbrt-v4 does the same */
+            char note[1024];
+            snprintf(note, sizeof note,
+                     "%s: note: Sampler \"pmj02bn\": %d samples per pixel is not a power of 4; rounded up to %d "
+                     "(as pbrt-v4)",
+                     where, r->sampler.spp, n);
+            lf_warn_text(&r->warnings, note);
+        }
         r->sampler.spp = n;
     }
     if (lf_sampler_prepare(&r->sampler, r->xres, r->yres))
@@ -370,10 +373,10 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                             "%s: Integrator \"%s\" is not supported (it computes something other than radiance)", where,
                             type);
     if (strcmp(type, "path") && strcmp(type, "volpath"))
-        lf_warn_append(&r->warnings,
-                       "%s: warning: Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
-                       "image",
-                       where, type);
+        lf_warn_at(&r->warnings, oe.loc,
+                   "Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
+                   "image",
+                   type);
     r->integrator.volumetric = strcmp(type, "path") != 0;
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);
@@ -411,26 +414,16 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     return option_entity_finish(&oe, "Integrator", err);
 }
 
-static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+/* The shutter every camera shares (read by the host): open and close times,
+ * global or rolling, readout time and direction (docs/motion.md). */
+static int read_shutter(lf_renderer *r, const option_entity *oe, lf_error *err)
 {
-    lf_camera_desc *cd = &d->camera;
-    option_entity oe;
-    option_entity_init(&oe, &cd->e, "perspective");
-    lf_paramset *ps = oe.ps;
-    const char *type = oe.type, *where = oe.where;
-    r->camera_type = lf_camera_find(type);
-    if (!r->camera_type) {
-        char names[512] = "";
-        for (int i = 0; i < lf_camera_count(); i++) {
-            strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
-            strncat(names, lf_camera_at(i)->name, sizeof names - strlen(names) - 1);
-        }
-        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown camera \"%s\" (registered: %s)", where, type, names);
-    }
+    lf_paramset *ps = oe->ps;
+    const char *where = oe->where;
     r->shutter_open = lf_params_float(ps, "shutteropen", 0.0);
     r->shutter_close = lf_params_float(ps, "shutterclose", 1.0);
     if (r->shutter_close < r->shutter_open) {
-        lf_warn_append(&r->warnings, "%s: warning: shutterclose < shutteropen; swapping them (as pbrt does)", where);
+        lf_warn_at(&r->warnings, oe->loc, "shutterclose < shutteropen; swapping them (as pbrt does)");
         double t = r->shutter_open;
         r->shutter_open = r->shutter_close;
         r->shutter_close = t;
@@ -457,13 +450,19 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (!(r->readout >= 0) || !isfinite(r->readout))
         return lf_error_set(err, LF_ERR_PARAM, "%s: \"readouttime\" must be >= 0", where);
     if (r->readout > 0 && !r->rolling)
-        lf_warn_append(&r->warnings, "%s: warning: \"readouttime\" only matters with \"shutter\" \"rolling\"", where);
+        lf_warn_at(&r->warnings, oe->loc, "\"readouttime\" only matters with \"shutter\" \"rolling\"");
+    return 0;
+}
+
+/* "shuttercurve": (time fraction, efficiency) pairs over the exposure,
+ * piecewise linear, tabulated finely for importance sampling; sets
+ * r->curve_mean, the effective fraction of the exposure. */
+static int read_shutter_curve(lf_renderer *r, lf_paramset *ps, const char *where, lf_error *err)
+{
     size_t ncurve = 0;
     const double *curve = lf_params_nums(ps, "shuttercurve", LF_PT_FLOAT, &ncurve);
     r->curve_mean = 1.0;
     if (curve) {
-        /* (time fraction, efficiency) pairs over the exposure, piecewise linear,
-         * tabulated finely for importance sampling. */
         if (ncurve < 4 || ncurve % 2)
             return lf_error_set(err, LF_ERR_PARAM,
                                 "%s: \"shuttercurve\" needs (time efficiency) pairs, at least 2, got %zu numbers", where,
@@ -499,7 +498,15 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         r->has_curve = 1;
         r->curve_mean = sum / NB;
     }
-    r->imaging_ratio *= (r->shutter_close - r->shutter_open) * r->curve_mean;
+    return 0;
+}
+
+/* The camera model itself, created through the registry from its
+ * parameters (the plugin ABI's lf_camera_params). */
+static int create_camera(lf_renderer *r, lf_camera_desc *cd, const option_entity *oe, lf_error *err)
+{
+    lf_paramset *ps = oe->ps;
+    const char *type = oe->type, *where = oe->where;
     char cerr[1024] = "", cwarn[1024] = "";
     char scene_dir[4096] = ".";
     const char *scene_file = cd->e.loc.file ? cd->e.loc.file : r->scene_path;
@@ -517,9 +524,16 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Camera \"%s\": %s", where, type, cerr[0] ? cerr : "cannot create");
     }
     if (cwarn[0])
-        lf_warn_append(&r->warnings, "%s: warning: Camera \"%s\": %s", where, type, cwarn);
+        lf_warn_at(&r->warnings, oe->loc, "Camera \"%s\": %s", type, cwarn);
     r->camera_needs = r->camera_type->needs(r->camera);
     r->camera_name = dupstr(type);
+    return 0;
+}
+
+/* Where the camera is, and how it moves over the shutter. */
+static int read_camera_motion(lf_renderer *r, lf_scene_desc *d, const char *where, lf_error *err)
+{
+    lf_camera_desc *cd = &d->camera;
     r->world_to_camera = cd->world_to_camera.xf[0];
     r->camera_to_world = lf_transform_inverse(&cd->world_to_camera.xf[0]);
     r->camera_origin_world = lf_xform_point_d(&r->camera_to_world, (lf_dvec3){0, 0, 0});
@@ -542,6 +556,35 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         lf_motion_table_init(&r->camera_motion, 1e-9, 16384, &r->camera_table);
         r->camera_moving = 1;
     }
+    return 0;
+}
+
+static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
+{
+    lf_camera_desc *cd = &d->camera;
+    option_entity oe;
+    option_entity_init(&oe, &cd->e, "perspective");
+    const char *type = oe.type, *where = oe.where;
+    r->camera_type = lf_camera_find(type);
+    if (!r->camera_type) {
+        char names[512] = "";
+        for (int i = 0; i < lf_camera_count(); i++) {
+            strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
+            strncat(names, lf_camera_at(i)->name, sizeof names - strlen(names) - 1);
+        }
+        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown camera \"%s\" (registered: %s)", where, type, names);
+    }
+    int rc = read_shutter(r, &oe, err);
+    if (!rc)
+        rc = read_shutter_curve(r, oe.ps, where, err);
+    if (rc)
+        return rc;
+    r->imaging_ratio *= (r->shutter_close - r->shutter_open) * r->curve_mean;
+    rc = create_camera(r, cd, &oe, err);
+    if (!rc)
+        rc = read_camera_motion(r, d, where, err);
+    if (rc)
+        return rc;
     return option_entity_finish(&oe, "Camera", err);
 }
 
@@ -553,8 +596,7 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     r->opts = *opts;
     r->scene_path = dupstr(opts->scene_path);
-    if (d->warnings)
-        lf_warn_append(&r->warnings, "%s", d->warnings);
+    lf_warn_block(&r->warnings, d->warnings);
     if (read_film(r, d, err) || read_sampler(r, d, err) || read_filter(r, d, err) || read_integrator(r, d, err) ||
         make_camera(r, d, err))
         goto fail;
@@ -616,15 +658,11 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     } else if (lf_scene_build(d, &r->scene, err)) {
         goto fail;
     }
-    if (r->scene.warnings)
-        lf_warn_append(&r->warnings, "%s", r->scene.warnings);
+    lf_warn_block(&r->warnings, lf_warnings_text(&r->scene.warnings));
     if (r->scene.has_media && !r->integrator.volumetric) {
-        char where[512];
-        where_of(where, sizeof where, &d->integrator.loc);
-        lf_warn_append(&r->warnings,
-                       "%s: warning: Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
-                       "renders them",
-                       where);
+        lf_warn_at(&r->warnings, &d->integrator.loc,
+                   "Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
+                   "renders them");
     }
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
@@ -651,10 +689,7 @@ void lf_renderer_set_opts(lf_renderer *r, const lf_render_opts *opts)
     r->opts.progress_ctx = opts->progress_ctx;
 }
 
-const char *lf_renderer_warnings(const lf_renderer *r)
-{
-    return r->warnings;
-}
+const char *lf_renderer_warnings(const lf_renderer *r) { return lf_warnings_text(&r->warnings); }
 
 const char *lf_renderer_film_filename(const lf_renderer *r)
 {
@@ -690,7 +725,7 @@ void lf_renderer_free(lf_renderer *r)
     free(r->filter_name);
     free(r->integrator_name);
     free(r->scene_path);
-    free(r->warnings);
+    lf_warnings_free(&r->warnings);
     free(r);
 }
 
@@ -1226,6 +1261,92 @@ static int load_checkpoint(lf_renderer *r, job *jb, lf_error *err)
     return 0;
 }
 
+/* Renders on worker threads while the calling thread watches: periodic
+ * checkpoints and stop requests; a stopped render leaves a final
+ * checkpoint of every finished tile. */
+static int render_watched(lf_renderer *r, job *jb, int total, lf_error *err)
+{
+    int rc = 0;
+    lf_parallel_job *pj = lf_parallel_start(jb->n_order, r->threads, 1, render_tiles, jb);
+    double last = lf_seconds();
+    for (;;) {
+        long done = atomic_load(&jb->done_tiles);
+        if (done >= total || (r->opts.stop && *r->opts.stop))
+            break;
+        struct timespec ts = {0, 20 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+        if (r->opts.checkpoint_every > 0 && lf_seconds() - last >= r->opts.checkpoint_every) {
+            lf_error cerr = {0};
+            if (write_checkpoint(r, jb, &cerr) && !rc)
+                rc = lf_error_set(err, cerr.code, "checkpoint: %s", cerr.msg);
+            last = lf_seconds();
+        }
+    }
+    lf_parallel_join(pj);
+    if (atomic_load(&jb->done_tiles) < total) {
+        /* stopped: the final checkpoint holds every finished tile */
+        lf_error cerr = {0};
+        if (write_checkpoint(r, jb, &cerr))
+            rc = lf_error_set(err, cerr.code, "final checkpoint: %s", cerr.msg);
+        else
+            rc = lf_error_set(err, LF_ERR_INTERRUPTED,
+                              "interrupted with %ld of %d tiles done; checkpoint written to %s (continue with "
+                              "--resume)",
+                              atomic_load(&jb->done_tiles), total, r->opts.checkpoint_path);
+    }
+    return rc;
+}
+
+/* What the image's lensfield:* attributes record of this render. */
+static void render_attrs(const lf_renderer *r, lf_attrs *meta)
+{
+    lf_attrs_set_string(meta, LF_KEY_VERSION, LF_VERSION_STRING);
+    lf_attrs_set_string(meta, LF_KEY_CAMERA, r->camera_name);
+    if (r->scene_path)
+        lf_attrs_set_string(meta, LF_KEY_SCENE, r->scene_path);
+    lf_attrs_set_int(meta, LF_KEY_SPP, r->spp_end - r->spp_begin);
+    lf_attrs_set_string(meta, LF_KEY_SCENE_HASH, r->scene_hash);
+    lf_attrs_set_int(meta, LF_KEY_SAVEFP16, r->save_half);
+    if (r->opts.part) {
+        lf_attrs_set_int(meta, LF_KEY_PART, 1);
+        part_attrs(r, meta);
+    }
+    lf_attrs_set_int(meta, LF_KEY_SEED, (int)r->sampler.seed);
+    lf_attrs_set_string(meta, LF_KEY_SAMPLER, r->sampler_name);
+    lf_attrs_set_string(meta, LF_KEY_FILTER, r->filter_name);
+    lf_attrs_set_int(meta, LF_KEY_MAXDEPTH, r->integrator.max_depth);
+    lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, r->stats.seconds);
+    lf_attrs_set_int(meta, LF_KEY_THREADS, r->threads);
+    float res[2] = {(float)r->xres, (float)r->yres};
+    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
+    float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
+    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
+    lf_attrs_set_double(meta, LF_KEY_FILM_DIAGONAL_MM, r->diagonal_mm);
+    lf_attrs_set_double(meta, LF_KEY_SHUTTER_OPEN, r->shutter_open);
+    lf_attrs_set_double(meta, LF_KEY_SHUTTER_CLOSE, r->shutter_close);
+    lf_attrs_set_double(meta, LF_KEY_IMAGING_RATIO, r->imaging_ratio);
+    lf_attrs_set_int(meta, LF_KEY_NONFINITE_SAMPLES, (int)r->stats.nonfinite_samples);
+    double m[16];
+    for (int i = 0; i < 16; i++)
+        m[i] = r->world_to_camera.m[i / 4][i % 4];
+    lf_attrs_set_m44d(meta, LF_KEY_WORLD_TO_CAMERA, m);
+    if (r->white)
+        lf_attrs_set_int(meta, LF_KEY_WHITE, 1);
+    lf_attrs_set_string(meta, LF_KEY_SHUTTER, r->rolling ? "rolling" : "global");
+    if (r->rolling) {
+        lf_attrs_set_double(meta, LF_KEY_READOUT_TIME, r->readout);
+        lf_attrs_set_string(meta, LF_KEY_READOUT_DIRECTION,
+                            (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir]);
+    }
+    if (r->has_curve)
+        lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean);
+    lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed);
+    if (r->camera_type->metadata) {
+        lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
+        r->camera_type->metadata(r->camera, &sink);
+    }
+}
+
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err)
 {
     int w = r->px1 - r->px0, h = r->py1 - r->py0;
@@ -1266,34 +1387,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     if (!r->opts.checkpoint_path) {
         lf_parallel_for(jb.n_order, r->threads, 1, render_tiles, &jb); /* the calling thread renders too */
     } else {
-        /* the calling thread watches: periodic checkpoints and stop requests */
-        lf_parallel_job *pj = lf_parallel_start(jb.n_order, r->threads, 1, render_tiles, &jb);
-        double last = lf_seconds();
-        for (;;) {
-            long done = atomic_load(&jb.done_tiles);
-            if (done >= total || (r->opts.stop && *r->opts.stop))
-                break;
-            struct timespec ts = {0, 20 * 1000 * 1000};
-            nanosleep(&ts, NULL);
-            if (r->opts.checkpoint_every > 0 && lf_seconds() - last >= r->opts.checkpoint_every) {
-                lf_error cerr = {0};
-                if (write_checkpoint(r, &jb, &cerr) && !rc)
-                    rc = lf_error_set(err, cerr.code, "checkpoint: %s", cerr.msg);
-                last = lf_seconds();
-            }
-        }
-        lf_parallel_join(pj);
-        if (atomic_load(&jb.done_tiles) < total) {
-            /* stopped: the final checkpoint holds every finished tile */
-            lf_error cerr = {0};
-            if (write_checkpoint(r, &jb, &cerr))
-                rc = lf_error_set(err, cerr.code, "final checkpoint: %s", cerr.msg);
-            else
-                rc = lf_error_set(err, LF_ERR_INTERRUPTED,
-                                  "interrupted with %ld of %d tiles done; checkpoint written to %s (continue with "
-                                  "--resume)",
-                                  atomic_load(&jb.done_tiles), total, r->opts.checkpoint_path);
-        }
+        rc = render_watched(r, &jb, total, err);
     }
     pthread_mutex_destroy(&jb.progress_lock);
     if (!rc && r->opts.part) {
@@ -1317,52 +1411,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     r->stats.camera_paths = jb.paths;
     r->stats.nonfinite_samples = jb.nonfinite;
     r->stats.zero_weight_camera_rays = jb.zero_weight;
-    if (meta) {
-        lf_attrs_set_string(meta, LF_KEY_VERSION, LF_VERSION_STRING);
-        lf_attrs_set_string(meta, LF_KEY_CAMERA, r->camera_name);
-        if (r->scene_path)
-            lf_attrs_set_string(meta, LF_KEY_SCENE, r->scene_path);
-        lf_attrs_set_int(meta, LF_KEY_SPP, r->spp_end - r->spp_begin);
-        lf_attrs_set_string(meta, LF_KEY_SCENE_HASH, r->scene_hash);
-        lf_attrs_set_int(meta, LF_KEY_SAVEFP16, r->save_half);
-        if (r->opts.part) {
-            lf_attrs_set_int(meta, LF_KEY_PART, 1);
-            part_attrs(r, meta);
-        }
-        lf_attrs_set_int(meta, LF_KEY_SEED, (int)r->sampler.seed);
-        lf_attrs_set_string(meta, LF_KEY_SAMPLER, r->sampler_name);
-        lf_attrs_set_string(meta, LF_KEY_FILTER, r->filter_name);
-        lf_attrs_set_int(meta, LF_KEY_MAXDEPTH, r->integrator.max_depth);
-        lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, r->stats.seconds);
-        lf_attrs_set_int(meta, LF_KEY_THREADS, r->threads);
-        float res[2] = {(float)r->xres, (float)r->yres};
-        lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
-        float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
-        lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
-        lf_attrs_set_double(meta, LF_KEY_FILM_DIAGONAL_MM, r->diagonal_mm);
-        lf_attrs_set_double(meta, LF_KEY_SHUTTER_OPEN, r->shutter_open);
-        lf_attrs_set_double(meta, LF_KEY_SHUTTER_CLOSE, r->shutter_close);
-        lf_attrs_set_double(meta, LF_KEY_IMAGING_RATIO, r->imaging_ratio);
-        lf_attrs_set_int(meta, LF_KEY_NONFINITE_SAMPLES, (int)r->stats.nonfinite_samples);
-        double m[16];
-        for (int i = 0; i < 16; i++)
-            m[i] = r->world_to_camera.m[i / 4][i % 4];
-        lf_attrs_set_m44d(meta, LF_KEY_WORLD_TO_CAMERA, m);
-        if (r->white)
-            lf_attrs_set_int(meta, LF_KEY_WHITE, 1);
-        lf_attrs_set_string(meta, LF_KEY_SHUTTER, r->rolling ? "rolling" : "global");
-        if (r->rolling) {
-            lf_attrs_set_double(meta, LF_KEY_READOUT_TIME, r->readout);
-            lf_attrs_set_string(meta, LF_KEY_READOUT_DIRECTION,
-                                (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir]);
-        }
-        if (r->has_curve)
-            lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean);
-        lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed);
-        if (r->camera_type->metadata) {
-            lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
-            r->camera_type->metadata(r->camera, &sink);
-        }
-    }
+    if (meta)
+        render_attrs(r, meta);
     return 0;
 }

@@ -6,7 +6,7 @@
  * ActiveTransform), named coordinate systems, named materials and textures,
  * area lights attached to following shapes, object instancing.  It resolves
  * names to indices and includes, but it does not interpret shape, material or
- * light parameters: the scene builder (render/scene.c) does, and calls
+ * light parameters: the scene builder (render/scene_build.c) does, and calls
  * lf_params_finish() on every set it consumed so unused parameters are
  * reported with their location.
  *

@@ -480,7 +480,7 @@ struct parser {
 
     size_t cap_strings, cap_textures, cap_materials, cap_lights, cap_area_lights, cap_shapes, cap_objects,
         cap_instances, cap_media;
-    size_t warnings_len, warnings_cap;
+    lf_warnings warnings; /* its text is d->warnings */
     int warned_transform_begin;
     /* Errors are collected: the parse goes on at the next directive, and
      * every message (up to max_errors) is kept here, one per line. */
@@ -493,15 +493,14 @@ struct parser {
 
 static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
 {
-    char msg[900], line[1100];
+    char msg[900];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    if (loc)
-        snprintf(line, sizeof line, "%s:%d:%d: %s", loc->file ? loc->file : "<unknown>", loc->line, loc->col, msg);
-    else
-        snprintf(line, sizeof line, "%s", msg);
+    lf_error one = {0};
+    lf_error_at(&one, code, loc, "%s", msg);
+    const char *line = one.msg;
     if (P->n_errors++ == 0)
         P->first_code = code;
     lf_error_set(P->err, code, "%s", line);
@@ -533,28 +532,13 @@ static void pwarn(parser *P, const lf_loc *loc, const char *fmt, ...)
 
 static void pwarn(parser *P, const lf_loc *loc, const char *fmt, ...)
 {
-    char msg[900], line[1024];
+    char msg[900];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    int n = snprintf(line, sizeof line, "%s:%d:%d: warning: %s\n", loc->file, loc->line, loc->col, msg);
-    if (n < 0)
-        return;
-    size_t len = (size_t)n < sizeof line ? (size_t)n : sizeof line - 1;
-    lf_scene_desc *d = P->d;
-    if (P->warnings_len + len + 1 > P->warnings_cap) {
-        size_t cap = P->warnings_cap ? P->warnings_cap : 256;
-        while (cap < P->warnings_len + len + 1)
-            cap *= 2;
-        char *w = realloc(d->warnings, cap);
-        if (!w)
-            return; /* a lost warning is not worth failing the parse */
-        d->warnings = w;
-        P->warnings_cap = cap;
-    }
-    memcpy(d->warnings + P->warnings_len, line, len + 1);
-    P->warnings_len += len;
+    lf_warn_at(&P->warnings, loc, "%s", msg);
+    P->d->warnings = P->warnings.text; /* the description owns the text */
 }
 
 /* Keeps a copy of s alive as long as the description (file names for
@@ -1282,9 +1266,12 @@ static int pop_state(parser *P, char kind, const token *dir)
     if (P->n_stack == 0)
         return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s without a matching %s", (int)dir->n, dir->s, block_name(kind));
     pushed *e = &P->stack[P->n_stack - 1];
-    if (e->kind != kind)
-        return perr(P, LF_ERR_PARSE, &dir->loc, "mismatched nesting: %.*s closes the %s at %s:%d:%d", (int)dir->n,
-                    dir->s, block_name(e->kind), e->loc.file, e->loc.line, e->loc.col);
+    if (e->kind != kind) {
+        char opened[512];
+        lf_loc_format(opened, sizeof opened, &e->loc);
+        return perr(P, LF_ERR_PARSE, &dir->loc, "mismatched nesting: %.*s closes the %s at %s", (int)dir->n, dir->s,
+                    block_name(e->kind), opened);
+    }
     if (kind == 't') {
         P->gs.ctm[0] = e->saved.ctm[0];
         P->gs.ctm[1] = e->saved.ctm[1];
@@ -1715,8 +1702,10 @@ static int d_make_named_material(parser *P, lexer *L, const token *dir)
         int prev = strmap_get(&P->material_map, m->name);
         if (prev >= 0) {
             const lf_loc *pl = &d->materials[prev].e.loc;
-            rc = perr(P, LF_ERR_PARSE, &name_loc, "named material \"%s\" redefined (first defined at %s:%d:%d)",
-                      m->name, pl->file, pl->line, pl->col);
+            char first[512];
+            lf_loc_format(first, sizeof first, pl);
+            rc = perr(P, LF_ERR_PARSE, &name_loc, "named material \"%s\" redefined (first defined at %s)", m->name,
+                      first);
         }
     }
     if (!rc) {
@@ -1807,8 +1796,10 @@ static int d_texture(parser *P, lexer *L, const token *dir)
         int prev = strmap_get(names, t->name);
         if (prev >= 0) {
             const lf_loc *pl = &d->textures[prev].e.loc;
-            rc = perr(P, LF_ERR_PARSE, &name_loc, "%s texture \"%s\" redefined (first defined at %s:%d:%d)", kind,
-                      t->name, pl->file, pl->line, pl->col);
+            char first[512];
+            lf_loc_format(first, sizeof first, pl);
+            rc = perr(P, LF_ERR_PARSE, &name_loc, "%s texture \"%s\" redefined (first defined at %s)", kind, t->name,
+                      first);
         }
     }
     if (!rc && strmap_put(names, t->name, (int)d->n_textures))

@@ -70,8 +70,10 @@ typedef struct ply_reader {
  * offset) for binary data. */
 static int ply_fail(ply_reader *r, int in_header, const char *msg, const char *detail)
 {
-    if (in_header || r->format == PLY_ASCII)
-        return lf_error_set(r->err, LF_ERR_PARSE, "%s:%d: %s%s", r->path, r->line, msg, detail ? detail : "");
+    if (in_header || r->format == PLY_ASCII) {
+        lf_loc at = {r->path, r->line, 0};
+        return lf_error_at(r->err, LF_ERR_PARSE, &at, "%s%s", msg, detail ? detail : "");
+    }
     return lf_error_set(r->err, LF_ERR_PARSE, "%s: %s%s (at byte %zu)", r->path, msg, detail ? detail : "", r->pos);
 }
 
@@ -362,6 +364,140 @@ static int push_tri(tri_buf *t, int a, int b, int c)
     return 0;
 }
 
+/* The vertex and face elements, their properties given roles; every other
+ * element is read past. */
+static void find_elements(ply_element *els, size_t n_els, ply_element **vertex, ply_element **face, int *has_normals,
+                          int *has_uv)
+{
+    *vertex = *face = NULL;
+    *has_normals = *has_uv = 0;
+    for (size_t i = 0; i < n_els; i++) {
+        if (!*vertex && strcmp(els[i].name, "vertex") == 0) {
+            *vertex = &els[i];
+            assign_roles(*vertex, has_normals, has_uv, 1);
+        } else if (!*face && strcmp(els[i].name, "face") == 0) {
+            *face = &els[i];
+            assign_roles(*face, NULL, NULL, 0);
+        } else {
+            for (size_t k = 0; k < els[i].n_props; k++)
+                els[i].props[k].role = ROLE_SKIP;
+        }
+    }
+}
+
+/* A mesh needs positions and faces; counts must fit the file. */
+static int check_elements(const char *path, size_t len, const ply_element *vertex, const ply_element *face,
+                          lf_error *err)
+{
+    int face_has_indices = 0;
+    if (face)
+        for (size_t k = 0; k < face->n_props; k++)
+            face_has_indices |= face->props[k].role == ROLE_INDICES;
+    if (!vertex || !has_xyz(vertex))
+        return lf_error_set(err, LF_ERR_PARSE, "%s: no \"vertex\" element with x, y and z properties", path);
+    if (!face || !face_has_indices)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: no \"face\" element with a vertex_indices list", path);
+    if (vertex->count > (size_t)INT32_MAX)
+        return lf_error_set(err, LF_ERR_PARSE, "%s: too many vertices (%zu)", path, vertex->count);
+    if (vertex->count > len) /* every vertex takes at least one byte: a corrupt count */
+        return lf_error_set(err, LF_ERR_PARSE, "%s: vertex count %zu exceeds the file size", path, vertex->count);
+    return 0;
+}
+
+/* One scalar property of element item, stored by its role. */
+static int read_scalar_property(ply_reader *r, const ply_property *p, const ply_element *el, size_t item,
+                                lf_ply_mesh *out)
+{
+    double v;
+    int got = read_scalar(r, p->type, &v);
+    if (got) {
+        char what[160];
+        snprintf(what, sizeof what, "\"%s\" of %s %zu", p->name, el->name, item);
+        return ply_fail(r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value for ", what);
+    }
+    float f = (float)v;
+    switch (p->role) {
+    case ROLE_X: out->P[3 * item] = f; break;
+    case ROLE_Y: out->P[3 * item + 1] = f; break;
+    case ROLE_Z: out->P[3 * item + 2] = f; break;
+    case ROLE_NX: out->N[3 * item] = f; break;
+    case ROLE_NY: out->N[3 * item + 1] = f; break;
+    case ROLE_NZ: out->N[3 * item + 2] = f; break;
+    case ROLE_U: out->uv[2 * item] = f; break;
+    case ROLE_V: out->uv[2 * item + 1] = f; break;
+    default: break;
+    }
+    return 0;
+}
+
+/* A polygon's vertex indices, kept between faces. */
+typedef struct poly_buf {
+    int *idx;
+    size_t cap;
+} poly_buf;
+
+/* One list property of element item: a face's vertex indices become a
+ * triangle fan; other lists are read past. */
+static int read_list_property(ply_reader *r, const ply_property *p, const ply_element *el, size_t item, size_t nv,
+                              poly_buf *poly, tri_buf *tris)
+{
+    char what[160];
+    double cnt, v;
+    int got = read_scalar(r, p->count_type, &cnt);
+    if (got || cnt < 0 || cnt > 1e6) {
+        snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
+        return ply_fail(r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad list count in ", what);
+    }
+    size_t n = (size_t)cnt;
+    if (p->role == ROLE_INDICES && n > poly->cap) {
+        int *np = realloc(poly->idx, n * sizeof *np);
+        if (!np)
+            return lf_error_set(r->err, LF_ERR_NOMEM, "%s: out of memory", r->path);
+        poly->idx = np;
+        poly->cap = n;
+    }
+    for (size_t k = 0; k < n; k++) {
+        if ((got = read_scalar(r, p->type, &v))) {
+            snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
+            return ply_fail(r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value in ", what);
+        }
+        if (p->role != ROLE_INDICES)
+            continue;
+        if (v < 0 || v >= (double)nv) {
+            snprintf(what, sizeof what, "%.0f in face %zu (%zu vertices)", v, item, nv);
+            return ply_fail(r, 0, "vertex index out of range: ", what);
+        }
+        poly->idx[k] = (int)v;
+    }
+    if (p->role != ROLE_INDICES)
+        return 0;
+    /* Fan from vertex 0: a quad gives (0,1,2) (0,2,3), as pbrt. */
+    for (size_t k = 1; k + 1 < n; k++)
+        if (push_tri(tris, poly->idx[0], poly->idx[k], poly->idx[k + 1]))
+            return lf_error_set(r->err, LF_ERR_NOMEM, "%s: out of memory", r->path);
+    return 0;
+}
+
+/* The data section: every element's items in order. */
+static int read_data(ply_reader *r, ply_element *els, size_t n_els, size_t nv, lf_ply_mesh *out, tri_buf *tris)
+{
+    if (r->format == PLY_ASCII)
+        r->line++; /* data starts on the line after end_header */
+    poly_buf poly = {0};
+    int rc = 0;
+    for (size_t ei = 0; ei < n_els && !rc; ei++) {
+        ply_element *el = &els[ei];
+        for (size_t item = 0; item < el->count && !rc; item++)
+            for (size_t pi = 0; pi < el->n_props && !rc; pi++) {
+                const ply_property *p = &el->props[pi];
+                rc = p->is_list ? read_list_property(r, p, el, item, nv, &poly, tris)
+                                : read_scalar_property(r, p, el, item, out);
+            }
+    }
+    free(poly.idx);
+    return rc;
+}
+
 int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -380,128 +516,22 @@ int lf_ply_read(const char *path, lf_ply_mesh *out, lf_error *err)
         free(buf);
         return rc;
     }
-
-    ply_element *vertex = NULL, *face = NULL;
-    int has_normals = 0, has_uv = 0;
-    for (size_t i = 0; i < n_els; i++) {
-        if (!vertex && strcmp(els[i].name, "vertex") == 0) {
-            vertex = &els[i];
-            assign_roles(vertex, &has_normals, &has_uv, 1);
-        } else if (!face && strcmp(els[i].name, "face") == 0) {
-            face = &els[i];
-            assign_roles(face, NULL, NULL, 0);
-        } else {
-            for (size_t k = 0; k < els[i].n_props; k++)
-                els[i].props[k].role = ROLE_SKIP;
-        }
-    }
+    ply_element *vertex, *face;
+    int has_normals, has_uv;
+    find_elements(els, n_els, &vertex, &face, &has_normals, &has_uv);
     tri_buf tris = {0};
-    int face_has_indices = 0;
-    if (face)
-        for (size_t k = 0; k < face->n_props; k++)
-            face_has_indices |= face->props[k].role == ROLE_INDICES;
-    if (!vertex || !has_xyz(vertex))
-        rc = lf_error_set(err, LF_ERR_PARSE, "%s: no \"vertex\" element with x, y and z properties", path);
-    else if (!face || !face_has_indices)
-        rc = lf_error_set(err, LF_ERR_PARSE, "%s: no \"face\" element with a vertex_indices list", path);
-    else if (vertex->count > (size_t)INT32_MAX)
-        rc = lf_error_set(err, LF_ERR_PARSE, "%s: too many vertices (%zu)", path, vertex->count);
-    else if (vertex->count > len) /* every vertex takes at least one byte: a corrupt count */
-        rc = lf_error_set(err, LF_ERR_PARSE, "%s: vertex count %zu exceeds the file size", path, vertex->count);
-    if (rc)
-        goto done;
-
-    size_t nv = vertex->count;
-    out->n_vertices = nv;
-    out->P = malloc((nv ? nv : 1) * 3 * sizeof *out->P);
-    out->N = has_normals ? malloc((nv ? nv : 1) * 3 * sizeof *out->N) : NULL;
-    out->uv = has_uv ? malloc((nv ? nv : 1) * 2 * sizeof *out->uv) : NULL;
-    if (!out->P || (has_normals && !out->N) || (has_uv && !out->uv)) {
-        rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory for %zu vertices", path, nv);
-        goto done;
+    rc = check_elements(path, len, vertex, face, err);
+    if (!rc) {
+        size_t nv = vertex->count;
+        out->n_vertices = nv;
+        out->P = malloc((nv ? nv : 1) * 3 * sizeof *out->P);
+        out->N = has_normals ? malloc((nv ? nv : 1) * 3 * sizeof *out->N) : NULL;
+        out->uv = has_uv ? malloc((nv ? nv : 1) * 2 * sizeof *out->uv) : NULL;
+        if (!out->P || (has_normals && !out->N) || (has_uv && !out->uv))
+            rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory for %zu vertices", path, nv);
+        else
+            rc = read_data(&r, els, n_els, nv, out, &tris);
     }
-
-    if (r.format == PLY_ASCII)
-        r.line++; /* data starts on the line after end_header */
-    int *poly = NULL;
-    size_t poly_cap = 0;
-    for (size_t ei = 0; ei < n_els && !rc; ei++) {
-        ply_element *el = &els[ei];
-        for (size_t item = 0; item < el->count && !rc; item++) {
-            for (size_t pi = 0; pi < el->n_props && !rc; pi++) {
-                ply_property *p = &el->props[pi];
-                double v;
-                char what[160];
-                if (!p->is_list) {
-                    int got = read_scalar(&r, p->type, &v);
-                    if (got) {
-                        snprintf(what, sizeof what, "\"%s\" of %s %zu", p->name, el->name, item);
-                        rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value for ",
-                                      what);
-                        break;
-                    }
-                    float f = (float)v;
-                    switch (p->role) {
-                    case ROLE_X: out->P[3 * item] = f; break;
-                    case ROLE_Y: out->P[3 * item + 1] = f; break;
-                    case ROLE_Z: out->P[3 * item + 2] = f; break;
-                    case ROLE_NX: out->N[3 * item] = f; break;
-                    case ROLE_NY: out->N[3 * item + 1] = f; break;
-                    case ROLE_NZ: out->N[3 * item + 2] = f; break;
-                    case ROLE_U: out->uv[2 * item] = f; break;
-                    case ROLE_V: out->uv[2 * item + 1] = f; break;
-                    default: break;
-                    }
-                    continue;
-                }
-                double cnt;
-                int got = read_scalar(&r, p->count_type, &cnt);
-                if (got || cnt < 0 || cnt > 1e6) {
-                    snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
-                    rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad list count in ",
-                                  what);
-                    break;
-                }
-                size_t n = (size_t)cnt;
-                if (p->role == ROLE_INDICES && n > poly_cap) {
-                    int *np = realloc(poly, n * sizeof *np);
-                    if (!np) {
-                        rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", path);
-                        break;
-                    }
-                    poly = np;
-                    poly_cap = n;
-                }
-                for (size_t k = 0; k < n; k++) {
-                    if ((got = read_scalar(&r, p->type, &v))) {
-                        snprintf(what, sizeof what, "list \"%s\" of %s %zu", p->name, el->name, item);
-                        rc = ply_fail(&r, 0, got == END_OF_DATA ? "unexpected end of data reading " : "bad value in ",
-                                      what);
-                        break;
-                    }
-                    if (p->role != ROLE_INDICES)
-                        continue;
-                    if (v < 0 || v >= (double)nv) {
-                        snprintf(what, sizeof what, "%.0f in face %zu (%zu vertices)", v, item, nv);
-                        rc = ply_fail(&r, 0, "vertex index out of range: ", what);
-                        break;
-                    }
-                    poly[k] = (int)v;
-                }
-                if (rc || p->role != ROLE_INDICES)
-                    continue;
-                /* Fan from vertex 0: a quad gives (0,1,2) (0,2,3), as pbrt. */
-                for (size_t k = 1; k + 1 < n; k++)
-                    if (push_tri(&tris, poly[0], poly[k], poly[k + 1])) {
-                        rc = lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", path);
-                        break;
-                    }
-            }
-        }
-    }
-    free(poly);
-
-done:
     free_elements(els, n_els);
     free(buf);
     if (rc) {

@@ -225,20 +225,13 @@ float lf_tex_input_float(const lf_tex_input *in, const lf_shading_ctx *ctx);
 lf_vec3 lf_tex_input_rgb(const lf_tex_input *in, const lf_shading_ctx *ctx);
 void lf_bump_shading(const lf_tex_input *disp, const lf_shading_ctx *ctx, lf_shading_ctx *out);
 
-/* Builds d's texture td (which may use the textures in texs); warnings are
- * appended to *warnings. */
-int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, char **warnings, lf_texture **out,
+/* Builds d's texture td (which may use the textures in texs); warnings go
+ * to *warnings. */
+int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings *warnings, lf_texture **out,
                    lf_error *err);
 void lf_texture_free(lf_texture *t); /* accepts NULL */
 const char *lf_texture_name(const lf_texture *t);
 int lf_texture_is_float(const lf_texture *t);
-
-/* Appends "file:line:col: warning: <message>\n" to *buf (ignores out of memory). */
-void lf_shading_warn(char **buf, const lf_loc *loc, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
 
 /* Index of refraction of pbrt-v4's named glasses ("glass-BK7", ...) at
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */

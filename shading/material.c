@@ -63,7 +63,7 @@ struct lf_materials {
     size_t count;
     lf_material def; /* index -1 */
     lf_texture_list texs;
-    char *warnings;
+    lf_warnings warnings;
 };
 
 /* --------------------------------------------------------- named glasses */
@@ -98,8 +98,6 @@ float lf_named_glass_eta(const char *name, float lambda_nm)
 }
 
 /* --------------------------------------------------------- reading */
-
-static const char *lf_file(const lf_loc *l) { return l->file ? l->file : "<unknown>"; }
 
 static int read_roughness(lf_paramset *ps, const char *prefix, const lf_texture_list *texs, roughness *r,
                           lf_error *err)
@@ -172,9 +170,8 @@ static int read_eta(lf_paramset *ps, const char *name, float def, float *eta, lf
         *eta = (float)x;
     } else if (pk->type == LF_PT_TEXTURE) {
         lf_params_find(ps, name);
-        return lf_error_set(err, LF_ERR_UNSUPPORTED,
-                            "%s:%d:%d: \"%s\" must be a float or a spectrum, not a texture (as in pbrt-v4)", lf_file(l),
-                            l->line, l->col, name);
+        return lf_error_at(err, LF_ERR_UNSUPPORTED, l,
+                           "\"%s\" must be a float or a spectrum, not a texture (as in pbrt-v4)", name);
     } else if (pk->type == LF_PT_FLOAT) {
         *eta = (float)lf_params_float(ps, name, def);
     } else {
@@ -186,8 +183,7 @@ static int read_eta(lf_paramset *ps, const char *name, float def, float *eta, lf
     if (*eta == 0.f)
         *eta = 1.f;
     if (!(*eta > 0.f) || !isfinite(*eta))
-        return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: \"%s\" must be positive, got %g", lf_file(l), l->line,
-                            l->col, name, *eta);
+        return lf_error_at(err, LF_ERR_PARAM, l, "\"%s\" must be positive, got %g", name, *eta);
     return LF_OK;
 }
 
@@ -201,9 +197,8 @@ static int read_conductor(lf_paramset *ps, const char *prefix, const lf_texture_
     int has_eta = lf_params_peek(ps, en) != NULL, has_k = lf_params_peek(ps, kn) != NULL;
     int has_r = lf_params_peek(ps, "reflectance") != NULL;
     if (has_r && (has_eta || has_k))
-        return lf_error_set(err, LF_ERR_PARAM,
-                            "%s:%d:%d: %s material: give either \"reflectance\" or \"%s\" and \"%s\", not both",
-                            lf_file(loc), loc->line, loc->col, m->type, en, kn);
+        return lf_error_at(err, LF_ERR_PARAM, loc,
+                           "%s material: give either \"reflectance\" or \"%s\" and \"%s\", not both", m->type, en, kn);
     if (has_r) {
         m->from_reflectance = 1;
         return lf_tex_input_read(ps, "reflectance", 0, LF_SPECTRUM_ALBEDO, lf_v3(0, 0, 0), texs, &m->reflectance, err);
@@ -241,7 +236,7 @@ static void conductor_index(const lf_material *m, const lf_shading_ctx *ctx, lf_
 
 /* Layered-material parameters that pbrt-v4's random walk uses and our
  * closed-form approximation does not: read them, warn when they matter. */
-static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, char **warnings,
+static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, lf_warnings *warnings,
                              lf_error *err)
 {
     lf_tex_input thick, albedo, g;
@@ -253,26 +248,25 @@ static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_ma
     if (rc)
         return rc;
     if (thick.tex) {
-        lf_shading_warn(warnings, &lf_params_peek(ps, "thickness")->loc,
-                        "%s: a textured \"thickness\" is not supported; using 0.01", m->type);
+        lf_warn_at(warnings, &lf_params_peek(ps, "thickness")->loc,
+                   "%s: a textured \"thickness\" is not supported; using 0.01", m->type);
         m->thickness = 0.01f;
     } else {
         m->thickness = fmaxf(0.f, thick.value.x);
     }
     if (albedo.tex || !lf_is_black(albedo.value))
-        lf_shading_warn(warnings, &lf_params_peek(ps, "albedo")->loc,
-                        "%s: scattering inside the coat (\"albedo\") is not simulated; the layer is treated as clear",
-                        m->type);
+        lf_warn_at(warnings, &lf_params_peek(ps, "albedo")->loc,
+                   "%s: scattering inside the coat (\"albedo\") is not simulated; the layer is treated as clear",
+                   m->type);
     if (g.tex || g.value.x != 0.f)
-        lf_shading_warn(warnings, &lf_params_peek(ps, "g")->loc, "%s: \"g\" ignored (no scattering in the coat)",
-                        m->type);
+        lf_warn_at(warnings, &lf_params_peek(ps, "g")->loc, "%s: \"g\" ignored (no scattering in the coat)", m->type);
     int maxdepth = lf_params_int(ps, "maxdepth", 10), nsamples = lf_params_int(ps, "nsamples", 1);
     if (maxdepth != 10)
-        lf_shading_warn(warnings, &lf_params_peek(ps, "maxdepth")->loc,
-                        "%s: \"maxdepth\" ignored (the layers are summed in closed form)", m->type);
+        lf_warn_at(warnings, &lf_params_peek(ps, "maxdepth")->loc,
+                   "%s: \"maxdepth\" ignored (the layers are summed in closed form)", m->type);
     if (nsamples != 1)
-        lf_shading_warn(warnings, &lf_params_peek(ps, "nsamples")->loc,
-                        "%s: \"nsamples\" ignored (the layers are summed in closed form)", m->type);
+        lf_warn_at(warnings, &lf_params_peek(ps, "nsamples")->loc,
+                   "%s: \"nsamples\" ignored (the layers are summed in closed form)", m->type);
     return LF_OK;
 }
 
@@ -348,8 +342,7 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
         const lf_param *p = lf_params_peek(ps, "materials");
         const lf_loc *pl = p ? &p->loc : loc;
         if (!names || n != 2) {
-            rc = lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: mix material needs \"string materials\" with two names",
-                              lf_file(pl), pl->line, pl->col);
+            rc = lf_error_at(err, LF_ERR_PARAM, pl, "mix material needs \"string materials\" with two names");
         } else {
             /* The names are resolved by link_mixes once every material is read. */
             m->mix_index[0] = m->mix_index[1] = -2;
@@ -358,11 +351,9 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
             rc = lf_tex_input_read(ps, "amount", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(0.5f, 0.5f, 0.5f), texs, &m->amount,
                                    err);
     } else if (!strcmp(type, "measured") || !strcmp(type, "hair") || !strcmp(type, "subsurface")) {
-        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s:%d:%d: material \"%s\" is not supported", lf_file(loc),
-                            loc->line, loc->col, type);
+        return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "material \"%s\" is not supported", type);
     } else {
-        return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s:%d:%d: unknown material \"%s\"", lf_file(loc), loc->line,
-                            loc->col, type);
+        return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "unknown material \"%s\"", type);
     }
     if (rc)
         return rc;
@@ -380,8 +371,7 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
         if (np) {
             const char *fn = lf_params_string(ps, "normalmap", "");
             if (fn && *fn)
-                lf_shading_warn(&ms->warnings, &np->loc, "%s: \"normalmap\" \"%s\" is not supported; ignored", m->type,
-                                fn);
+                lf_warn_at(&ms->warnings, &np->loc, "%s: \"normalmap\" \"%s\" is not supported; ignored", m->type, fn);
         }
     }
     if (m->kind == MAT_COATED_DIFFUSE || m->kind == MAT_COATED_CONDUCTOR) {
@@ -415,8 +405,8 @@ static int link_mixes(lf_scene_desc *d, lf_materials *ms, lf_error *err)
                     break;
                 }
             if (found < 0)
-                return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: mix material: named material \"%s\" is not defined",
-                                    lf_file(&p->loc), p->loc.line, p->loc.col, name);
+                return lf_error_at(err, LF_ERR_PARAM, &p->loc, "mix material: named material \"%s\" is not defined",
+                                   name);
             m->mix_index[k] = found;
             m->mix[k] = &ms->items[found];
         }
@@ -439,9 +429,9 @@ static int link_mixes(lf_scene_desc *d, lf_materials *ms, lf_error *err)
                 int nx = m->mix_index[k];
                 if (nx == (int)i || dd + 1 > (int)ms->count || top >= 62) {
                     const lf_loc *l = &ms->items[i].loc;
-                    return lf_error_set(err, LF_ERR_PARAM,
-                                        "%s:%d:%d: mix material \"%s\" contains itself (or nests too deeply)", lf_file(l),
-                                        l->line, l->col, d->materials[i].name ? d->materials[i].name : "");
+                    return lf_error_at(err, LF_ERR_PARAM, l,
+                                       "mix material \"%s\" contains itself (or nests too deeply)",
+                                       d->materials[i].name ? d->materials[i].name : "");
                 }
                 stack[top] = nx;
                 depth[top++] = dd + 1;
@@ -501,11 +491,11 @@ void lf_materials_free(lf_materials *ms)
     for (size_t i = 0; i < ms->texs.count; i++)
         lf_texture_free(ms->texs.items[i]);
     free(ms->texs.items);
-    free(ms->warnings);
+    lf_warnings_free(&ms->warnings);
     free(ms);
 }
 
-const char *lf_materials_warnings(const lf_materials *ms) { return ms ? ms->warnings : NULL; }
+const char *lf_materials_warnings(const lf_materials *ms) { return ms ? lf_warnings_text(&ms->warnings) : NULL; }
 
 const lf_material *lf_materials_get(const lf_materials *ms, int index)
 {

@@ -14,7 +14,6 @@
 #include "image/lf_image.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,28 +53,6 @@ struct lf_texture {
     float scale;
 };
 
-/* ------------------------------------------------------------- warnings */
-
-void lf_shading_warn(char **buf, const lf_loc *loc, const char *fmt, ...)
-{
-    char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    char line[1400];
-    int n = snprintf(line, sizeof line, "%s:%d:%d: warning: %s\n", loc && loc->file ? loc->file : "<unknown>",
-                     loc ? loc->line : 0, loc ? loc->col : 0, msg);
-    if (n < 0)
-        return;
-    size_t old = *buf ? strlen(*buf) : 0, add = strlen(line);
-    char *nb = realloc(*buf, old + add + 1);
-    if (!nb)
-        return;
-    memcpy(nb + old, line, add + 1);
-    *buf = nb;
-}
-
 /* ------------------------------------------------------------- inputs */
 
 static const lf_texture *find_texture(const lf_texture_list *texs, const char *name, int is_float)
@@ -98,17 +75,15 @@ int lf_tex_input_read(lf_paramset *ps, const char *name, int is_float, lf_spectr
         lf_param *p = lf_params_find(ps, name);
         const lf_loc *l = &p->loc;
         if (p->n_strs != 1)
-            return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: texture parameter \"%s\" needs exactly one name",
-                                l->file ? l->file : "<unknown>", l->line, l->col, name);
+            return lf_error_at(err, LF_ERR_PARAM, l, "texture parameter \"%s\" needs exactly one name", name);
         out->tex = find_texture(texs, p->strs[0], is_float);
         if (!out->tex) {
             const lf_texture *other = find_texture(texs, p->strs[0], !is_float);
-            return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: %s texture \"%s\" (parameter \"%s\") is not defined%s",
-                                l->file ? l->file : "<unknown>", l->line, l->col, is_float ? "float" : "spectrum",
-                                p->strs[0], name,
-                                other ? (is_float ? " (there is a spectrum texture of that name)"
-                                                  : " (there is a float texture of that name)")
-                                      : "");
+            return lf_error_at(err, LF_ERR_PARAM, l, "%s texture \"%s\" (parameter \"%s\") is not defined%s",
+                               is_float ? "float" : "spectrum", p->strs[0], name,
+                               other ? (is_float ? " (there is a spectrum texture of that name)"
+                                                 : " (there is a float texture of that name)")
+                                     : "");
         }
         return LF_OK;
     }
@@ -194,9 +169,9 @@ static int read_mapping(lf_texture_desc *td, mapping2d *m, lf_error *err)
     } else {
         const lf_param *p = lf_params_peek(ps, "mapping");
         const lf_loc *l = p ? &p->loc : &td->e.loc;
-        return lf_error_set(err, LF_ERR_PARAM,
-                            "%s:%d:%d: texture \"%s\": unknown mapping \"%s\" (uv, spherical, cylindrical, planar)",
-                            l->file ? l->file : "<unknown>", l->line, l->col, td->name, kind);
+        return lf_error_at(err, LF_ERR_PARAM, l,
+                           "texture \"%s\": unknown mapping \"%s\" (uv, spherical, cylindrical, planar)", td->name,
+                           kind);
     }
     return LF_OK;
 }
@@ -236,20 +211,17 @@ static char *resolve_path(const char *scene_file, const char *filename)
     return out;
 }
 
-static int read_imagemap(lf_texture_desc *td, lf_texture *t, char **warnings, lf_error *err)
+static int read_imagemap(lf_texture_desc *td, lf_texture *t, lf_warnings *warnings, lf_error *err)
 {
     lf_paramset *ps = &td->e.params;
     const lf_loc *l = &td->e.loc;
-    const char *file = l->file ? l->file : "<unknown>";
     const char *filename = lf_params_string(ps, "filename", NULL);
     if (!filename || !*filename)
-        return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: imagemap texture \"%s\": \"filename\" must be given", file,
-                            l->line, l->col, td->name);
+        return lf_error_at(err, LF_ERR_PARAM, l, "imagemap texture \"%s\": \"filename\" must be given", td->name);
     const char *filter = lf_params_string(ps, "filter", "bilinear");
     if (strcmp(filter, "point") && strcmp(filter, "bilinear") && strcmp(filter, "trilinear") && strcmp(filter, "ewa") &&
         strcmp(filter, "EWA"))
-        return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: imagemap texture \"%s\": unknown filter \"%s\"", file,
-                            l->line, l->col, td->name, filter);
+        return lf_error_at(err, LF_ERR_PARAM, l, "imagemap texture \"%s\": unknown filter \"%s\"", td->name, filter);
     t->point_filter = strcmp(filter, "point") == 0;
     (void)lf_params_float(ps, "maxanisotropy", 8.0); /* EWA only; no differentials here */
     const char *wrap = lf_params_string(ps, "wrap", "repeat");
@@ -260,9 +232,9 @@ static int read_imagemap(lf_texture_desc *td, lf_texture *t, char **warnings, lf
     else if (!strcmp(wrap, "clamp"))
         t->wrap = WRAP_CLAMP;
     else
-        return lf_error_set(err, LF_ERR_UNSUPPORTED,
-                            "%s:%d:%d: imagemap texture \"%s\": wrap mode \"%s\" not supported (repeat, black, clamp)",
-                            file, l->line, l->col, td->name, wrap);
+        return lf_error_at(err, LF_ERR_UNSUPPORTED, l,
+                           "imagemap texture \"%s\": wrap mode \"%s\" not supported (repeat, black, clamp)", td->name,
+                           wrap);
     t->scale = (float)lf_params_float(ps, "scale", 1.0);
     t->invert = lf_params_bool(ps, "invert", 0);
 
@@ -282,14 +254,14 @@ static int read_imagemap(lf_texture_desc *td, lf_texture *t, char **warnings, lf
         gamma = (float)atof(enc + 6);
     else {
         free(path);
-        return lf_error_set(err, LF_ERR_PARAM,
-                            "%s:%d:%d: imagemap texture \"%s\": unknown encoding \"%s\" (sRGB, linear, \"gamma x\")",
-                            file, l->line, l->col, td->name, enc);
+        return lf_error_at(err, LF_ERR_PARAM, l,
+                           "imagemap texture \"%s\": unknown encoding \"%s\" (sRGB, linear, \"gamma x\")", td->name,
+                           enc);
     }
     lf_error ierr = {0};
     if (lf_image_read(path, &t->img, NULL, &ierr)) {
         int code = ierr.code ? ierr.code : LF_ERR_IO;
-        lf_error_set(err, code, "%s:%d:%d: imagemap texture \"%s\": %s", file, l->line, l->col, td->name, ierr.msg);
+        lf_error_at(err, code, l, "imagemap texture \"%s\": %s", td->name, ierr.msg);
         free(path);
         return code;
     }
@@ -306,13 +278,12 @@ static int read_imagemap(lf_texture_desc *td, lf_texture *t, char **warnings, lf
                 *v = gamma == 1.f ? code : powf(code, gamma);
             }
     } else if (!eight_bit && strcmp(enc, "linear") != 0 && lf_params_peek(ps, "encoding")) {
-        lf_shading_warn(warnings, &lf_params_peek(ps, "encoding")->loc,
-                        "imagemap \"%s\": \"encoding\" ignored for a floating-point image", filename);
+        lf_warn_at(warnings, &lf_params_peek(ps, "encoding")->loc,
+                   "imagemap \"%s\": \"encoding\" ignored for a floating-point image", filename);
     }
     free(path);
     if (t->img.channels < 1) {
-        return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: imagemap texture \"%s\": image has no channels", file,
-                            l->line, l->col, td->name);
+        return lf_error_at(err, LF_ERR_PARAM, l, "imagemap texture \"%s\": image has no channels", td->name);
     }
     return LF_OK;
 }
@@ -469,12 +440,11 @@ static int float_input(lf_texture_desc *td, const lf_texture_list *texs, const c
     return lf_tex_input_read(&td->e.params, name, 1, LF_SPECTRUM_UNBOUNDED, lf_v3(def, def, def), texs, out, err);
 }
 
-int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, char **warnings, lf_texture **out,
+int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings *warnings, lf_texture **out,
                    lf_error *err)
 {
     *out = NULL;
     const lf_loc *l = &td->e.loc;
-    const char *file = l->file ? l->file : "<unknown>";
     const char *cls = td->e.type ? td->e.type : "";
     lf_texture *t = calloc(1, sizeof *t);
     if (!t)
@@ -515,8 +485,8 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, char **warn
         if (dim != 2 && dim != 3) {
             const lf_param *p = lf_params_peek(&td->e.params, "dimension");
             const lf_loc *pl = p ? &p->loc : l;
-            rc = lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: checkerboard texture \"%s\": dimension %d (must be 2 or 3)",
-                              pl->file ? pl->file : "<unknown>", pl->line, pl->col, td->name, dim);
+            rc = lf_error_at(err, LF_ERR_PARAM, pl, "checkerboard texture \"%s\": dimension %d (must be 2 or 3)",
+                             td->name, dim);
         } else {
             t->cls = dim == 2 ? TEX_CHECKER2D : TEX_CHECKER3D;
             if (dim == 2)
@@ -532,10 +502,10 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, char **warn
         if (!rc)
             rc = read_imagemap(td, t, warnings, err);
     } else {
-        rc = lf_error_set(err, LF_ERR_UNSUPPORTED,
-                          "%s:%d:%d: texture \"%s\": %s texture class \"%s\" not supported (constant, scale, mix, "
-                          "bilerp, checkerboard, imagemap)",
-                          file, l->line, l->col, td->name, td->is_float ? "float" : "spectrum", cls);
+        rc = lf_error_at(err, LF_ERR_UNSUPPORTED, l,
+                         "texture \"%s\": %s texture class \"%s\" not supported (constant, scale, mix, "
+                         "bilerp, checkerboard, imagemap)",
+                         td->name, td->is_float ? "float" : "spectrum", cls);
     }
     if (!rc) {
         char ctx[256];

@@ -33,6 +33,10 @@ if [ -n "$hits" ]; then bad "relative includes: $hits"; else ok; fi
 # Libraries never print to stdout/stderr or exit (only tools/ do).
 hits=$(grep -nE "\b(exit|abort)\(|\bprintf\(|fprintf\(std(out|err)|\bputs\(|perror\(" base/*.c image/*.c image/*.cpp camera/*.c scenefile/*.c shading/*.c render/*.c lightfield/*.c grade/*.c web/*.c 2>/dev/null | grep -v "^\s*//" )
 if [ -n "$hits" ]; then bad "a library prints or exits: $hits"; else ok; fi
+# Locations are formatted once (lf_loc_format, lf_error_at, lf_warn_at in
+# base/lf_error.h), not by hand, in the renderer's folders.
+hits=$(grep -n '%s:%d' scenefile/*.c shading/*.c render/*.c 2>/dev/null)
+if [ -n "$hits" ]; then bad "hand-written file:line locations: $hits"; else ok; fi
 # lensfield:* attribute names are spelled once, in base/lf_keys.h.
 hits=$(grep -nE '"lensfield:[a-z_0-9]+"' base/*.c image/*.c image/*.cpp camera/*.c scenefile/*.c shading/*.c render/*.c lightfield/*.c grade/*.c web/*.c tools/*.c 2>/dev/null)
 if [ -n "$hits" ]; then bad "attribute names spelled outside base/lf_keys.h: $hits"; else ok; fi

@@ -12,25 +12,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "render_internal.h"
+#include "render/integrator.h"
 
-
-double lf_light_pmf(const lf_scene *s, lf_light_sampler ls, int light)
-{
-    if (s->lights[light].kind == LF_LIGHT_INFINITE_UNIFORM)
-        return 0.0; /* never sampled by NEE (lf_scene.nee_lights) */
-    switch (ls) {
-    case LF_LIGHTS_ALL:
-        return 1.0;
-    case LF_LIGHTS_UNIFORM:
-        return 1.0 / s->n_nee_lights;
-    default:
-        return lf_distrib1d_pmf(&s->light_distrib, light);
-    }
-}
-
-/* Direct lighting at a non-specular surface: one light sample, MIS-weighted.
- * ul chooses the light; the light position pair comes from st. */
 /* Light li's direct contribution at a non-specular surface, sampled with
  * (u0, u1) and chosen with probability pmf; MIS-weighted. */
 static lf_vec3 light_direct(const lf_scene *s, const lf_hit *h, const lf_bsdf *bsdf, lf_vec3 wo, int li, double pmf,

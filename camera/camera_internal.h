@@ -49,8 +49,10 @@ static inline void lf_cam_chunks(lf_cam_chunk_fn chunk, const void *state, int n
         chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
 }
 
-/* A library's lf_error into a create call's message buffer (the plugin
- * ABI, lf_camera.h, keeps char buffers).  Returns rc. */
+/* A library's lf_error into a create call's message buffer: the one place
+ * where the built-in cameras meet the plugin ABI's char buffers
+ * (lf_camera.h); everything below create reports into an lf_error.
+ * Returns rc. */
 static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size)
 {
     if (rc && buf && size)
@@ -59,9 +61,10 @@ static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size
 }
 
 /* "string sensor" (named format) or "float sensorsize" [w h] mm; default
- * full frame.  Returns 0, or -1 with a message in err. (camera/sensor.c) */
+ * full frame; name receives the format's name ("custom" for a size).
+ * Returns 0, or LF_ERR_PARAM with the message in err. (camera/sensor.c) */
 int lf_cam_read_sensor(const lf_camera_params *p, double *w_mm, double *h_mm, char *name, size_t name_size,
-                       char *err, size_t err_size);
+                       lf_error *err);
 
 /* For describe(): appends to buf (size bytes) with snprintf semantics; the
  * caller's int n stays the would-be length. */

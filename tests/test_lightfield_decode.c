@@ -282,11 +282,11 @@ static void test_layouts(void)
     CHECK(strstr(err.msg, "lensfield:kind") && strstr(err.msg, "--camsperdim") && strstr(err.msg, "--pitch"));
     lf_error_clear(&err);
     /* camera-array attributes, as lfrender writes them */
-    lf_attrs_set_string(&a, "lensfield:kind", "camera-array");
+    lf_attrs_set_string(&a, "lensfield:kind", "camera-array", NULL);
     float cams[2] = {4, 3}, bounds[4] = {-0.3f, 0.3f, -0.2f, 0.2f};
-    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2);
-    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4);
-    lf_attrs_set_double(&a, "lensfield:fov_deg", 30);
+    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2, NULL);
+    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4, NULL);
+    lf_attrs_set_double(&a, "lensfield:fov_deg", 30, NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == 0);
     CHECK(lf_lightfield_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
     CHECK(out.tile_w == 20 && out.tile_h == 15);
@@ -319,7 +319,7 @@ static void test_layouts(void)
     CHECK(back.cams_x == 4 && back.cams_y == 3 && back.tile_w == 20 && fabs(back.fov_deg - 30) < 1e-9);
     CHECK(fabs(back.grid_bounds[2] + 0.2) < 1e-6);
     /* wrong types are parse errors */
-    lf_attrs_set_string(&a, "lensfield:kind", "hologram");
+    lf_attrs_set_string(&a, "lensfield:kind", "hologram", NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == LF_ERR_PARSE);
     lf_error_clear(&err);
     lf_attrs_free(&a);

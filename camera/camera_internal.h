@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "base/lf_error.h"
 #include "base/lf_math.h"
@@ -58,6 +59,24 @@ static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size
     if (rc && buf && size)
         snprintf(buf, size, "%s", e->msg);
     return rc;
+}
+
+/* The ABI's create calls keep their warnings as text in a char buffer; a
+ * library's lf_warnings (given without a place) reach it one message at a
+ * time: copies the message at *t into msg without the "warning: " and the
+ * newline of the channel's lines, and advances *t.  0 when none is left.
+ *   for (const char *t = lf_warnings_text(&w); lf_cam_next_warning(&t, msg, sizeof msg);) ... */
+static inline int lf_cam_next_warning(const char **t, char *msg, size_t size)
+{
+    static const char prefix[] = "warning: ";
+    if (!*t || !**t)
+        return 0;
+    const char *nl = strchr(*t, '\n');
+    size_t len = nl ? (size_t)(nl - *t) : strlen(*t);
+    size_t skip = strncmp(*t, prefix, sizeof prefix - 1) == 0 ? sizeof prefix - 1 : 0;
+    snprintf(msg, size, "%.*s", (int)(len - skip), *t + skip);
+    *t += nl ? len + 1 : len;
+    return 1;
 }
 
 /* "string sensor" (named format) or "float sensorsize" [w h] mm; default

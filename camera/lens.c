@@ -195,15 +195,14 @@ void lf_lens_free(lf_lens *lens)
     lens->n = 0;
 }
 
-int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, char *warn, size_t warn_size)
+int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, lf_warnings *w)
 {
     if (lens->stop < 0)
         return 0;
     double r = 0.5 * diameter_mm;
     if (r > lens->stop_max_radius_mm) {
-        if (warn && warn_size)
-            snprintf(warn, warn_size, "aperture diameter %g mm is larger than the stop of %s (%g mm); clamping it",
-                     diameter_mm, lens->path, 2.0 * lens->stop_max_radius_mm);
+        lf_warn_at(w, NULL, "aperture diameter %g mm is larger than the stop of %s (%g mm); clamping it", diameter_mm,
+                   lens->path, 2.0 * lens->stop_max_radius_mm);
         lens->s[lens->stop].aperture_radius_mm = lens->stop_max_radius_mm;
         return 1;
     }

@@ -211,9 +211,12 @@ static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, cons
     if (L->stop < 0) {
         warn(a, "%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
     } else {
-        char msg[600] = "";
-        if (lf_lens_set_stop_diameter(L, aperture_mm, msg, sizeof msg))
+        lf_warnings lw = {0};
+        char msg[1536];
+        lf_lens_set_stop_diameter(L, aperture_mm, &lw);
+        for (const char *t = lf_warnings_text(&lw); lf_cam_next_warning(&t, msg, sizeof msg);)
             warn(a, "%s", msg);
+        lf_warnings_free(&lw);
     }
     if (lf_lens_paraxial_analyse(L, &c->px) || !(c->px.efl_mm > 0.0))
         return lf_error_set(err, LF_ERR_PARAM, "%s: the lens forms no real image (afocal or negative focal length)",

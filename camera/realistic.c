@@ -187,9 +187,12 @@ static int load_lens(const lf_camera_create_args *a, realistic *c, const realist
     if (c->lens.stop < 0) {
         warn(a, wlen, "%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
     } else {
-        char msg[600] = "";
-        if (lf_lens_set_stop_diameter(&c->lens, rp->aperture_diameter, msg, sizeof msg))
+        lf_warnings lw = {0};
+        char msg[1536];
+        lf_lens_set_stop_diameter(&c->lens, rp->aperture_diameter, &lw);
+        for (const char *t = lf_warnings_text(&lw); lf_cam_next_warning(&t, msg, sizeof msg);)
             warn(a, wlen, "%s", msg);
+        lf_warnings_free(&lw);
     }
     if (lf_lens_paraxial_analyse(&c->lens, &c->px))
         return lf_error_set(err, LF_ERR_PARAM, "%s: the lens has no focal power (afocal)", path);

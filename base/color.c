@@ -292,8 +292,8 @@ int lf_spectrum_file_read(const char *path, double **nums, size_t *n_pairs, lf_e
                 const char *w = p;
                 while (w < end && !strchr(" \t\r\n\f\v,#", *w))
                     w++;
-                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: expected a number, got \"%.*s\"", path,
-                                  line, (int)((w - p) > 40 ? 40 : (w - p)), p);
+                rc = lf_error_at(err, LF_ERR_PARSE, &(lf_loc){path, line, 0},
+                                 "spectrum file: expected a number, got \"%.*s\"", (int)((w - p) > 40 ? 40 : (w - p)), p);
                 break;
             }
             if (n == cap) {
@@ -306,8 +306,8 @@ int lf_spectrum_file_read(const char *path, double **nums, size_t *n_pairs, lf_e
                 v = nv;
             }
             if (n % 2 == 0 && n >= 2 && !(x > v[n - 2])) {
-                rc = lf_error_set(err, LF_ERR_PARSE, "%s:%d: spectrum file: wavelengths must increase (%g after %g)",
-                                  path, line, x, v[n - 2]);
+                rc = lf_error_at(err, LF_ERR_PARSE, &(lf_loc){path, line, 0},
+                                 "spectrum file: wavelengths must increase (%g after %g)", x, v[n - 2]);
                 break;
             }
             v[n++] = x;

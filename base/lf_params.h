@@ -3,11 +3,12 @@
  *   Shape "sphere" "float radius" [2] "rgb reflectance" [.5 .5 .5]
  *
  * Every lookup marks the parameter as used.  A lookup whose type does not
- * match the declared type (e.g. "integer fov" looked up as float) records an
- * error in the set.  After a consumer has read everything it understands it
- * calls lf_params_finish(), which reports the first type error or the first
- * parameter nobody read, with the file:line:column where it was written, so
- * typos in scene files never pass silently (pbrt-v4 does the same).
+ * match the declared type (e.g. "integer fov" looked up as float) parks an
+ * lf_error in the set (the first one; lf_params_error reads it).  After a
+ * consumer has read everything it understands it calls lf_params_finish(),
+ * which reports the parked error or the first parameter nobody read, with
+ * the file:line:column where it was written, so typos in scene files never
+ * pass silently (pbrt-v4 does the same).
  *
  * pbrt type aliases are normalised by the parser: "point" -> point3,
  * "vector" -> vector3, "normal" -> normal3, "color" -> rgb.
@@ -56,8 +57,19 @@ typedef struct lf_param {
 typedef struct lf_paramset {
     lf_param *items;
     size_t count, cap;
-    lf_error error; /* first type mismatch found by a lookup */
+    /* The first error a lookup found (a type mismatch, a wrong value count,
+     * a bad colour), an lf_error like any other, carrying the parameter's
+     * file:line:col.  Lookups return their default instead of failing, so a
+     * directive reads its parameters one after another as pbrt-v4's do; the
+     * error is deferred, not lost: lf_params_finish reports it.  Read it
+     * with lf_params_error. */
+    lf_error error;
 } lf_paramset;
+
+/* The error parked by the lookups so far (code LF_OK when none), for a
+ * caller that must stop before lf_params_finish (e.g. a shape whose
+ * geometry a bad lookup left unread). */
+const lf_error *lf_params_error(const lf_paramset *ps);
 
 const char *lf_param_type_name(lf_param_type t);
 /* Parses a pbrt type word ("float", "point", "color", ...); -1 if unknown. */
@@ -77,8 +89,9 @@ lf_param *lf_params_find(lf_paramset *ps, const char *name);
 /* Finds by name without marking it used. */
 const lf_param *lf_params_peek(const lf_paramset *ps, const char *name);
 
-/* Single-value lookups: default when absent; type mismatch or a wrong value
- * count is recorded in ps->error and the default returned. */
+/* Single-value lookups: default when absent; a type mismatch or a wrong
+ * value count is parked in the set (lf_params_error) and the default
+ * returned. */
 double lf_params_float(lf_paramset *ps, const char *name, double def);
 int lf_params_int(lf_paramset *ps, const char *name, int def);
 int lf_params_bool(lf_paramset *ps, const char *name, int def);
@@ -106,7 +119,7 @@ typedef enum lf_spectrum_kind {
  * and a single float (grey).  Returns 1 if found, 0 if absent (out = def). */
 int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_vec3 def, lf_vec3 *out);
 
-/* Reports the first recorded type error or the first unused parameter:
+/* Reports the parked lookup error, else the first unused parameter:
  * "file:line:col: unused parameter "float fvo" in Camera "perspective"".
  * `context` names the directive, e.g. "Camera \"perspective\"". */
 int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err);

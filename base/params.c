@@ -181,19 +181,16 @@ lf_param *lf_params_find(lf_paramset *ps, const char *name)
     return p;
 }
 
-static const char *loc_file(const lf_loc *l) { return l->file ? l->file : "<unknown>"; }
-
 static void type_error(lf_paramset *ps, const lf_param *p, const char *expected)
 {
-    lf_error_set(&ps->error, LF_ERR_PARAM, "%s:%d:%d: parameter \"%s\" is declared %s, expected %s",
-                 loc_file(&p->loc), p->loc.line, p->loc.col, p->name, lf_param_type_name(p->type), expected);
+    lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc, "parameter \"%s\" is declared %s, expected %s", p->name,
+                lf_param_type_name(p->type), expected);
 }
 
 static void count_error(lf_paramset *ps, const lf_param *p, size_t expected, size_t got)
 {
-    lf_error_set(&ps->error, LF_ERR_PARAM, "%s:%d:%d: parameter \"%s %s\" expects %zu value%s, got %zu",
-                 loc_file(&p->loc), p->loc.line, p->loc.col, lf_param_type_name(p->type), p->name, expected,
-                 expected == 1 ? "" : "s", got);
+    lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc, "parameter \"%s %s\" expects %zu value%s, got %zu",
+                lf_param_type_name(p->type), p->name, expected, expected == 1 ? "" : "s", got);
 }
 
 /* Finds `name`, marks it used and checks its type and value count; NULL if
@@ -291,7 +288,6 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
     lf_param *p = lf_params_find(ps, name);
     if (!p)
         return 0;
-    const char *f = loc_file(&p->loc);
     lf_vec3 c;
     switch (p->type) {
     case LF_PT_RGB:
@@ -302,14 +298,13 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
         c = lf_v3((float)p->nums[0], (float)p->nums[1], (float)p->nums[2]);
         /* pbrt-v4 rejects these rather than guessing what was meant. */
         if (c.x < 0.f || c.y < 0.f || c.z < 0.f) {
-            lf_error_set(&ps->error, LF_ERR_PARAM, "%s:%d:%d: rgb parameter \"%s\" has a negative component",
-                         f, p->loc.line, p->loc.col, p->name);
+            lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc, "rgb parameter \"%s\" has a negative component", p->name);
             return 1;
         }
         if (kind == LF_SPECTRUM_ALBEDO && lf_maxc(c) > 1.f) {
-            lf_error_set(&ps->error, LF_ERR_PARAM,
-                         "%s:%d:%d: rgb albedo parameter \"%s\" (%g %g %g) has a component greater than 1", f,
-                         p->loc.line, p->loc.col, p->name, p->nums[0], p->nums[1], p->nums[2]);
+            lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc,
+                        "rgb albedo parameter \"%s\" (%g %g %g) has a component greater than 1", p->name, p->nums[0],
+                        p->nums[1], p->nums[2]);
             return 1;
         }
         break;
@@ -319,8 +314,8 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
             return 1;
         }
         if (!(p->nums[0] > 0.0)) {
-            lf_error_set(&ps->error, LF_ERR_PARAM, "%s:%d:%d: blackbody parameter \"%s\": temperature %g K is not positive",
-                         f, p->loc.line, p->loc.col, p->name, p->nums[0]);
+            lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc,
+                        "blackbody parameter \"%s\": temperature %g K is not positive", p->name, p->nums[0]);
             return 1;
         }
         c = lf_blackbody_rgb(p->nums[0]);
@@ -330,18 +325,17 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
     case LF_PT_SPECTRUM:
         if (p->n_strs == 1 && p->n_nums == 0) {
             if (lf_named_spectrum_rgb(p->strs[0], &c)) {
-                lf_error_set(&ps->error, LF_ERR_PARAM,
-                             "%s:%d:%d: spectrum parameter \"%s\": unknown named spectrum \"%s\" "
-                             "(the scene parser reads spectrum files)",
-                             f, p->loc.line, p->loc.col, p->name, p->strs[0]);
+                lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc,
+                            "spectrum parameter \"%s\": unknown named spectrum \"%s\" "
+                            "(the scene parser reads spectrum files)",
+                            p->name, p->strs[0]);
                 return 1;
             }
             break;
         }
         if (p->n_strs || p->n_nums < 2 || p->n_nums % 2) {
-            lf_error_set(&ps->error, LF_ERR_PARAM,
-                         "%s:%d:%d: spectrum parameter \"%s\" needs (wavelength, value) pairs or one name", f,
-                         p->loc.line, p->loc.col, p->name);
+            lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc,
+                        "spectrum parameter \"%s\" needs (wavelength, value) pairs or one name", p->name);
             return 1;
         } else {
             size_t n = p->n_nums / 2;
@@ -356,9 +350,9 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
                 v[i] = p->nums[2 * i + 1];
                 if (i > 0 && !(l[i] > l[i - 1])) {
                     free(l);
-                    lf_error_set(&ps->error, LF_ERR_PARAM,
-                                 "%s:%d:%d: spectrum parameter \"%s\": wavelengths must increase (%g after %g)", f,
-                                 p->loc.line, p->loc.col, p->name, p->nums[2 * i], p->nums[2 * i - 2]);
+                    lf_error_at(&ps->error, LF_ERR_PARAM, &p->loc,
+                                "spectrum parameter \"%s\": wavelengths must increase (%g after %g)", p->name,
+                                p->nums[2 * i], p->nums[2 * i - 2]);
                     return 1;
                 }
             }
@@ -383,16 +377,18 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
     return 1;
 }
 
+const lf_error *lf_params_error(const lf_paramset *ps) { return &ps->error; }
+
 int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err)
 {
-    if (ps->error.code != LF_OK)
-        return lf_error_set(err, ps->error.code, "%s", ps->error.msg);
+    const lf_error *parked = lf_params_error(ps);
+    if (parked->code != LF_OK)
+        return lf_error_set(err, parked->code, "%s", parked->msg);
     for (size_t i = 0; i < ps->count; i++) {
         const lf_param *p = &ps->items[i];
         if (!p->used)
-            return lf_error_set(err, LF_ERR_PARAM, "%s:%d:%d: unused parameter \"%s %s\" in %s", loc_file(&p->loc),
-                                p->loc.line, p->loc.col, lf_param_type_name(p->type), p->name,
-                                context ? context : "directive");
+            return lf_error_at(err, LF_ERR_PARAM, &p->loc, "unused parameter \"%s %s\" in %s",
+                               lf_param_type_name(p->type), p->name, context ? context : "directive");
     }
     return LF_OK;
 }

@@ -191,7 +191,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
-        lf_lens_set_stop_diameter(&L, 1e3, NULL, 0);
+        lf_lens_set_stop_diameter(&L, 1e3, NULL);
         if (lf_lens_focus_thick(&L, 3000.0, &L.film_distance_mm, &err)) {
             fprintf(stderr, "%s\n", err.msg);
             return 1;

@@ -37,126 +37,138 @@ static double star_area(int n)
     return n * star_inner_radius(n) * sin(M_PI / n);
 }
 
-int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, char *err, size_t err_size)
+/* The shape's kind, with the blade count and rotation it implies. */
+static int parse_kind(const char *shape, lf_aperture *a, int *default_blades, double *base_rotation, lf_error *err)
 {
-    memset(a, 0, sizeof *a);
-    const char *shape = p->get_string(p->ctx, "aperture", "circular");
-    int default_blades = 6;
-    double base_rotation = 0.0;
+    *default_blades = 6;
+    *base_rotation = 0.0;
     if (!strcmp(shape, "circular") || !strcmp(shape, "circle")) {
         a->kind = LF_APERTURE_CIRCLE;
     } else if (!strcmp(shape, "polygon")) {
         a->kind = LF_APERTURE_POLYGON;
     } else if (!strcmp(shape, "square")) {
         a->kind = LF_APERTURE_POLYGON;
-        default_blades = 4;
-        base_rotation = M_PI / 4.0; /* sides horizontal and vertical */
+        *default_blades = 4;
+        *base_rotation = M_PI / 4.0; /* sides horizontal and vertical */
     } else if (!strcmp(shape, "pentagon")) {
         a->kind = LF_APERTURE_POLYGON;
-        default_blades = 5;
+        *default_blades = 5;
     } else if (!strcmp(shape, "star")) {
         a->kind = LF_APERTURE_STAR;
-        default_blades = 5;
+        *default_blades = 5;
     } else if (shape[0] == '\0') {
-        snprintf(err, err_size, "\"aperture\" is empty (want circular, polygon, square, pentagon, star or an image)");
-        return -1;
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "\"aperture\" is empty (want circular, polygon, square, pentagon, star or an image)");
     } else {
         a->kind = LF_APERTURE_IMAGE;
     }
+    return LF_OK;
+}
+
+/* Polygons and stars: the area and the closed outline.  Polygons have their
+ * corners on the unit circle; stars alternate outer and inner vertices. */
+static int build_outline(lf_aperture *a, lf_error *err)
+{
+    int n = a->blades, star = a->kind == LF_APERTURE_STAR, m = star ? 2 * n : n;
+    a->area = star ? star_area(n) : polygon_area(n);
+    a->corners = malloc(sizeof *a->corners * (size_t)(m + 1));
+    if (!a->corners)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    double ri = star_inner_radius(n);
+    for (int k = 0; k <= m; k++) {
+        double t = M_PI / 2.0 + a->rotation_rad + (star ? M_PI : 2.0 * M_PI) * (k % m) / n;
+        double r = star && (k & 1) ? ri : 1.0;
+        a->corners[k][0] = r * cos(t);
+        a->corners[k][1] = r * sin(t);
+    }
+    return LF_OK;
+}
+
+/* An image aperture: the file's grey transmission, clamped to [0,1], and
+ * the table that samples it. */
+static int load_image(const lf_camera_params *p, const char *shape, lf_aperture *a, lf_error *err)
+{
+    char msg[512] = "";
+    int w = 0, h = 0;
+    float *px = NULL;
+    if (p->load_image(p->ctx, shape, &w, &h, &px, msg, sizeof msg))
+        return lf_error_set(err, LF_ERR_IO, "aperture image \"%s\": %s", shape, msg[0] ? msg : "cannot read it");
+    if (w <= 0 || h <= 0 || !px) {
+        free(px);
+        return lf_error_set(err, LF_ERR_PARAM, "aperture image \"%s\" is empty", shape);
+    }
+    size_t n = (size_t)w * h;
+    double *f = malloc(sizeof(double) * n);
+    if (!f) {
+        free(px);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for aperture image \"%s\"", shape);
+    }
+    double sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        /* transmission is a fraction: NaN/negative -> 0, above 1 -> 1 */
+        float t = px[i];
+        t = t > 0.f ? (t < 1.f ? t : 1.f) : 0.f;
+        px[i] = t;
+        f[i] = t;
+        sum += t;
+    }
+    if (!(sum > 0)) {
+        free(f);
+        free(px);
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "aperture image \"%s\" is all black: it lets no light through (white = open, black = "
+                            "closed)",
+                            shape);
+    }
+    lf_error e = {0};
+    if (lf_distrib2d_init(&a->distrib, f, w, h, &e)) {
+        free(f);
+        free(px);
+        return lf_error_set(err, e.code, "aperture image \"%s\": %s", shape, e.msg);
+    }
+    free(f);
+    a->img = px;
+    a->img_w = w;
+    a->img_h = h;
+    a->area = 4.0 * sum / (double)n; /* the image fills [-1,1]^2 */
+    return LF_OK;
+}
+
+int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, lf_error *err)
+{
+    memset(a, 0, sizeof *a);
+    const char *shape = p->get_string(p->ctx, "aperture", "circular");
+    int default_blades;
+    double base_rotation;
+    int rc = parse_kind(shape, a, &default_blades, &base_rotation, err);
+    if (rc)
+        return rc;
     a->blades = p->get_int(p->ctx, "blades", default_blades);
     double rot_deg = p->get_float(p->ctx, "aperturerotation", 0.0);
     a->anamorphic = p->get_float(p->ctx, "anamorphic", 1.0);
-    if ((a->kind == LF_APERTURE_POLYGON || a->kind == LF_APERTURE_STAR) && (a->blades < 3 || a->blades > 1000)) {
-        snprintf(err, err_size, "\"blades\" must be in 3..1000, got %d", a->blades);
-        return -1;
-    }
-    if (!isfinite(rot_deg)) {
-        snprintf(err, err_size, "\"aperturerotation\" must be finite");
-        return -1;
-    }
-    if (!(a->anamorphic > 0.0) || !isfinite(a->anamorphic)) {
-        snprintf(err, err_size, "\"anamorphic\" must be positive, got %g", a->anamorphic);
-        return -1;
-    }
+    if ((a->kind == LF_APERTURE_POLYGON || a->kind == LF_APERTURE_STAR) && (a->blades < 3 || a->blades > 1000))
+        return lf_error_set(err, LF_ERR_PARAM, "\"blades\" must be in 3..1000, got %d", a->blades);
+    if (!isfinite(rot_deg))
+        return lf_error_set(err, LF_ERR_PARAM, "\"aperturerotation\" must be finite");
+    if (!(a->anamorphic > 0.0) || !isfinite(a->anamorphic))
+        return lf_error_set(err, LF_ERR_PARAM, "\"anamorphic\" must be positive, got %g", a->anamorphic);
     a->rotation_rad = base_rotation + rot_deg * M_PI / 180.0;
     switch (a->kind) {
     case LF_APERTURE_CIRCLE:
         a->area = M_PI;
         break;
     case LF_APERTURE_POLYGON:
-    case LF_APERTURE_STAR: {
-        int n = a->blades, star = a->kind == LF_APERTURE_STAR, m = star ? 2 * n : n;
-        a->area = star ? star_area(n) : polygon_area(n);
-        a->corners = malloc(sizeof *a->corners * (size_t)(m + 1));
-        if (!a->corners) {
-            snprintf(err, err_size, "out of memory");
-            return -1;
-        }
-        /* polygons: corners on the unit circle; stars alternate outer and
-         * inner vertices */
-        double ri = star_inner_radius(n);
-        for (int k = 0; k <= m; k++) {
-            double t = M_PI / 2.0 + a->rotation_rad + (star ? M_PI : 2.0 * M_PI) * (k % m) / n;
-            double r = star && (k & 1) ? ri : 1.0;
-            a->corners[k][0] = r * cos(t);
-            a->corners[k][1] = r * sin(t);
-        }
+    case LF_APERTURE_STAR:
+        rc = build_outline(a, err);
+        break;
+    case LF_APERTURE_IMAGE:
+        rc = load_image(p, shape, a, err);
         break;
     }
-    case LF_APERTURE_IMAGE: {
-        char msg[512] = "";
-        int w = 0, h = 0;
-        float *px = NULL;
-        if (p->load_image(p->ctx, shape, &w, &h, &px, msg, sizeof msg)) {
-            snprintf(err, err_size, "aperture image \"%s\": %s", shape, msg[0] ? msg : "cannot read it");
-            return -1;
-        }
-        if (w <= 0 || h <= 0 || !px) {
-            free(px);
-            snprintf(err, err_size, "aperture image \"%s\" is empty", shape);
-            return -1;
-        }
-        size_t n = (size_t)w * h;
-        double *f = malloc(sizeof(double) * n);
-        if (!f) {
-            free(px);
-            snprintf(err, err_size, "out of memory for aperture image \"%s\"", shape);
-            return -1;
-        }
-        double sum = 0;
-        for (size_t i = 0; i < n; i++) {
-            /* transmission is a fraction: NaN/negative -> 0, above 1 -> 1 */
-            float t = px[i];
-            t = t > 0.f ? (t < 1.f ? t : 1.f) : 0.f;
-            px[i] = t;
-            f[i] = t;
-            sum += t;
-        }
-        if (!(sum > 0)) {
-            free(f);
-            free(px);
-            snprintf(err, err_size,
-                     "aperture image \"%s\" is all black: it lets no light through (white = open, black = closed)",
-                     shape);
-            return -1;
-        }
-        lf_error e = {0};
-        if (lf_distrib2d_init(&a->distrib, f, w, h, &e)) {
-            free(f);
-            free(px);
-            snprintf(err, err_size, "aperture image \"%s\": %s", shape, e.msg);
-            return -1;
-        }
-        free(f);
-        a->img = px;
-        a->img_w = w;
-        a->img_h = h;
-        a->area = 4.0 * sum / (double)n; /* the image fills [-1,1]^2 */
-        break;
-    }
-    }
+    if (rc)
+        return rc;
     a->area *= a->anamorphic;
-    return 0;
+    return LF_OK;
 }
 
 /* Uniform point in the triangle (0, p, q): s = sqrt(u) along the radius,

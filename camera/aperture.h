@@ -48,8 +48,9 @@ typedef struct lf_aperture {
     double (*corners)[2];
 } lf_aperture;
 
-/* Reads the parameters above; 0 or -1 with a message (e.g. an all-black image). */
-int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, char *err, size_t err_size);
+/* Reads the parameters above.  Returns 0, or an LF_ERR_* status with the
+ * message in err (e.g. an all-black image). */
+int lf_aperture_parse(const lf_camera_params *p, lf_aperture *a, lf_error *err);
 /* u, v in [0,1); returns the weight (0: no point), fills (x, y) in radius units. */
 double lf_aperture_sample(const lf_aperture *a, double u, double v, double *x, double *y);
 /* A batch kernel's lens points: lf_aperture_sample for the first n of a

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "base/lf_error.h"
 #include "base/lf_math.h"
@@ -49,8 +50,10 @@ static inline void lf_cam_chunks(lf_cam_chunk_fn chunk, const void *state, int n
         chunk(state, n - i < LF_CAM_CHUNK ? n - i : LF_CAM_CHUNK, s + i, r + i, w + i);
 }
 
-/* A library's lf_error into a create call's message buffer (the plugin
- * ABI, lf_camera.h, keeps char buffers).  Returns rc. */
+/* A library's lf_error into a create call's message buffer: the one place
+ * where the built-in cameras meet the plugin ABI's char buffers
+ * (lf_camera.h); everything below create reports into an lf_error.
+ * Returns rc. */
 static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size)
 {
     if (rc && buf && size)
@@ -58,10 +61,29 @@ static inline int lf_cam_error(int rc, const lf_error *e, char *buf, size_t size
     return rc;
 }
 
+/* The ABI's create calls keep their warnings as text in a char buffer; a
+ * library's lf_warnings (given without a place) reach it one message at a
+ * time: copies the message at *t into msg without the "warning: " and the
+ * newline of the channel's lines, and advances *t.  0 when none is left.
+ *   for (const char *t = lf_warnings_text(&w); lf_cam_next_warning(&t, msg, sizeof msg);) ... */
+static inline int lf_cam_next_warning(const char **t, char *msg, size_t size)
+{
+    static const char prefix[] = "warning: ";
+    if (!*t || !**t)
+        return 0;
+    const char *nl = strchr(*t, '\n');
+    size_t len = nl ? (size_t)(nl - *t) : strlen(*t);
+    size_t skip = strncmp(*t, prefix, sizeof prefix - 1) == 0 ? sizeof prefix - 1 : 0;
+    snprintf(msg, size, "%.*s", (int)(len - skip), *t + skip);
+    *t += nl ? len + 1 : len;
+    return 1;
+}
+
 /* "string sensor" (named format) or "float sensorsize" [w h] mm; default
- * full frame.  Returns 0, or -1 with a message in err. (camera/sensor.c) */
+ * full frame; name receives the format's name ("custom" for a size).
+ * Returns 0, or LF_ERR_PARAM with the message in err. (camera/sensor.c) */
 int lf_cam_read_sensor(const lf_camera_params *p, double *w_mm, double *h_mm, char *name, size_t name_size,
-                       char *err, size_t err_size);
+                       lf_error *err);
 
 /* For describe(): appends to buf (size bytes) with snprintf semantics; the
  * caller's int n stays the would-be length. */

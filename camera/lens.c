@@ -55,11 +55,12 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_erro
     const char *p = text;
     while (*p) {
         line_no++;
+        lf_loc at = {filename, line_no, 0};
         const char *eol = strchr(p, '\n');
         size_t len = eol ? (size_t)(eol - p) : strlen(p);
         char line[1024];
         if (len >= sizeof line) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: line too long", filename, line_no);
+            lf_error_at(err, LF_ERR_PARSE, &at, "line too long");
             goto fail;
         }
         memcpy(line, p, len);
@@ -78,48 +79,47 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_erro
         if (nt == 0)
             continue;
         if (nt != 4 && nt != 5) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: expected 4 or 5 columns (radius thickness ior aperture [abbe]), got %d",
-                     filename, line_no, nt);
+            lf_error_at(err, LF_ERR_PARSE, &at, "expected 4 or 5 columns (radius thickness ior aperture [abbe]), got %d",
+                        nt);
             goto fail;
         }
         double v[5] = {0, 0, 0, 0, 0};
         static const char *const col[5] = {"radius", "thickness", "ior", "aperture", "abbe"};
         for (int i = 0; i < nt; i++)
             if (parse_number(tok[i], &v[i])) {
-                lf_error_set(err, LF_ERR_PARSE, "%s:%d: %s \"%s\" is not a number", filename, line_no, col[i], tok[i]);
+                lf_error_at(err, LF_ERR_PARSE, &at, "%s \"%s\" is not a number", col[i], tok[i]);
                 goto fail;
             }
         if (v[1] < 0.0) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: thickness %g must be >= 0", filename, line_no, v[1]);
+            lf_error_at(err, LF_ERR_PARSE, &at, "thickness %g must be >= 0", v[1]);
             goto fail;
         }
         if (v[2] != 0.0 && v[2] < 1.0) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: ior %g must be >= 1 (0 or 1 = air)", filename, line_no, v[2]);
+            lf_error_at(err, LF_ERR_PARSE, &at, "ior %g must be >= 1 (0 or 1 = air)", v[2]);
             goto fail;
         }
         if (!(v[3] > 0.0)) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: aperture diameter %g must be > 0", filename, line_no, v[3]);
+            lf_error_at(err, LF_ERR_PARSE, &at, "aperture diameter %g must be > 0", v[3]);
             goto fail;
         }
         if (v[0] != 0.0 && v[3] > 2.0 * fabs(v[0])) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: aperture diameter %g exceeds the sphere's diameter 2|%g|", filename,
-                     line_no, v[3], v[0]);
+            lf_error_at(err, LF_ERR_PARSE, &at, "aperture diameter %g exceeds the sphere's diameter 2|%g|", v[3], v[0]);
             goto fail;
         }
         if (v[4] < 0.0) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: Abbe number %g must be >= 0", filename, line_no, v[4]);
+            lf_error_at(err, LF_ERR_PARSE, &at, "Abbe number %g must be >= 0", v[4]);
             goto fail;
         }
         if (v[0] == 0.0 && lens->stop >= 0) {
-            lf_error_set(err, LF_ERR_PARSE, "%s:%d: a second aperture stop (radius 0); the first is on line %d", filename,
-                     line_no, lens->s[lens->stop].line);
+            lf_error_at(err, LF_ERR_PARSE, &at, "a second aperture stop (radius 0); the first is on line %d",
+                        lens->s[lens->stop].line);
             goto fail;
         }
         if (lens->n == cap) {
             cap = cap ? 2 * cap : 16;
             lf_lens_surface *ns = realloc(lens->s, (size_t)cap * sizeof *ns);
             if (!ns) {
-                lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory", filename);
+                lf_error_at(err, LF_ERR_NOMEM, &(lf_loc){filename, 0, 0}, "out of memory");
                 goto fail;
             }
             lens->s = ns;
@@ -142,13 +142,13 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_erro
         lens->n++;
     }
     if (lens->n == 0) {
-        lf_error_set(err, LF_ERR_PARSE, "%s: no lens surfaces (expected rows: radius thickness ior aperture [abbe])",
-                 filename);
+        lf_error_at(err, LF_ERR_PARSE, &(lf_loc){filename, 0, 0},
+                    "no lens surfaces (expected rows: radius thickness ior aperture [abbe])");
         goto fail;
     }
     if (lens->s[lens->n - 1].ior != 1.0) {
-        lf_error_set(err, LF_ERR_PARSE, "%s:%d: the last surface must leave into air (ior 0 or 1), got %g", filename,
-                 lens->s[lens->n - 1].line, lens->s[lens->n - 1].ior);
+        lf_error_at(err, LF_ERR_PARSE, &(lf_loc){filename, lens->s[lens->n - 1].line, 0},
+                    "the last surface must leave into air (ior 0 or 1), got %g", lens->s[lens->n - 1].ior);
         goto fail;
     }
     double z = 0.0;
@@ -195,15 +195,14 @@ void lf_lens_free(lf_lens *lens)
     lens->n = 0;
 }
 
-int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, char *warn, size_t warn_size)
+int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, lf_warnings *w)
 {
     if (lens->stop < 0)
         return 0;
     double r = 0.5 * diameter_mm;
     if (r > lens->stop_max_radius_mm) {
-        if (warn && warn_size)
-            snprintf(warn, warn_size, "aperture diameter %g mm is larger than the stop of %s (%g mm); clamping it",
-                     diameter_mm, lens->path, 2.0 * lens->stop_max_radius_mm);
+        lf_warn_at(w, NULL, "aperture diameter %g mm is larger than the stop of %s (%g mm); clamping it", diameter_mm,
+                   lens->path, 2.0 * lens->stop_max_radius_mm);
         lens->s[lens->stop].aperture_radius_mm = lens->stop_max_radius_mm;
         return 1;
     }

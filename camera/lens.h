@@ -8,7 +8,7 @@
  *   lf_error err = {0};
  *   if (lf_lens_load("scenes/lenses/dgauss.50mm.dat", &lens, &err)) ... err.msg ...
  *   lf_lens_paraxial px; lf_lens_paraxial_analyse(&lens, &px);   // px.efl_mm ...
- *   lf_lens_set_stop_diameter(&lens, 10.0, warn, sizeof warn);
+ *   lf_lens_set_stop_diameter(&lens, 10.0, &warnings);          // lf_warnings: a clamp
  *   lf_lens_focus_thick(&lens, 1000.0, &lens.film_distance_mm, &err);
  *   lf_lens_pupil pupil; lf_lens_pupil_build(&lens, 43.3, 0, &pupil);
  *   double w = lf_lens_sample_ray(&lens, &pupil, 1, fx, fy, u, v, NULL, &ray);
@@ -74,8 +74,9 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_erro
 int lf_lens_load(const char *path, lf_lens *lens, lf_error *err);
 void lf_lens_free(lf_lens *lens);
 /* Sets the stop's clear diameter (pbrt "aperturediameter"), clamped to the
- * file's value with a message in warn.  Returns 1 if clamped, 0 if not. */
-int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, char *warn, size_t warn_size);
+ * file's value with a warning in w (may be NULL).  Returns 1 if clamped, 0
+ * if not. */
+int lf_lens_set_stop_diameter(lf_lens *lens, double diameter_mm, lf_warnings *w);
 /* Index of refraction after surface i at a wavelength (nm); lambda <= 0 or a
  * non-dispersive lens gives n_d. */
 double lf_lens_ior(const lf_lens *lens, int i, double lambda_nm);

@@ -482,10 +482,10 @@ done:
     return rc;
 }
 
-int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens_poly_opts *opts_in,
-                     lf_lens_poly *P, char *err, size_t err_size)
+/* The caller's options with the degree and sample count clamped to what
+ * the fit supports. */
+static lf_lens_poly_opts fit_options(const lf_lens_poly_opts *opts_in)
 {
-    double t0 = seconds();
     lf_lens_poly_opts o = opts_in ? *opts_in : lf_lens_poly_opts_default();
     if (o.max_degree < 3)
         o.max_degree = 3;
@@ -493,31 +493,25 @@ int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens
         o.max_degree = LF_LENS_POLY_MAX_DEGREE;
     if (o.fit_samples < 500)
         o.fit_samples = 500;
-    memset(P, 0, sizeof *P);
-    P->film_radius_mm = pupil->film_radius_mm;
-    P->rear_disk_radius_mm = pupil->rear_disk_radius_mm;
-    P->film_distance_mm = L->film_distance_mm;
-    P->z_out_mm = output_plane(L);
-    P->has_stop = L->stop >= 0;
-    P->stop_radius_mm = P->has_stop ? L->s[L->stop].aperture_radius_mm : 0.0;
-    int n = L->n;
-    if (!(P->film_radius_mm > 0.0) || !(P->rear_disk_radius_mm > 0.0) || !(P->film_distance_mm > 0.0)) {
-        snprintf(err, err_size, "polynomial lens: no film or pupil to fit");
-        return -1;
-    }
+    return o;
+}
 
-    /* A copy of the lens with every clear aperture grown 3% (and the stop
-     * 3%), so the samples cover both sides of each aperture's edge: the
-     * fitted radii then place the edges, and the outer-ray fit holds up to
-     * them. */
+/* The fit's samples: exact traces through a copy of the lens with every
+ * clear aperture grown 3% (and the stop 3%), so the samples cover both
+ * sides of each aperture's edge: the fitted radii then place the edges,
+ * and the outer-ray fit holds up to them.  Fills S (and each sample's
+ * radii in `radial`), counts per surface the samples it clips (clip_count
+ * may be NULL); returns how many samples got through, or -1 when out of
+ * memory. */
+static int trace_fit_samples(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens_poly_opts *o, lf_lens_poly *P,
+                             fit_sample *S, float *radial, long *clip_count)
+{
+    int n = L->n;
     lf_lens grown = *L;
     grown.s = malloc((size_t)n * sizeof *grown.s);
-    fit_sample *S = calloc((size_t)o.fit_samples, sizeof *S);
-    float *radial = malloc((size_t)o.fit_samples * n * sizeof *radial);
     double(*path)[3] = malloc((size_t)(n + 1) * sizeof *path);
-    if (!grown.s || !S || !radial || !path) {
-        free(grown.s), free(S), free(radial), free(path);
-        snprintf(err, err_size, "out of memory");
+    if (!grown.s || !path) {
+        free(grown.s), free(path);
         return -1;
     }
     memcpy(grown.s, L->s, (size_t)n * sizeof *grown.s);
@@ -525,14 +519,12 @@ int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens
         double a = grown.s[i].aperture_radius_mm * 1.03, R = fabs(grown.s[i].radius_mm);
         grown.s[i].aperture_radius_mm = grown.s[i].radius_mm != 0.0 && a > R ? R : a;
     }
-    long clipped[LF_LENS_POLY_MAX_CLIP * 4] = {0};
-    long *clip_count = n <= (int)(sizeof clipped / sizeof clipped[0]) ? clipped : NULL;
-    uint64_t s = rng_seed(o.seed, 1);
+    uint64_t s = rng_seed(o->seed, 1);
     int ns = 0;
-    for (int i = 0; i < o.fit_samples; i++) {
+    for (int i = 0; i < o->fit_samples; i++) {
         /* film radius stratified uniformly in r (the edge of the field is
          * where vignetting and distortion change fastest), pupil from the bound */
-        double r = pupil->film_radius_mm * (i + rnd(&s)) / o.fit_samples, rx, ry;
+        double r = pupil->film_radius_mm * (i + rnd(&s)) / o->fit_samples, rx, ry;
         if (!(lf_lens_pupil_sample(pupil, r, 0.0, rnd(&s), rnd(&s), &rx, &ry) > 0.0))
             continue;
         lf_lens_ray in = {{r, 0.0, 0.0}, {rx - r, ry, -L->film_distance_mm}}, out;
@@ -564,10 +556,15 @@ int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens
     }
     free(path);
     free(grown.s);
-    /* Surfaces that clip more than 0.02% of the samples (the stop always),
-     * most often clipping first. */
-    int clip_surface[LF_LENS_POLY_MAX_CLIP], n_clip = 0;
-    for (int i = 0; i < n && clip_count; i++)
+    return ns;
+}
+
+/* Surfaces that clip more than 0.02% of the samples (the stop always),
+ * most often clipping first.  Returns their count. */
+static int clipping_surfaces(const lf_lens *L, const long *clip_count, int ns, int clip_surface[LF_LENS_POLY_MAX_CLIP])
+{
+    int n_clip = 0;
+    for (int i = 0; i < L->n && clip_count; i++)
         if ((i == L->stop || clip_count[i] * 5000 > ns) && n_clip < LF_LENS_POLY_MAX_CLIP) {
             int j = n_clip++;
             while (j > 0 && clip_count[clip_surface[j - 1]] < clip_count[i]) {
@@ -576,64 +573,105 @@ int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens
             }
             clip_surface[j] = i;
         }
-    int rc = -1;
-    if (ns < 200) {
-        snprintf(err, err_size, "polynomial lens: only %d of %d fit samples get through", ns, o.fit_samples);
-        goto done;
+    return n_clip;
+}
+
+/* Magnification near the axis: a ray from just off the axis through the
+ * centre of the rear plane, met on the focus plane; 1 when that fails. */
+static double axial_magnification(const lf_lens *L, const lf_lens_poly *P, double focus_distance_mm)
+{
+    double delta = 1e-3 * P->film_radius_mm, m = 0.0;
+    lf_lens_ray in = {{delta, 0.0, 0.0}, {-delta, 0.0, -L->film_distance_mm}}, out;
+    double y;
+    if (lf_lens_trace_from_film(L, &in, &out, NULL) == LF_LENS_PASSED) {
+        double X = focus_plane_x(&out, focus_distance_mm, &y);
+        m = fabs(delta / X);
     }
-    /* magnification near the axis: a ray from just off the axis through the
-     * centre of the rear plane, met on the focus plane */
-    {
-        double delta = 1e-3 * P->film_radius_mm;
-        lf_lens_ray in = {{delta, 0.0, 0.0}, {-delta, 0.0, -L->film_distance_mm}}, out;
-        double y;
-        if (lf_lens_trace_from_film(L, &in, &out, NULL) == LF_LENS_PASSED) {
-            double X = focus_plane_x(&out, o.focus_distance_mm, &y);
-            P->magnification = fabs(delta / X);
-        }
-        if (!(P->magnification > 0.0) || !isfinite(P->magnification))
-            P->magnification = 1.0;
-    }
-    /* Error budgets per output for dropping terms.  A point error dp on the
-     * output plane moves the ray's point on the focus plane by dp, a
-     * direction error dd by about D dd; on the film both shrink by the
-     * magnification.  A tenth of the target each; radii squared to 0.2% of
-     * the aperture's. */
-    double budget[LF_LENS_POLY_FIXED + LF_LENS_POLY_MAX_CLIP];
-    {
-        double film_mm = o.target_px * o.pixel_mm, D = o.focus_distance_mm;
-        budget[LF_LENS_POLY_OUT_X] = budget[LF_LENS_POLY_OUT_Y] = 0.1 * film_mm / P->magnification;
-        budget[LF_LENS_POLY_OUT_DX] = budget[LF_LENS_POLY_OUT_DY] = 0.1 * film_mm / (P->magnification * D);
-        budget[LF_LENS_POLY_STOP_X] = budget[LF_LENS_POLY_STOP_Y] = 0.002 * P->stop_radius_mm;
-        for (int c = 0; c < n_clip; c++)
-            budget[LF_LENS_POLY_FIXED + c] = 0.002;
-    }
+    return !(m > 0.0) || !isfinite(m) ? 1.0 : m;
+}
+
+/* Error budgets per output for dropping terms.  A point error dp on the
+ * output plane moves the ray's point on the focus plane by dp, a direction
+ * error dd by about D dd; on the film both shrink by the magnification.  A
+ * tenth of the target each; radii squared to 0.2% of the aperture's. */
+static void error_budgets(const lf_lens_poly_opts *o, const lf_lens_poly *P, int n_clip,
+                          double budget[LF_LENS_POLY_FIXED + LF_LENS_POLY_MAX_CLIP])
+{
+    double film_mm = o->target_px * o->pixel_mm, D = o->focus_distance_mm;
+    budget[LF_LENS_POLY_OUT_X] = budget[LF_LENS_POLY_OUT_Y] = 0.1 * film_mm / P->magnification;
+    budget[LF_LENS_POLY_OUT_DX] = budget[LF_LENS_POLY_OUT_DY] = 0.1 * film_mm / (P->magnification * D);
+    budget[LF_LENS_POLY_STOP_X] = budget[LF_LENS_POLY_STOP_Y] = 0.002 * P->stop_radius_mm;
+    for (int c = 0; c < n_clip; c++)
+        budget[LF_LENS_POLY_FIXED + c] = 0.002;
+}
+
+/* Raises the degree 3, 5, 7, 9 until the held-out error meets the target,
+ * and leaves P fitted at the best degree tried, with its report in P->fit. */
+static int choose_degree(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens_poly_opts *o, lf_lens_poly *P,
+                         const fit_sample *S, int ns, const int *clip_surface, int n_clip, const double *budget,
+                         lf_error *err)
+{
     int best_degree = -1;
     double best_p99 = INFINITY;
-    for (int d = 3; d <= o.max_degree; d += 2) {
+    for (int d = 3; d <= o->max_degree; d += 2) {
         if (fit_degree(P, d, S, ns, clip_surface, n_clip, budget))
             continue;
-        lf_lens_poly_measure(L, P, pupil, o.focus_distance_mm, o.pixel_mm, o.check_samples, o.seed, &P->fit);
+        lf_lens_poly_measure(L, P, pupil, o->focus_distance_mm, o->pixel_mm, o->check_samples, o->seed, &P->fit);
         double score = P->fit.p99_px + 10.0 * P->fit.mismatch_fraction; /* 1% mismatches ~ 0.1 px */
         if (score < best_p99)
             best_p99 = score, best_degree = d;
-        if (P->fit.p99_px <= o.target_px && P->fit.mismatch_fraction < 0.005)
+        if (P->fit.p99_px <= o->target_px && P->fit.mismatch_fraction < 0.005)
             break;
     }
-    if (best_degree < 0) {
-        snprintf(err, err_size, "polynomial lens: the least-squares fit is singular");
-        goto done;
-    }
+    if (best_degree < 0)
+        return lf_error_set(err, LF_ERR_NUMERIC, "polynomial lens: the least-squares fit is singular");
     if (best_degree != P->degree) {
-        if (fit_degree(P, best_degree, S, ns, clip_surface, n_clip, budget)) {
-            snprintf(err, err_size, "polynomial lens: the least-squares fit is singular");
-            goto done;
-        }
-        lf_lens_poly_measure(L, P, pupil, o.focus_distance_mm, o.pixel_mm, o.check_samples, o.seed, &P->fit);
+        if (fit_degree(P, best_degree, S, ns, clip_surface, n_clip, budget))
+            return lf_error_set(err, LF_ERR_NUMERIC, "polynomial lens: the least-squares fit is singular");
+        lf_lens_poly_measure(L, P, pupil, o->focus_distance_mm, o->pixel_mm, o->check_samples, o->seed, &P->fit);
     }
-    P->traces += 2L * o.check_samples;
-    rc = 0;
-done:
+    return LF_OK;
+}
+
+int lf_lens_poly_fit(const lf_lens *L, const lf_lens_pupil *pupil, const lf_lens_poly_opts *opts_in,
+                     lf_lens_poly *P, lf_error *err)
+{
+    double t0 = seconds();
+    lf_lens_poly_opts o = fit_options(opts_in);
+    memset(P, 0, sizeof *P);
+    P->film_radius_mm = pupil->film_radius_mm;
+    P->rear_disk_radius_mm = pupil->rear_disk_radius_mm;
+    P->film_distance_mm = L->film_distance_mm;
+    P->z_out_mm = output_plane(L);
+    P->has_stop = L->stop >= 0;
+    P->stop_radius_mm = P->has_stop ? L->s[L->stop].aperture_radius_mm : 0.0;
+    int n = L->n;
+    if (!(P->film_radius_mm > 0.0) || !(P->rear_disk_radius_mm > 0.0) || !(P->film_distance_mm > 0.0))
+        return lf_error_set(err, LF_ERR_NUMERIC, "polynomial lens: no film or pupil to fit");
+
+    fit_sample *S = calloc((size_t)o.fit_samples, sizeof *S);
+    float *radial = malloc((size_t)o.fit_samples * n * sizeof *radial);
+    long clipped[LF_LENS_POLY_MAX_CLIP * 4] = {0};
+    long *clip_count = n <= (int)(sizeof clipped / sizeof clipped[0]) ? clipped : NULL;
+    int ns = S && radial ? trace_fit_samples(L, pupil, &o, P, S, radial, clip_count) : -1;
+    if (ns < 0) {
+        free(S), free(radial);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    int clip_surface[LF_LENS_POLY_MAX_CLIP];
+    int n_clip = clipping_surfaces(L, clip_count, ns, clip_surface);
+    int rc;
+    if (ns < 200) {
+        rc = lf_error_set(err, LF_ERR_NUMERIC, "polynomial lens: only %d of %d fit samples get through", ns,
+                          o.fit_samples);
+    } else {
+        P->magnification = axial_magnification(L, P, o.focus_distance_mm);
+        double budget[LF_LENS_POLY_FIXED + LF_LENS_POLY_MAX_CLIP];
+        error_budgets(&o, P, n_clip, budget);
+        rc = choose_degree(L, pupil, &o, P, S, ns, clip_surface, n_clip, budget, err);
+        if (!rc)
+            P->traces += 2L * o.check_samples;
+    }
     free(S), free(radial);
     if (rc)
         lf_lens_poly_free(P);

@@ -12,7 +12,8 @@
  *   lf_lens_poly_opts o = lf_lens_poly_opts_default();
  *   o.pixel_mm = film_width_mm / width;                  // to report errors in pixels
  *   o.focus_distance_mm = 6130;
- *   if (lf_lens_poly_fit(&lens, &pupil, &o, &poly, err, sizeof err)) ...   // fit failed
+ *   lf_error err = {0};
+ *   if (lf_lens_poly_fit(&lens, &pupil, &o, &poly, &err)) ...   // fit failed: err.msg
  *   if (poly.fit.p99_px > 0.1) ...                        // too poor: trace instead
  *   double w = lf_lens_poly_sample_ray(&lens, &poly, &pupil, 1, fx, fy, u, v, NULL, NULL, &ray);
  *   lf_lens_poly_free(&poly);
@@ -42,6 +43,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/lf_error.h"
 #include "lens.h"
 
 #define LF_LENS_POLY_MAX_DEGREE 9
@@ -100,10 +102,11 @@ typedef struct lf_lens_poly {
 } lf_lens_poly;
 
 /* Fits the lens as focused (lens->film_distance_mm) for film points up to
- * pupil->film_radius_mm, sampling the exit-pupil bound.  0, or -1 with a
- * message (no light, singular fit, out of memory). */
+ * pupil->film_radius_mm, sampling the exit-pupil bound.  Returns 0, or
+ * LF_ERR_NUMERIC (no light, singular fit) or LF_ERR_NOMEM with the message
+ * in err. */
 int lf_lens_poly_fit(const lf_lens *lens, const lf_lens_pupil *pupil, const lf_lens_poly_opts *opts,
-                     lf_lens_poly *poly, char *err, size_t err_size);
+                     lf_lens_poly *poly, lf_error *err);
 void lf_lens_poly_free(lf_lens_poly *poly);
 
 /* The polynomial's ray for the film point (fx, fy) aimed at the rear-plane

@@ -112,23 +112,6 @@ typedef struct plenoptic {
     double overlap_ratio;         /* main aperture image diameter / image spacing (1 = matched) */
 } plenoptic;
 
-static int fail(const lf_camera_create_args *a, plenoptic *c, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-static int fail(const lf_camera_create_args *a, plenoptic *c, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(a->error, a->error_size, fmt, ap);
-    va_end(ap);
-    if (c)
-        lf_lens_free(&c->lens);
-    free(c);
-    return -1;
-}
-
 static void warn(const lf_camera_create_args *a, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -205,55 +188,51 @@ static void place_lattice(plenoptic *c)
  * docs/physics.md) hold for the paraxial lens.  The lattice geometry sees the
  * aperture as the paraxial exit pupil; candidates are searched within a
  * radius there that bounds every ray that gets through (traced at create). */
-static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, const char *lensfile, double zo)
+static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, const char *lensfile, double zo,
+                              lf_error *err)
 {
     const lf_camera_params *p = a->params;
     double aperture_mm = p->get_float(p->ctx, "aperturediameter", 1.0); /* pbrt-v4's default, as realistic */
-    if (!lensfile[0]) {
-        snprintf(a->error, a->error_size, "\"lensfile\" is empty (give a .dat prescription; see scenes/lenses/)");
-        return -1;
-    }
-    if (!(aperture_mm > 0.0) || !isfinite(aperture_mm)) {
-        snprintf(a->error, a->error_size, "\"aperturediameter\" must be > 0 mm, got %g", aperture_mm);
-        return -1;
-    }
-    if (!(zo >= 0.0)) {
-        snprintf(a->error, a->error_size, "\"focusdistance\" must be > 0 m (0 = infinity), got %g", zo);
-        return -1;
-    }
+    if (!lensfile[0])
+        return lf_error_set(err, LF_ERR_PARAM, "\"lensfile\" is empty (give a .dat prescription; see scenes/lenses/)");
+    if (!(aperture_mm > 0.0) || !isfinite(aperture_mm))
+        return lf_error_set(err, LF_ERR_PARAM, "\"aperturediameter\" must be > 0 mm, got %g", aperture_mm);
+    if (!(zo >= 0.0))
+        return lf_error_set(err, LF_ERR_PARAM, "\"focusdistance\" must be > 0 m (0 = infinity), got %g", zo);
     char path[4096];
     if (lensfile[0] == '/' || !a->scene_dir || !a->scene_dir[0])
         snprintf(path, sizeof path, "%s", lensfile);
     else
         snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
-    lf_error lerr = {0};
-    if (lf_cam_error(lf_lens_load(path, &c->lens, &lerr), &lerr, a->error, a->error_size))
-        return -1;
+    int rc = lf_lens_load(path, &c->lens, err);
+    if (rc)
+        return rc;
     lf_lens *L = &c->lens;
     if (L->stop < 0) {
         warn(a, "%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
     } else {
-        char msg[600] = "";
-        if (lf_lens_set_stop_diameter(L, aperture_mm, msg, sizeof msg))
+        lf_warnings lw = {0};
+        char msg[1536];
+        lf_lens_set_stop_diameter(L, aperture_mm, &lw);
+        for (const char *t = lf_warnings_text(&lw); lf_cam_next_warning(&t, msg, sizeof msg);)
             warn(a, "%s", msg);
+        lf_warnings_free(&lw);
     }
-    if (lf_lens_paraxial_analyse(L, &c->px) || !(c->px.efl_mm > 0.0)) {
-        snprintf(a->error, a->error_size, "%s: the lens forms no real image (afocal or negative focal length)", path);
-        return -1;
-    }
+    if (lf_lens_paraxial_analyse(L, &c->px) || !(c->px.efl_mm > 0.0))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: the lens forms no real image (afocal or negative focal length)",
+                            path);
     double focus_mm = zo == 0.0 || isinf(zo) ? INFINITY : zo * 1e3;
-    if (lf_cam_error(lf_lens_focus_thick(L, focus_mm, &L->film_distance_mm, &lerr), &lerr, a->error, a->error_size))
-        return -1;
+    rc = lf_lens_focus_thick(L, focus_mm, &L->film_distance_mm, err);
+    if (rc)
+        return rc;
     c->compound = 1;
     c->focus_from_mla_m = isinf(focus_mm) ? INFINITY : zo;
     c->working_fnumber = lf_lens_working_fnumber(L, &c->px, focus_mm, L->film_distance_mm);
     double f = c->px.efl_mm, zi = L->film_distance_mm - c->px.rear_principal_mm; /* H' -> MLA */
     c->principal_to_mla_mm = L->film_distance_mm + c->px.total_length_mm - c->px.front_principal_mm;
-    if (!(zi > 0.0) || !isfinite(c->working_fnumber) || !(c->working_fnumber > 0.0)) {
-        snprintf(a->error, a->error_size, "%s: no usable image at %g mm behind the rear vertex", path,
-                 L->film_distance_mm);
-        return -1;
-    }
+    if (!(zi > 0.0) || !isfinite(c->working_fnumber) || !(c->working_fnumber > 0.0))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: no usable image at %g mm behind the rear vertex", path,
+                            L->film_distance_mm);
     /* the equivalent thin lens at H': same f, same z_i, same image-side cone */
     c->focal_length = f * 1e-3;
     c->mla_distance = zi * 1e-3;
@@ -263,11 +242,9 @@ static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, cons
     /* paraxial exit pupil, seen from the MLA */
     c->pupil_distance = (L->film_distance_mm - c->px.exit_pupil_mm) * 1e-3;
     c->pupil_radius = 0.5 * c->px.exit_pupil_diameter_mm * 1e-3;
-    if (!(c->pupil_distance > 0.0) || !(c->pupil_radius > 0.0)) {
-        snprintf(a->error, a->error_size, "%s: the exit pupil (%g mm from the MLA) is not in front of the MLA", path,
-                 c->pupil_distance * 1e3);
-        return -1;
-    }
+    if (!(c->pupil_distance > 0.0) || !(c->pupil_radius > 0.0))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: the exit pupil (%g mm from the MLA) is not in front of the MLA",
+                            path, c->pupil_distance * 1e3);
     /* search radius on the exit-pupil plane: every ray from an MLA point
      * within the sensor's half diagonal that gets through crosses the
      * rear-vertex plane inside lf_lens_rear_disk_radius; trace a grid of
@@ -292,12 +269,167 @@ static int main_lens_compound(const lf_camera_create_args *a, plenoptic *c, cons
                 hmax = fmax(hmax, hypot(hx, hy));
             }
     }
-    if (!(hmax > 0.0)) {
-        snprintf(a->error, a->error_size, "%s admits no light at stop diameter %g mm", path, aperture_mm);
-        return -1;
-    }
+    if (!(hmax > 0.0))
+        return lf_error_set(err, LF_ERR_PARAM, "%s admits no light at stop diameter %g mm", path, aperture_mm);
     c->search_radius = (hmax + 1.5 * step * Zp / Zr) * 1e-3;
     return 0;
+}
+
+/* A thin main lens ("focallength", "fstop"): the MLA sits where the lens
+ * images the plane in focus (0 or inf: infinity, the focal plane). */
+static int main_lens_thin(const lf_camera_params *p, plenoptic *c, double zo, lf_error *err)
+{
+    double f_mm = p->get_float(p->ctx, "focallength", 50.0);
+    c->fstop = p->get_float(p->ctx, "fstop", 2.8);
+    if (!(f_mm > 0.0) || !isfinite(f_mm))
+        return lf_error_set(err, LF_ERR_PARAM, "\"focallength\" must be > 0 mm, got %g", f_mm);
+    if (!(c->fstop > 0.0) || !isfinite(c->fstop))
+        return lf_error_set(err, LF_ERR_PARAM, "\"fstop\" must be > 0, got %g", c->fstop);
+    c->focal_length = f_mm * 1e-3;
+    c->aperture_radius = c->focal_length / (2.0 * c->fstop);
+    if (zo == 0.0 || zo == INFINITY) {
+        c->focus_distance = INFINITY;
+        c->mla_distance = c->focal_length;
+    } else if (!(zo > c->focal_length) || !isfinite(zo)) {
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "\"focusdistance\" %g m must exceed the focal length (%g mm) for a real image (or be 0 "
+                            "for infinity)",
+                            zo, f_mm);
+    } else {
+        c->focus_distance = zo;
+        c->mla_distance = c->focal_length / (1.0 - c->focal_length / zo);
+    }
+    c->pupil_distance = c->mla_distance;
+    c->pupil_radius = c->search_radius = c->aperture_radius;
+    return LF_OK;
+}
+
+/* "grid" and "rotation" of the lattice. */
+static int lattice_shape(plenoptic *c, const char *grid, double rot_deg, lf_error *err)
+{
+    if (!strcmp(grid, "square"))
+        c->hex = 0;
+    else if (!strcmp(grid, "hex"))
+        c->hex = 1;
+    else
+        return lf_error_set(err, LF_ERR_PARAM, "unknown \"grid\" \"%s\" (square or hex)", grid);
+    if (!isfinite(rot_deg))
+        return lf_error_set(err, LF_ERR_PARAM, "\"rotation\" must be finite, got %g", rot_deg);
+    c->rotation_rad = rot_deg * M_PI / 180.0;
+    c->cos_r = cos(c->rotation_rad);
+    c->sin_r = sin(c->rotation_rad);
+    return LF_OK;
+}
+
+/* The sensor: "float sensorsize" [w h] mm wins over "string sensor" (as
+ * thinlens); its width maps to the image width, pixels are square. */
+static int sensor(const lf_camera_create_args *a, plenoptic *c, lf_error *err)
+{
+    int rc = lf_cam_read_sensor(a->params, &c->nominal_w_mm, &c->nominal_h_mm, c->sensor_name,
+                                sizeof c->sensor_name, err);
+    if (rc)
+        return rc;
+    c->sensor_w = c->nominal_w_mm * 1e-3;
+    c->sensor_h = c->sensor_w * c->height / c->width; /* square pixels */
+    c->pixel = c->sensor_w / c->width;
+    if (fabs(c->sensor_h * 1e3 - c->nominal_h_mm) > 0.01 * c->nominal_h_mm)
+        warn(a,
+             "the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to "
+             "the image width, pixels are square)",
+             c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm, c->sensor_h * 1e3);
+    return LF_OK;
+}
+
+/* The microlens array as asked for: "pitch" (um) or "microlenses" (count
+ * across the width), "microlensfocallength", "sensoroffset". */
+typedef struct mla_params {
+    double pitch_um, fmla_mm, offset_mm;
+    int count;
+} mla_params;
+
+/* Microlens pitch and focal length (matched to the main lens unless given),
+ * the lattice in pixels and the candidate search (Ng 2005's geometry). */
+static int microlens_array(plenoptic *c, mla_params m, lf_error *err)
+{
+    if (m.pitch_um != 0.0 && m.count != 0)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "give either \"pitch\" (um) or \"microlenses\" (count across the width), not both");
+    if (m.pitch_um == 0.0 && m.count == 0)
+        m.count = (int)lround(c->width / 14.0) > 0 ? (int)lround(c->width / 14.0) : 1; /* ~Ng 2005: 14 px per lens */
+    if (m.count < 0 || m.count > c->width * 4)
+        return lf_error_set(err, LF_ERR_PARAM, "\"microlenses\" must be in 1..%d (4 per pixel), got %d", c->width * 4,
+                            m.count);
+    if (m.pitch_um < 0.0 || !isfinite(m.pitch_um))
+        return lf_error_set(err, LF_ERR_PARAM, "\"pitch\" must be > 0 um, got %g", m.pitch_um);
+    if (!(m.fmla_mm >= 0.0) || !isfinite(m.fmla_mm))
+        return lf_error_set(err, LF_ERR_PARAM, "\"microlensfocallength\" must be > 0 mm, got %g", m.fmla_mm);
+    if (!isfinite(m.offset_mm))
+        return lf_error_set(err, LF_ERR_PARAM, "\"sensoroffset\" must be finite, got %g", m.offset_mm);
+    /* the lattice sees the aperture at the (exit) pupil: Z and D below are z_i and f/N for a thin lens */
+    double zi = c->pupil_distance, D = 2.0 * c->pupil_radius, off = m.offset_mm * 1e-3;
+    c->sensor_offset = off;
+    if (m.count > 0) {
+        /* the images tile the width: spacing P = W / count pixels = p (z_i + d) / z_i */
+        double P = c->sensor_w / m.count; /* metres on the sensor */
+        if (m.fmla_mm > 0.0) {
+            c->mla_focal = m.fmla_mm * 1e-3;
+            c->pitch = P * zi / (zi + c->mla_focal + off);
+        } else {
+            /* matched: f_mla = p z_i / D, so P = p (1 + off/z_i) + p^2 / D */
+            double b = 1.0 + off / zi;
+            c->pitch = 0.5 * D * (sqrt(b * b + 4.0 * P / D) - b);
+            c->mla_focal = c->pitch * zi / D;
+        }
+    } else {
+        c->pitch = m.pitch_um * 1e-6;
+        c->mla_focal = m.fmla_mm > 0.0 ? m.fmla_mm * 1e-3 : c->pitch * zi / D;
+    }
+    c->mla_sensor = c->mla_focal + off;
+    if (!(c->mla_sensor > 0.0))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "\"sensoroffset\" %g mm puts the sensor in front of the microlenses (f_mla = %g mm)",
+                            m.offset_mm, c->mla_focal * 1e3);
+    double d = c->mla_sensor, Zs = zi + d;
+    c->phys_per_px = c->pixel * zi / Zs;
+    c->image_pitch_px = c->pitch / c->phys_per_px;
+    c->row_px = c->hex ? c->image_pitch_px * sqrt(3.0) / 2.0 : c->image_pitch_px;
+    if (!(c->image_pitch_px >= 0.25) || !isfinite(c->image_pitch_px))
+        return lf_error_set(err, LF_ERR_PARAM, "the microlens pitch is %g pixels: at least 0.25 pixel is needed",
+                            c->image_pitch_px);
+    c->cell_area = c->hex ? sqrt(3.0) / 2.0 * c->pitch * c->pitch : c->pitch * c->pitch;
+    c->cell_radius = c->hex ? c->pitch / sqrt(3.0) : c->pitch / sqrt(2.0);
+    double alpha = 1.0 + zi / d - zi / c->mla_focal;
+    c->search_px = (c->search_radius + fabs(alpha) * c->cell_radius) * d / zi / c->pixel;
+    double cell_px = c->hex ? sqrt(3.0) / 2.0 * c->image_pitch_px * c->image_pitch_px
+                            : c->image_pitch_px * c->image_pitch_px;
+    double max_cand = M_PI * pow(c->search_px + c->image_pitch_px, 2.0) / cell_px;
+    if (max_cand > MAX_CANDIDATES)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "each sensor point would see the main lens through up to %.0f microlenses (limit %d): the "
+                            "microlens focal length or sensor offset is too far from the matched design",
+                            max_cand, MAX_CANDIDATES);
+    c->weight_scale = c->cell_area / (d * d);
+    place_lattice(c);
+    return LF_OK;
+}
+
+/* f-number matching (plenoptic 1.0 geometry, d = f_mla): a main lens
+ * faster or slower than the microlenses is allowed, with a warning. */
+static void fnumber_warnings(const lf_camera_create_args *a, plenoptic *c)
+{
+    double zi = c->pupil_distance, D = 2.0 * c->pupil_radius;
+    double Nimg = zi / D, Nmla = c->mla_focal / c->pitch;
+    c->overlap_ratio = (D + c->pitch) * c->mla_focal / (c->pitch * (zi + c->mla_focal));
+    if (c->overlap_ratio > 1.01)
+        warn(a,
+             "f-number mismatch: the main lens (image side f/%.3g) is faster than the microlenses (f/%.3g): "
+             "microlens images overlap (each is %.1f%% of their spacing; neighbours cross-talk)",
+             Nimg, Nmla, 100.0 * c->overlap_ratio);
+    else if (c->overlap_ratio < 0.99)
+        warn(a,
+             "f-number mismatch: the main lens (image side f/%.3g) is slower than the microlenses (f/%.3g): "
+             "microlens images leave gaps (each is %.1f%% of their spacing; pixels between them stay dark)",
+             Nimg, Nmla, 100.0 * c->overlap_ratio);
 }
 
 static int plenoptic_create(const lf_camera_create_args *a, void **state)
@@ -313,142 +445,30 @@ static int plenoptic_create(const lf_camera_create_args *a, void **state)
     const char *lensfile = p->get_string(p->ctx, "lensfile", NULL);
     double zo = p->get_float(p->ctx, "focusdistance", 1.0);
     const char *grid = p->get_string(p->ctx, "grid", "square");
-    double pitch_um = p->get_float(p->ctx, "pitch", 0.0);
-    int count = p->get_int(p->ctx, "microlenses", 0);
-    double fmla_mm = p->get_float(p->ctx, "microlensfocallength", 0.0);
+    mla_params m;
+    m.pitch_um = p->get_float(p->ctx, "pitch", 0.0);
+    m.count = p->get_int(p->ctx, "microlenses", 0);
+    m.fmla_mm = p->get_float(p->ctx, "microlensfocallength", 0.0);
     double rot_deg = p->get_float(p->ctx, "rotation", 0.0);
-    double offset_mm = p->get_float(p->ctx, "sensoroffset", 0.0);
+    m.offset_mm = p->get_float(p->ctx, "sensoroffset", 0.0);
 
-    if (!lensfile) {
-        double f_mm = p->get_float(p->ctx, "focallength", 50.0);
-        c->fstop = p->get_float(p->ctx, "fstop", 2.8);
-        if (!(f_mm > 0.0) || !isfinite(f_mm))
-            return fail(a, c, "\"focallength\" must be > 0 mm, got %g", f_mm);
-        if (!(c->fstop > 0.0) || !isfinite(c->fstop))
-            return fail(a, c, "\"fstop\" must be > 0, got %g", c->fstop);
-        c->focal_length = f_mm * 1e-3;
-        c->aperture_radius = c->focal_length / (2.0 * c->fstop);
-        /* 0 (or inf) means infinity: the MLA then sits in the focal plane */
-        if (zo == 0.0 || zo == INFINITY) {
-            c->focus_distance = INFINITY;
-            c->mla_distance = c->focal_length;
-        } else if (!(zo > c->focal_length) || !isfinite(zo)) {
-            return fail(a, c,
-                        "\"focusdistance\" %g m must exceed the focal length (%g mm) for a real image (or be 0 for "
-                        "infinity)",
-                        zo, f_mm);
-        } else {
-            c->focus_distance = zo;
-            c->mla_distance = c->focal_length / (1.0 - c->focal_length / zo);
-        }
-        c->pupil_distance = c->mla_distance;
-        c->pupil_radius = c->search_radius = c->aperture_radius;
-    }
-    if (!strcmp(grid, "square"))
-        c->hex = 0;
-    else if (!strcmp(grid, "hex"))
-        c->hex = 1;
-    else
-        return fail(a, c, "unknown \"grid\" \"%s\" (square or hex)", grid);
-    if (!isfinite(rot_deg))
-        return fail(a, c, "\"rotation\" must be finite, got %g", rot_deg);
-    c->rotation_rad = rot_deg * M_PI / 180.0;
-    c->cos_r = cos(c->rotation_rad);
-    c->sin_r = sin(c->rotation_rad);
-
-    /* sensor: "float sensorsize" [w h] mm wins over "string sensor" (as thinlens) */
-    {
-        char msg[512];
-        if (lf_cam_read_sensor(p, &c->nominal_w_mm, &c->nominal_h_mm, c->sensor_name, sizeof c->sensor_name, msg,
-                               sizeof msg))
-            return fail(a, c, "%s", msg);
-    }
-    c->sensor_w = c->nominal_w_mm * 1e-3;
-    c->sensor_h = c->sensor_w * c->height / c->width; /* square pixels */
-    c->pixel = c->sensor_w / c->width;
-    if (fabs(c->sensor_h * 1e3 - c->nominal_h_mm) > 0.01 * c->nominal_h_mm)
-        warn(a,
-             "the image is %dx%d, so the %s sensor (%g x %g mm) is used as %g x %.4g mm (its width maps to "
-             "the image width, pixels are square)",
-             c->width, c->height, c->sensor_name, c->nominal_w_mm, c->nominal_h_mm, c->nominal_w_mm, c->sensor_h * 1e3);
-
+    lf_error err = {0};
+    int rc = lensfile ? LF_OK : main_lens_thin(p, c, zo, &err);
+    if (!rc)
+        rc = lattice_shape(c, grid, rot_deg, &err);
+    if (!rc)
+        rc = sensor(a, c, &err);
     /* a compound main lens needs the sensor size for its pupil search */
-    if (lensfile && main_lens_compound(a, c, lensfile, zo)) {
+    if (!rc && lensfile)
+        rc = main_lens_compound(a, c, lensfile, zo, &err);
+    if (!rc)
+        rc = microlens_array(c, m, &err);
+    if (lf_cam_error(rc, &err, a->error, a->error_size)) {
         lf_lens_free(&c->lens);
         free(c);
         return -1;
     }
-
-    /* microlens pitch and focal length */
-    if (pitch_um != 0.0 && count != 0)
-        return fail(a, c, "give either \"pitch\" (um) or \"microlenses\" (count across the width), not both");
-    if (pitch_um == 0.0 && count == 0)
-        count = (int)lround(c->width / 14.0) > 0 ? (int)lround(c->width / 14.0) : 1; /* ~Ng 2005: 14 px per lens */
-    if (count < 0 || count > c->width * 4)
-        return fail(a, c, "\"microlenses\" must be in 1..%d (4 per pixel), got %d", c->width * 4, count);
-    if (pitch_um < 0.0 || !isfinite(pitch_um))
-        return fail(a, c, "\"pitch\" must be > 0 um, got %g", pitch_um);
-    if (!(fmla_mm >= 0.0) || !isfinite(fmla_mm))
-        return fail(a, c, "\"microlensfocallength\" must be > 0 mm, got %g", fmla_mm);
-    if (!isfinite(offset_mm))
-        return fail(a, c, "\"sensoroffset\" must be finite, got %g", offset_mm);
-    /* the lattice sees the aperture at the (exit) pupil: Z and D below are z_i and f/N for a thin lens */
-    double zi = c->pupil_distance, D = 2.0 * c->pupil_radius, off = offset_mm * 1e-3;
-    c->sensor_offset = off;
-    if (count > 0) {
-        /* the images tile the width: spacing P = W / count pixels = p (z_i + d) / z_i */
-        double P = c->sensor_w / count; /* metres on the sensor */
-        if (fmla_mm > 0.0) {
-            c->mla_focal = fmla_mm * 1e-3;
-            c->pitch = P * zi / (zi + c->mla_focal + off);
-        } else {
-            /* matched: f_mla = p z_i / D, so P = p (1 + off/z_i) + p^2 / D */
-            double b = 1.0 + off / zi;
-            c->pitch = 0.5 * D * (sqrt(b * b + 4.0 * P / D) - b);
-            c->mla_focal = c->pitch * zi / D;
-        }
-    } else {
-        c->pitch = pitch_um * 1e-6;
-        c->mla_focal = fmla_mm > 0.0 ? fmla_mm * 1e-3 : c->pitch * zi / D;
-    }
-    c->mla_sensor = c->mla_focal + off;
-    if (!(c->mla_sensor > 0.0))
-        return fail(a, c, "\"sensoroffset\" %g mm puts the sensor in front of the microlenses (f_mla = %g mm)",
-                    offset_mm, c->mla_focal * 1e3);
-    double d = c->mla_sensor, Zs = zi + d;
-    c->phys_per_px = c->pixel * zi / Zs;
-    c->image_pitch_px = c->pitch / c->phys_per_px;
-    c->row_px = c->hex ? c->image_pitch_px * sqrt(3.0) / 2.0 : c->image_pitch_px;
-    if (!(c->image_pitch_px >= 0.25) || !isfinite(c->image_pitch_px))
-        return fail(a, c, "the microlens pitch is %g pixels: at least 0.25 pixel is needed", c->image_pitch_px);
-    c->cell_area = c->hex ? sqrt(3.0) / 2.0 * c->pitch * c->pitch : c->pitch * c->pitch;
-    c->cell_radius = c->hex ? c->pitch / sqrt(3.0) : c->pitch / sqrt(2.0);
-    double alpha = 1.0 + zi / d - zi / c->mla_focal;
-    c->search_px = (c->search_radius + fabs(alpha) * c->cell_radius) * d / zi / c->pixel;
-    double cell_px = c->hex ? sqrt(3.0) / 2.0 * c->image_pitch_px * c->image_pitch_px
-                            : c->image_pitch_px * c->image_pitch_px;
-    double max_cand = M_PI * pow(c->search_px + c->image_pitch_px, 2.0) / cell_px;
-    if (max_cand > MAX_CANDIDATES)
-        return fail(a, c,
-                    "each sensor point would see the main lens through up to %.0f microlenses (limit %d): the "
-                    "microlens focal length or sensor offset is too far from the matched design",
-                    max_cand, MAX_CANDIDATES);
-    c->weight_scale = c->cell_area / (d * d);
-    place_lattice(c);
-
-    /* f-number matching (plenoptic 1.0 geometry, d = f_mla) */
-    double Nimg = zi / D, Nmla = c->mla_focal / c->pitch;
-    c->overlap_ratio = (D + c->pitch) * c->mla_focal / (c->pitch * (zi + c->mla_focal));
-    if (c->overlap_ratio > 1.01)
-        warn(a,
-             "f-number mismatch: the main lens (image side f/%.3g) is faster than the microlenses (f/%.3g): "
-             "microlens images overlap (each is %.1f%% of their spacing; neighbours cross-talk)",
-             Nimg, Nmla, 100.0 * c->overlap_ratio);
-    else if (c->overlap_ratio < 0.99)
-        warn(a,
-             "f-number mismatch: the main lens (image side f/%.3g) is slower than the microlenses (f/%.3g): "
-             "microlens images leave gaps (each is %.1f%% of their spacing; pixels between them stay dark)",
-             Nimg, Nmla, 100.0 * c->overlap_ratio);
+    fnumber_warnings(a, c);
     *state = c;
     return 0;
 }

@@ -84,7 +84,8 @@ static int projective_create(const lf_camera_create_args *a, void **state, int o
         free(c);
         return -1;
     }
-    if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
+    lf_error err = {0};
+    if (lf_cam_error(lf_aperture_parse(p, &c->aperture, &err), &err, a->error, a->error_size)) {
         free(c);
         return -1;
     }

@@ -24,6 +24,7 @@
  * lf_lens_sample_rays (bit-identical to generate_ray, several times faster).
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,6 +118,141 @@ static void estimate_useful_fraction(realistic *c)
     c->lit_film_fraction = (double)film_lit / (N * N);
 }
 
+/* The create call's warnings, joined by "; " in its buffer (the plugin
+ * ABI's char buffer); *wlen is the length written so far. */
+static void warn(const lf_camera_create_args *a, size_t *wlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void warn(const lf_camera_create_args *a, size_t *wlen, const char *fmt, ...)
+{
+    if (!a->warning || *wlen + 1 >= a->warning_size)
+        return;
+    int n = snprintf(a->warning + *wlen, a->warning_size - *wlen, "%s", *wlen ? "; " : "");
+    *wlen += n > 0 ? (size_t)n : 0;
+    if (*wlen < a->warning_size) {
+        va_list ap;
+        va_start(ap, fmt);
+        n = vsnprintf(a->warning + *wlen, a->warning_size - *wlen, fmt, ap);
+        va_end(ap);
+        *wlen += n > 0 ? (size_t)n : 0;
+    }
+    if (*wlen >= a->warning_size)
+        *wlen = a->warning_size - 1;
+}
+
+/* The camera's own parameters, pbrt-v4's names and defaults. */
+typedef struct realistic_params {
+    const char *lensfile, *lensmodel;
+    double aperture_diameter, focus_m;
+    int dispersion;
+} realistic_params;
+
+/* Checks the parameters and the film (read before the aperture's). */
+static int check_params(const lf_camera_create_args *a, realistic *c, const realistic_params *rp, lf_error *err)
+{
+    if (!rp->lensfile[0])
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "\"string lensfile\" is required: the realistic camera has no default lens (pbrt-v4: "
+                            "\"No lens description file supplied!\"); see scenes/lenses/");
+    if (strcmp(rp->lensmodel, "traced") && strcmp(rp->lensmodel, "polynomial"))
+        return lf_error_set(err, LF_ERR_PARAM, "\"string lensmodel\" must be \"traced\" or \"polynomial\", got \"%s\"",
+                            rp->lensmodel);
+    c->poly_requested = !strcmp(rp->lensmodel, "polynomial");
+    if (!(rp->aperture_diameter > 0.0) || !isfinite(rp->aperture_diameter))
+        return lf_error_set(err, LF_ERR_PARAM, "\"aperturediameter\" must be > 0 mm, got %g", rp->aperture_diameter);
+    if (!(rp->focus_m > 0.0) || !isfinite(rp->focus_m))
+        return lf_error_set(err, LF_ERR_PARAM, "\"focusdistance\" must be > 0 m, got %g", rp->focus_m);
+    if (!(a->film_diagonal_mm > 0.0) || !isfinite(a->film_diagonal_mm) || a->image_width <= 0 ||
+        a->image_height <= 0)
+        return lf_error_set(err, LF_ERR_PARAM, "film diagonal (%g mm) and resolution must be positive",
+                            a->film_diagonal_mm);
+    return LF_OK;
+}
+
+/* Loads the prescription (path: relative to the scene file), sets the stop
+ * and dispersion and focuses the lens (Kolb et al.'s thick-lens focusing,
+ * with the search as a cross-check for --explain). */
+static int load_lens(const lf_camera_create_args *a, realistic *c, const realistic_params *rp, const char *path,
+                     size_t *wlen, lf_error *err)
+{
+    int rc = lf_lens_load(path, &c->lens, err);
+    if (rc)
+        return rc;
+    if (rp->dispersion && !c->lens.has_abbe)
+        warn(a, wlen, "\"dispersion\" is on but %s has no Abbe numbers (5th column): rendering without dispersion",
+             path);
+    c->lens.dispersive = rp->dispersion && c->lens.has_abbe;
+    if (c->lens.stop < 0) {
+        warn(a, wlen, "%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
+    } else {
+        lf_warnings lw = {0};
+        char msg[1536];
+        lf_lens_set_stop_diameter(&c->lens, rp->aperture_diameter, &lw);
+        for (const char *t = lf_warnings_text(&lw); lf_cam_next_warning(&t, msg, sizeof msg);)
+            warn(a, wlen, "%s", msg);
+        lf_warnings_free(&lw);
+    }
+    if (lf_lens_paraxial_analyse(&c->lens, &c->px))
+        return lf_error_set(err, LF_ERR_PARAM, "%s: the lens has no focal power (afocal)", path);
+    c->focus_distance_mm = rp->focus_m * 1000.0;
+    rc = lf_lens_focus_thick(&c->lens, c->focus_distance_mm, &c->lens.film_distance_mm, err);
+    if (rc)
+        return rc;
+    if (lf_lens_focus_search(&c->lens, c->focus_distance_mm, &c->film_distance_search_mm, NULL))
+        c->film_distance_search_mm = NAN;
+    c->working_fnumber = lf_lens_working_fnumber(&c->lens, &c->px, c->focus_distance_mm, c->lens.film_distance_mm);
+    return LF_OK;
+}
+
+/* pbrt-v4: the physical film extent from the diagonal and the aspect
+ * ratio; then the exit-pupil bounds over the film's half diagonal. */
+static int place_film(const lf_camera_create_args *a, realistic *c, const char *path, lf_error *err)
+{
+    double aspect = (double)a->image_height / a->image_width;
+    c->diagonal_mm = a->film_diagonal_mm;
+    c->film_w_mm = sqrt(c->diagonal_mm * c->diagonal_mm / (1.0 + aspect * aspect));
+    c->film_h_mm = aspect * c->film_w_mm;
+    if (lf_lens_pupil_build(&c->lens, 0.5 * c->diagonal_mm, c->lens.dispersive, &c->pupil) == 0)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s admits no light: no ray from the film gets through all %d surfaces (stop diameter "
+                            "%g mm, film %g mm behind the rear vertex)",
+                            path, c->lens.n,
+                            c->lens.stop >= 0 ? 2.0 * c->lens.s[c->lens.stop].aperture_radius_mm : 0.0,
+                            c->lens.film_distance_mm);
+    return LF_OK;
+}
+
+/* "lensmodel" "polynomial": fits the ray transfer and uses it when it is
+ * close enough to tracing; otherwise warns and traces. */
+static void try_polynomial(const lf_camera_create_args *a, realistic *c, const char *path, size_t *wlen)
+{
+    if (c->poly_requested && c->lens.dispersive) {
+        warn(a, wlen, "\"lensmodel\" \"polynomial\" has no wavelength input: tracing %s instead (dispersion is on)",
+             path);
+        return;
+    }
+    if (!c->poly_requested)
+        return;
+    lf_lens_poly_opts po = lf_lens_poly_opts_default();
+    po.pixel_mm = c->film_w_mm / c->width;
+    po.focus_distance_mm = c->focus_distance_mm;
+    lf_error perr = {0};
+    if (lf_lens_poly_fit(&c->lens, &c->pupil, &po, &c->poly, &perr)) {
+        warn(a, wlen, "\"lensmodel\" \"polynomial\": %.255s; tracing %s instead", perr.msg, path);
+    } else if (!(c->poly.fit.p99_px <= POLY_MAX_P99_PX) || !(c->poly.fit.mismatch_fraction <= POLY_MAX_MISMATCH)) {
+        warn(a, wlen,
+             "\"lensmodel\" \"polynomial\": the best fit (degree %d) of %s puts 1%% of rays %.2g pixels or "
+             "more from the traced ones and passes or blocks %.2g%% of rays differently (limits %g px, %g%%); "
+             "tracing instead",
+             c->poly.degree, path, c->poly.fit.p99_px, 100.0 * c->poly.fit.mismatch_fraction, POLY_MAX_P99_PX,
+             100.0 * POLY_MAX_MISMATCH);
+    } else {
+        c->use_poly = 1;
+    }
+}
+
 static int realistic_create(const lf_camera_create_args *a, void **state)
 {
     const lf_camera_params *p = a->params;
@@ -128,127 +264,39 @@ static int realistic_create(const lf_camera_create_args *a, void **state)
     }
     c->width = a->image_width;
     c->height = a->image_height;
-    const char *lensfile = p->get_string(p->ctx, "lensfile", "");
-    double aperture_diameter = p->get_float(p->ctx, "aperturediameter", 1.0);
-    double focus_m = p->get_float(p->ctx, "focusdistance", 10.0);
-    int dispersion = p->get_bool(p->ctx, "dispersion", 0);
-    const char *lensmodel = p->get_string(p->ctx, "lensmodel", "traced");
+    realistic_params rp;
+    rp.lensfile = p->get_string(p->ctx, "lensfile", "");
+    rp.aperture_diameter = p->get_float(p->ctx, "aperturediameter", 1.0);
+    rp.focus_m = p->get_float(p->ctx, "focusdistance", 10.0);
+    rp.dispersion = p->get_bool(p->ctx, "dispersion", 0);
+    rp.lensmodel = p->get_string(p->ctx, "lensmodel", "traced");
     c->pupil_bounds = p->get_bool(p->ctx, "pupilbounds", 1);
-    if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
+    lf_error err = {0};
+    if (lf_cam_error(lf_aperture_parse(p, &c->aperture, &err), &err, a->error, a->error_size)) {
         free(c);
         return -1;
     }
     c->shaped = c->aperture.kind != LF_APERTURE_CIRCLE || c->aperture.anamorphic != 1.0;
-    if (!lensfile[0]) {
-        snprintf(a->error, a->error_size,
-                 "\"string lensfile\" is required: the realistic camera has no default lens (pbrt-v4: \"No lens "
-                 "description file supplied!\"); see scenes/lenses/");
-        goto fail;
-    }
-    if (strcmp(lensmodel, "traced") && strcmp(lensmodel, "polynomial")) {
-        snprintf(a->error, a->error_size, "\"string lensmodel\" must be \"traced\" or \"polynomial\", got \"%s\"",
-                 lensmodel);
-        goto fail;
-    }
-    c->poly_requested = !strcmp(lensmodel, "polynomial");
-    if (!(aperture_diameter > 0.0) || !isfinite(aperture_diameter)) {
-        snprintf(a->error, a->error_size, "\"aperturediameter\" must be > 0 mm, got %g", aperture_diameter);
-        goto fail;
-    }
-    if (!(focus_m > 0.0) || !isfinite(focus_m)) {
-        snprintf(a->error, a->error_size, "\"focusdistance\" must be > 0 m, got %g", focus_m);
-        goto fail;
-    }
-    if (!(a->film_diagonal_mm > 0.0) || !isfinite(a->film_diagonal_mm) || a->image_width <= 0 ||
-        a->image_height <= 0) {
-        snprintf(a->error, a->error_size, "film diagonal (%g mm) and resolution must be positive",
-                 a->film_diagonal_mm);
-        goto fail;
-    }
     char path[4096];
-    if (lensfile[0] == '/' || !a->scene_dir || !a->scene_dir[0])
-        snprintf(path, sizeof path, "%s", lensfile);
+    if (rp.lensfile[0] == '/' || !a->scene_dir || !a->scene_dir[0])
+        snprintf(path, sizeof path, "%s", rp.lensfile);
     else
-        snprintf(path, sizeof path, "%s/%s", a->scene_dir, lensfile);
-    lf_error lerr = {0};
-    if (lf_cam_error(lf_lens_load(path, &c->lens, &lerr), &lerr, a->error, a->error_size))
-        goto fail;
+        snprintf(path, sizeof path, "%s/%s", a->scene_dir, rp.lensfile);
     size_t wlen = a->warning && a->warning_size ? strlen(a->warning) : 0;
-#define WARN(...)                                                                                 \
-    do {                                                                                          \
-        if (a->warning && wlen + 1 < a->warning_size) {                                           \
-            int n_ = snprintf(a->warning + wlen, a->warning_size - wlen, "%s", wlen ? "; " : ""); \
-            wlen += n_ > 0 ? (size_t)n_ : 0;                                                      \
-            if (wlen < a->warning_size) {                                                         \
-                n_ = snprintf(a->warning + wlen, a->warning_size - wlen, __VA_ARGS__);            \
-                wlen += n_ > 0 ? (size_t)n_ : 0;                                                  \
-            }                                                                                     \
-            if (wlen >= a->warning_size)                                                          \
-                wlen = a->warning_size - 1;                                                       \
-        }                                                                                         \
-    } while (0)
-    if (dispersion && !c->lens.has_abbe)
-        WARN("\"dispersion\" is on but %s has no Abbe numbers (5th column): rendering without dispersion", path);
-    c->lens.dispersive = dispersion && c->lens.has_abbe;
-    if (c->lens.stop < 0) {
-        WARN("%s has no aperture stop (radius 0 row): \"aperturediameter\" is ignored", path);
-    } else {
-        char msg[600] = "";
-        if (lf_lens_set_stop_diameter(&c->lens, aperture_diameter, msg, sizeof msg))
-            WARN("%s", msg);
+    int rc = check_params(a, c, &rp, &err);
+    if (!rc)
+        rc = load_lens(a, c, &rp, path, &wlen, &err);
+    if (!rc)
+        rc = place_film(a, c, path, &err);
+    if (lf_cam_error(rc, &err, a->error, a->error_size)) {
+        realistic_free(c);
+        return -1;
     }
-    if (lf_lens_paraxial_analyse(&c->lens, &c->px)) {
-        snprintf(a->error, a->error_size, "%s: the lens has no focal power (afocal)", path);
-        goto fail;
-    }
-    c->focus_distance_mm = focus_m * 1000.0;
-    if (lf_cam_error(lf_lens_focus_thick(&c->lens, c->focus_distance_mm, &c->lens.film_distance_mm, &lerr), &lerr,
-                     a->error, a->error_size))
-        goto fail;
-    if (lf_lens_focus_search(&c->lens, c->focus_distance_mm, &c->film_distance_search_mm, NULL))
-        c->film_distance_search_mm = NAN;
-    c->working_fnumber =
-        lf_lens_working_fnumber(&c->lens, &c->px, c->focus_distance_mm, c->lens.film_distance_mm);
-    /* pbrt-v4: physical film extent from the diagonal and the aspect ratio. */
-    double aspect = (double)a->image_height / a->image_width;
-    c->diagonal_mm = a->film_diagonal_mm;
-    c->film_w_mm = sqrt(c->diagonal_mm * c->diagonal_mm / (1.0 + aspect * aspect));
-    c->film_h_mm = aspect * c->film_w_mm;
-    if (lf_lens_pupil_build(&c->lens, 0.5 * c->diagonal_mm, c->lens.dispersive, &c->pupil) == 0) {
-        snprintf(a->error, a->error_size,
-                 "%s admits no light: no ray from the film gets through all %d surfaces (stop diameter %g mm, "
-                 "film %g mm behind the rear vertex)",
-                 path, c->lens.n, c->lens.stop >= 0 ? 2.0 * c->lens.s[c->lens.stop].aperture_radius_mm : 0.0,
-                 c->lens.film_distance_mm);
-        goto fail;
-    }
-    if (c->poly_requested && c->lens.dispersive) {
-        WARN("\"lensmodel\" \"polynomial\" has no wavelength input: tracing %s instead (dispersion is on)", path);
-    } else if (c->poly_requested) {
-        lf_lens_poly_opts po = lf_lens_poly_opts_default();
-        po.pixel_mm = c->film_w_mm / c->width;
-        po.focus_distance_mm = c->focus_distance_mm;
-        char msg[256] = "";
-        if (lf_lens_poly_fit(&c->lens, &c->pupil, &po, &c->poly, msg, sizeof msg)) {
-            WARN("\"lensmodel\" \"polynomial\": %s; tracing %s instead", msg, path);
-        } else if (!(c->poly.fit.p99_px <= POLY_MAX_P99_PX) || !(c->poly.fit.mismatch_fraction <= POLY_MAX_MISMATCH)) {
-            WARN("\"lensmodel\" \"polynomial\": the best fit (degree %d) of %s puts 1%% of rays %.2g pixels or "
-                 "more from the traced ones and passes or blocks %.2g%% of rays differently (limits %g px, %g%%); "
-                 "tracing instead",
-                 c->poly.degree, path, c->poly.fit.p99_px, 100.0 * c->poly.fit.mismatch_fraction, POLY_MAX_P99_PX,
-                 100.0 * POLY_MAX_MISMATCH);
-        } else {
-            c->use_poly = 1;
-        }
-    }
+    try_polynomial(a, c, path, &wlen);
     estimate_useful_fraction(c);
     c->setup_seconds = seconds() - t0;
-#undef WARN
     *state = c;
     return 0;
-fail:
-    realistic_free(c);
-    return -1;
 }
 
 static uint32_t realistic_needs(const void *state)

@@ -67,61 +67,66 @@ void lf_camera_generate_rays(const lf_camera_type *t, const void *state, int n, 
 
 typedef const lf_camera_type *const *(*plugin_entry_fn)(int *count);
 
-static int load_plugin_locked(const char *path, char *err, size_t err_size);
+static int load_plugin_locked(const char *path, lf_error *err);
 
+/* The installed header keeps the ABI's char buffer (lf_camera.h needs no
+ * lensfield library); the loader itself reports into an lf_error. */
 int lf_camera_load_plugin(const char *path, char *err, size_t err_size)
 {
+    lf_error e = {0};
     pthread_mutex_lock(&plugin_lock);
-    int rc = load_plugin_locked(path, err, err_size);
+    int rc = load_plugin_locked(path, &e);
     pthread_mutex_unlock(&plugin_lock);
-    return rc;
+    return lf_cam_error(rc, &e, err, err_size) ? -1 : 0;
 }
 
-static int load_plugin_locked(const char *path, char *err, size_t err_size)
+static int load_plugin_locked(const char *path, lf_error *err)
 {
     int n_loaded = atomic_load_explicit(&n_plugin_types, memory_order_relaxed);
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        snprintf(err, err_size, "cannot load camera plugin %s: %s", path, dlerror());
-        return -1;
-    }
+    if (!h)
+        return lf_error_set(err, LF_ERR_IO, "cannot load camera plugin %s: %s", path, dlerror());
     plugin_entry_fn entry;
     *(void **)&entry = dlsym(h, "lf_camera_plugin_types");
     if (!entry) {
-        snprintf(err, err_size, "camera plugin %s does not export lf_camera_plugin_types()", path);
+        lf_error_set(err, LF_ERR_UNSUPPORTED, "camera plugin %s does not export lf_camera_plugin_types()", path);
         dlclose(h);
-        return -1;
+        return err->code;
     }
     int count = 0;
     const lf_camera_type *const *types = entry(&count);
     if (!types || count <= 0) {
-        snprintf(err, err_size, "camera plugin %s registers no camera types", path);
+        lf_error_set(err, LF_ERR_UNSUPPORTED, "camera plugin %s registers no camera types", path);
         dlclose(h);
-        return -1;
+        return err->code;
     }
     for (int i = 0; i < count; i++) {
         const lf_camera_type *t = types[i];
         if (!t || t->abi_version < 1u || t->abi_version > LF_CAMERA_ABI_VERSION) {
-            snprintf(err, err_size, "camera plugin %s: type %d has ABI version %u, this lfrender reads 1..%u", path, i,
-                     t ? t->abi_version : 0u, LF_CAMERA_ABI_VERSION);
+            lf_error_set(err, LF_ERR_UNSUPPORTED,
+                         "camera plugin %s: type %d has ABI version %u, this lfrender reads 1..%u", path, i,
+                         t ? t->abi_version : 0u, LF_CAMERA_ABI_VERSION);
             dlclose(h);
-            return -1;
+            return err->code;
         }
         if (!t->name || !t->create || !t->generate_ray || !t->destroy || !t->needs) {
-            snprintf(err, err_size, "camera plugin %s: type %d lacks a name or a required function", path, i);
+            lf_error_set(err, LF_ERR_UNSUPPORTED, "camera plugin %s: type %d lacks a name or a required function", path,
+                         i);
             dlclose(h);
-            return -1;
+            return err->code;
         }
         if (lf_camera_find(t->name)) {
-            snprintf(err, err_size, "camera plugin %s: a camera named \"%s\" is already registered", path, t->name);
+            lf_error_set(err, LF_ERR_PARAM, "camera plugin %s: a camera named \"%s\" is already registered", path,
+                         t->name);
             dlclose(h);
-            return -1;
+            return err->code;
         }
     }
     if (n_loaded + count > MAX_PLUGIN_TYPES) {
-        snprintf(err, err_size, "camera plugin %s: too many plugin camera types (limit %d)", path, MAX_PLUGIN_TYPES);
+        lf_error_set(err, LF_ERR_UNSUPPORTED, "camera plugin %s: too many plugin camera types (limit %d)", path,
+                     MAX_PLUGIN_TYPES);
         dlclose(h);
-        return -1;
+        return err->code;
     }
     for (int i = 0; i < count; i++) {
         const lf_camera_type *t = types[i];

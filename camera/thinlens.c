@@ -104,12 +104,9 @@ static int thinlens_create(const lf_camera_create_args *a, void **state)
                     c->focus_distance, f_mm, c->focal_length);
 
     /* sensor: "float sensorsize" [w h] mm wins over "string sensor" */
-    {
-        char msg[512];
-        if (lf_cam_read_sensor(p, &c->nominal_w_mm, &c->nominal_h_mm, c->sensor_name, sizeof c->sensor_name, msg,
-                               sizeof msg))
-            return fail(a, c, "%s", msg);
-    }
+    lf_error err = {0};
+    if (lf_cam_read_sensor(p, &c->nominal_w_mm, &c->nominal_h_mm, c->sensor_name, sizeof c->sensor_name, &err))
+        return fail(a, c, "%s", err.msg);
     /* the width maps to the image width; square pixels fix the height */
     c->sensor_w = c->nominal_w_mm * 1e-3;
     c->sensor_h = c->sensor_w * c->height / c->width;
@@ -125,10 +122,8 @@ static int thinlens_create(const lf_camera_create_args *a, void **state)
     if (!(c->coc_mm > 0.0) || !isfinite(c->coc_mm))
         return fail(a, c, "\"coc\" (circle of confusion, mm) must be > 0, got %g", c->coc_mm);
 
-    if (lf_aperture_parse(p, &c->aperture, a->error, a->error_size)) {
-        free(c);
-        return -1;
-    }
+    if (lf_aperture_parse(p, &c->aperture, &err))
+        return fail(a, c, "%s", err.msg);
 
     /* thin lens equation, written to stay accurate when z_o >> f */
     double f = c->focal_length, zo = c->focus_distance;

@@ -203,17 +203,17 @@ static int lf_fuzz_lf_attributes(const uint8_t *data, size_t size)
             if (lf_fuzz_take(&p, end, &len, 1) || lf_fuzz_take(&p, end, s, len))
                 break;
             s[len] = '\0';
-            lf_attrs_set_string(&attrs, name, s);
+            lf_attrs_set_string(&attrs, name, s, NULL);
         } else if (type == 1) {
             int32_t v;
             if (lf_fuzz_take(&p, end, &v, 4))
                 break;
-            lf_attrs_set_int(&attrs, name, v);
+            lf_attrs_set_int(&attrs, name, v, NULL);
         } else if (type == 2) {
             double v;
             if (lf_fuzz_take(&p, end, &v, 8))
                 break;
-            lf_attrs_set_double(&attrs, name, v);
+            lf_attrs_set_double(&attrs, name, v, NULL);
         } else {
             uint8_t cnt;
             float v[8];
@@ -222,7 +222,7 @@ static int lf_fuzz_lf_attributes(const uint8_t *data, size_t size)
             cnt %= 9;
             if (lf_fuzz_take(&p, end, v, 4u * cnt))
                 break;
-            lf_attrs_set_floats(&attrs, name, v, cnt);
+            lf_attrs_set_floats(&attrs, name, v, cnt, NULL);
         }
     }
     lf_lightfield_layout file, flags, lay;

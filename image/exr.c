@@ -251,26 +251,26 @@ static int read_attrs(exr_const_context_t ctxt, lf_attrs *attrs)
             if (len)
                 memcpy(s, at->string->str, (size_t)len);
             s[len] = '\0';
-            rc = lf_attrs_set_string(attrs, at->name, s);
+            rc = lf_attrs_set_string(attrs, at->name, s, NULL);
             free(s);
             break;
         }
         case EXR_ATTR_INT:
-            rc = lf_attrs_set_int(attrs, at->name, at->i);
+            rc = lf_attrs_set_int(attrs, at->name, at->i, NULL);
             break;
         case EXR_ATTR_FLOAT:
-            rc = lf_attrs_set_float(attrs, at->name, at->f);
+            rc = lf_attrs_set_float(attrs, at->name, at->f, NULL);
             break;
         case EXR_ATTR_DOUBLE:
-            rc = lf_attrs_set_double(attrs, at->name, at->d);
+            rc = lf_attrs_set_double(attrs, at->name, at->d, NULL);
             break;
         case EXR_ATTR_FLOAT_VECTOR:
             if (at->floatvector)
-                rc = lf_attrs_set_floats(attrs, at->name, at->floatvector->arr, at->floatvector->length);
+                rc = lf_attrs_set_floats(attrs, at->name, at->floatvector->arr, at->floatvector->length, NULL);
             break;
         case EXR_ATTR_M44D:
             if (at->m44d)
-                rc = lf_attrs_set_m44d(attrs, at->name, at->m44d->m);
+                rc = lf_attrs_set_m44d(attrs, at->name, at->m44d->m, NULL);
             break;
         case EXR_ATTR_M44F:
             /* Other writers store camera matrices as m44f; widening is exact. */
@@ -278,7 +278,7 @@ static int read_attrs(exr_const_context_t ctxt, lf_attrs *attrs)
                 double m[16];
                 for (int k = 0; k < 16; k++)
                     m[k] = at->m44f->m[k];
-                rc = lf_attrs_set_m44d(attrs, at->name, m);
+                rc = lf_attrs_set_m44d(attrs, at->name, m, NULL);
             }
             break;
         default: /* types lf_attrs cannot hold are skipped */
@@ -419,6 +419,88 @@ static int read_code(exr_result_t rv)
     }
 }
 
+/* The file's channels in image order (map_channels), each file channel's
+ * image channel (or -1) in out_of_file and which are stored as UINT;
+ * subsampled channels are refused.  *nout: the image channel count. */
+static int read_channel_map(const exr_attr_chlist_t *chl, const char *name, int *map, int *out_of_file, int *uint_of,
+                            int *nout, lf_error *err)
+{
+    *nout = map_channels(chl, map);
+    for (int i = 0; i < chl->num_channels; i++)
+        out_of_file[i] = -1;
+    for (int k = 0; k < *nout; k++) {
+        const exr_attr_chlist_entry_t *e = &chl->entries[map[k]];
+        if (e->x_sampling != 1 || e->y_sampling != 1)
+            return lf_error_set(err, LF_ERR_UNSUPPORTED, "cannot read '%s': channel '%s' is subsampled", name,
+                                e->name.str);
+        out_of_file[map[k]] = k;
+        uint_of[k] = e->pixel_type == EXR_PIXEL_UINT;
+    }
+    return LF_OK;
+}
+
+/* How the file is cut into chunks (tile size, or scanlines per chunk in
+ * *step), and the first chunk located before anything is allocated: a
+ * header promising a large image on a truncated or garbage file fails
+ * here, cheaply. */
+static exr_result_t locate_chunks(exr_context_t ctxt, exr_storage_t storage, const exr_attr_box2i_t *dw, int32_t *tile_w,
+                                  int32_t *tile_h, int32_t *step)
+{
+    exr_result_t rv;
+    if (storage == EXR_STORAGE_TILED) {
+        rv = exr_get_tile_sizes(ctxt, 0, 0, 0, tile_w, tile_h);
+        *step = *tile_h;
+        if (!rv && (*tile_w < 1 || *tile_h < 1))
+            rv = EXR_ERR_INVALID_ATTR;
+    } else {
+        rv = exr_get_scanlines_per_chunk(ctxt, 0, step);
+        if (!rv && *step < 1)
+            rv = EXR_ERR_INVALID_ATTR;
+    }
+    exr_chunk_info_t ci;
+    if (!rv)
+        rv = storage == EXR_STORAGE_TILED ? exr_read_tile_chunk_info(ctxt, 0, 0, 0, 0, 0, &ci)
+                                          : exr_read_scanline_chunk_info(ctxt, 0, dw->min.y, &ci);
+    return rv;
+}
+
+/* No EXR codec packs more than about 1000:1 (deflate's limit; RLE, PIZ and
+ * B44 far less), so a header promising more pixels than 2048 times the
+ * file's bytes (beyond a 256 MiB floor) is a lie: refuse it before
+ * allocating (a 747-byte file once asked for 2.4 GB). */
+static int check_claimed_size(const char *file, const char *name, int64_t width, int64_t height, int nout,
+                              lf_error *err)
+{
+    struct stat st;
+    double need = (double)width * (double)height * (double)nout * 4.0;
+    if (stat(file, &st) == 0 && need > 268435456.0 && need > 2048.0 * (double)st.st_size)
+        return lf_error_set(err, LF_ERR_PARSE,
+                            "cannot read '%s': its header claims %lldx%lld pixels (%.0f MB) but the file has only "
+                            "%lld bytes",
+                            name, (long long)width, (long long)height, need / 1e6, (long long)st.st_size);
+    return LF_OK;
+}
+
+/* Every chunk, tile by tile or scanline block by block, into the image. */
+static exr_result_t decode_chunks(exr_reader *r, exr_context_t ctxt, exr_storage_t storage, int64_t width,
+                                  int64_t height, int32_t tile_w, int32_t tile_h, int32_t step)
+{
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    exr_chunk_info_t ci;
+    if (storage == EXR_STORAGE_TILED) {
+        int32_t tiles_x = (int32_t)((width + tile_w - 1) / tile_w), tiles_y = (int32_t)((height + tile_h - 1) / tile_h);
+        for (int32_t ty = 0; ty < tiles_y && !rv; ty++)
+            for (int32_t tx = 0; tx < tiles_x && !rv; tx++)
+                if (!(rv = exr_read_tile_chunk_info(ctxt, 0, tx, ty, 0, 0, &ci)))
+                    rv = decode_chunk(r, &ci, (int64_t)tx * tile_w, (int64_t)ty * tile_h);
+    } else {
+        for (int64_t y = r->dw.min.y; y <= r->dw.max.y && !rv; y += step)
+            if (!(rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci)))
+                rv = decode_chunk(r, &ci, 0, (int64_t)ci.start_y - r->dw.min.y);
+    }
+    return rv;
+}
+
 int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *attrs, lf_error *err)
 {
     exr_last_msg[0] = '\0';
@@ -456,19 +538,9 @@ int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *att
         rc = lf_error_set(err, LF_ERR_NOMEM, "cannot read '%s': out of memory", name);
         goto done;
     }
-    int nout = map_channels(chl, map);
-    for (int i = 0; i < chl->num_channels; i++)
-        out_of_file[i] = -1;
-    for (int k = 0; k < nout; k++) {
-        const exr_attr_chlist_entry_t *e = &chl->entries[map[k]];
-        if (e->x_sampling != 1 || e->y_sampling != 1) {
-            rc = lf_error_set(err, LF_ERR_UNSUPPORTED, "cannot read '%s': channel '%s' is subsampled", name,
-                              e->name.str);
-            goto done;
-        }
-        out_of_file[map[k]] = k;
-        uint_of[k] = e->pixel_type == EXR_PIXEL_UINT;
-    }
+    int nout;
+    if ((rc = read_channel_map(chl, name, map, out_of_file, uint_of, &nout, err)) != 0)
+        goto done;
     r.out_of_file = out_of_file;
     r.uint_channel = uint_of;
 
@@ -480,43 +552,13 @@ int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *att
         rc = lf_error_set(err, LF_ERR_NOMEM, "cannot read '%s': out of memory for attributes", name);
         goto done;
     }
-
     int32_t tile_w = 0, tile_h = 0, step;
-    if (storage == EXR_STORAGE_TILED) {
-        rv = exr_get_tile_sizes(ctxt, 0, 0, 0, &tile_w, &tile_h);
-        step = tile_h;
-        if (!rv && (tile_w < 1 || tile_h < 1))
-            rv = EXR_ERR_INVALID_ATTR;
-    } else {
-        rv = exr_get_scanlines_per_chunk(ctxt, 0, &step);
-        if (!rv && step < 1)
-            rv = EXR_ERR_INVALID_ATTR;
-    }
-    /* Locate the first chunk before allocating: a header promising a large
-     * image on a truncated or garbage file fails here, cheaply. */
-    exr_chunk_info_t ci;
-    if (!rv)
-        rv = storage == EXR_STORAGE_TILED ? exr_read_tile_chunk_info(ctxt, 0, 0, 0, 0, 0, &ci)
-                                          : exr_read_scanline_chunk_info(ctxt, 0, r.dw.min.y, &ci);
-    if (rv) {
+    if ((rv = locate_chunks(ctxt, storage, &r.dw, &tile_w, &tile_h, &step)) != 0) {
         rc = lf_error_set(err, read_code(rv), "cannot read '%s': %s", name, exr_msg(rv));
         goto done;
     }
-    {
-        /* No EXR codec packs more than about 1000:1 (deflate's limit; RLE,
-         * PIZ and B44 far less), so a header promising more pixels than
-         * 2048 times the file's bytes (beyond a 256 MiB floor) is a lie:
-         * refuse it before allocating (a 747-byte file once asked for 2.4 GB). */
-        struct stat st;
-        double need = (double)width * (double)height * (double)nout * 4.0;
-        if (stat(file, &st) == 0 && need > 268435456.0 && need > 2048.0 * (double)st.st_size) {
-            rc = lf_error_set(err, LF_ERR_PARSE,
-                              "cannot read '%s': its header claims %lldx%lld pixels (%.0f MB) but the file has only "
-                              "%lld bytes",
-                              name, (long long)width, (long long)height, need / 1e6, (long long)st.st_size);
-            goto done;
-        }
-    }
+    if ((rc = check_claimed_size(file, name, width, height, nout, err)) != 0)
+        goto done;
     if ((rc = lf_image_alloc(img, (int)width, (int)height, nout, err)) != 0)
         goto done;
     /* A chunk never exceeds the image, whatever the header says of tiles. */
@@ -528,22 +570,8 @@ int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *att
         rc = lf_error_set(err, LF_ERR_NOMEM, "cannot read '%s': out of memory", name);
         goto done;
     }
-
-    if (storage == EXR_STORAGE_TILED) {
-        int32_t tiles_x = (int32_t)((width + tile_w - 1) / tile_w), tiles_y = (int32_t)((height + tile_h - 1) / tile_h);
-        for (int32_t ty = 0; ty < tiles_y && !rv; ty++)
-            for (int32_t tx = 0; tx < tiles_x && !rv; tx++)
-                if (!(rv = exr_read_tile_chunk_info(ctxt, 0, tx, ty, 0, 0, &ci)))
-                    rv = decode_chunk(&r, &ci, (int64_t)tx * tile_w, (int64_t)ty * tile_h);
-    } else {
-        for (int64_t y = r.dw.min.y; y <= r.dw.max.y && !rv; y += step)
-            if (!(rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &ci)))
-                rv = decode_chunk(&r, &ci, 0, (int64_t)ci.start_y - r.dw.min.y);
-    }
-    if (rv) {
+    if ((rv = decode_chunks(&r, ctxt, storage, width, height, tile_w, tile_h, step)) != 0)
         rc = lf_error_set(err, read_code(rv), "cannot read '%s': %s", name, exr_msg(rv));
-        goto done;
-    }
 
 done:
     if (r.initialized || r.dec.channels)

@@ -92,13 +92,18 @@ static void attr_free_value(lf_attr *at)
     at->v = NULL;
 }
 
+static int attrs_nomem(const char *name, lf_error *err)
+{
+    return lf_error_set(err, LF_ERR_NOMEM, "out of memory for attribute \"%s\"", name ? name : "");
+}
+
 /* Takes ownership of value's payload (s, v) whether it succeeds or not, so
  * callers never leak on the error path. */
-static int attrs_put(lf_attrs *a, const char *name, lf_attr *value)
+static int attrs_put(lf_attrs *a, const char *name, lf_attr *value, lf_error *err)
 {
     if (!a || !name) {
         attr_free_value(value);
-        return LF_ERR_PARAM;
+        return lf_error_set(err, LF_ERR_PARAM, "an attribute needs a list and a name");
     }
     for (size_t i = 0; i < a->count; i++) {
         if (strcmp(a->items[i].name, name) == 0) {
@@ -112,7 +117,7 @@ static int attrs_put(lf_attrs *a, const char *name, lf_attr *value)
     char *dup = strdup(name);
     if (!dup) {
         attr_free_value(value);
-        return LF_ERR_NOMEM;
+        return attrs_nomem(name, err);
     }
     if (a->count == a->cap) {
         size_t cap = a->cap ? a->cap * 2 : 8;
@@ -120,7 +125,7 @@ static int attrs_put(lf_attrs *a, const char *name, lf_attr *value)
         if (!items) {
             free(dup);
             attr_free_value(value);
-            return LF_ERR_NOMEM;
+            return attrs_nomem(name, err);
         }
         a->items = items;
         a->cap = cap;
@@ -131,67 +136,67 @@ static int attrs_put(lf_attrs *a, const char *name, lf_attr *value)
     return LF_OK;
 }
 
-int lf_attrs_set_string(lf_attrs *a, const char *name, const char *value)
+int lf_attrs_set_string(lf_attrs *a, const char *name, const char *value, lf_error *err)
 {
     lf_attr v = {.type = LF_ATTR_STRING};
     v.s = strdup(value ? value : "");
     if (!v.s)
-        return LF_ERR_NOMEM;
-    return attrs_put(a, name, &v);
+        return attrs_nomem(name, err);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_int(lf_attrs *a, const char *name, int value)
+int lf_attrs_set_int(lf_attrs *a, const char *name, int value, lf_error *err)
 {
     lf_attr v = {.type = LF_ATTR_INT, .i = value};
-    return attrs_put(a, name, &v);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_float(lf_attrs *a, const char *name, float value)
+int lf_attrs_set_float(lf_attrs *a, const char *name, float value, lf_error *err)
 {
     lf_attr v = {.type = LF_ATTR_FLOAT, .d = value};
-    return attrs_put(a, name, &v);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_double(lf_attrs *a, const char *name, double value)
+int lf_attrs_set_double(lf_attrs *a, const char *name, double value, lf_error *err)
 {
     lf_attr v = {.type = LF_ATTR_DOUBLE, .d = value};
-    return attrs_put(a, name, &v);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *values, int n)
+int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *values, int n, lf_error *err)
 {
     if (n < 0 || (n > 0 && !values))
-        return LF_ERR_PARAM;
+        return lf_error_set(err, LF_ERR_PARAM, "attribute \"%s\": %d values", name ? name : "", n);
     lf_attr v = {.type = LF_ATTR_FLOATS, .n = n};
     if (n > 0) {
         v.v = malloc((size_t)n * sizeof(float));
         if (!v.v)
-            return LF_ERR_NOMEM;
+            return attrs_nomem(name, err);
         memcpy(v.v, values, (size_t)n * sizeof(float));
     }
-    return attrs_put(a, name, &v);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16])
+int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16], lf_error *err)
 {
     if (!m)
-        return LF_ERR_PARAM;
+        return lf_error_set(err, LF_ERR_PARAM, "attribute \"%s\": no matrix", name ? name : "");
     lf_attr v = {.type = LF_ATTR_M44D};
     memcpy(v.m, m, sizeof v.m);
-    return attrs_put(a, name, &v);
+    return attrs_put(a, name, &v, err);
 }
 
-int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x)
+int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x, lf_error *err)
 {
     switch (x->type) {
-    case LF_ATTR_STRING: return lf_attrs_set_string(a, x->name, x->s);
-    case LF_ATTR_INT: return lf_attrs_set_int(a, x->name, x->i);
-    case LF_ATTR_FLOAT: return lf_attrs_set_float(a, x->name, (float)x->d);
-    case LF_ATTR_DOUBLE: return lf_attrs_set_double(a, x->name, x->d);
-    case LF_ATTR_FLOATS: return lf_attrs_set_floats(a, x->name, x->v, x->n);
-    case LF_ATTR_M44D: return lf_attrs_set_m44d(a, x->name, x->m);
+    case LF_ATTR_STRING: return lf_attrs_set_string(a, x->name, x->s, err);
+    case LF_ATTR_INT: return lf_attrs_set_int(a, x->name, x->i, err);
+    case LF_ATTR_FLOAT: return lf_attrs_set_float(a, x->name, (float)x->d, err);
+    case LF_ATTR_DOUBLE: return lf_attrs_set_double(a, x->name, x->d, err);
+    case LF_ATTR_FLOATS: return lf_attrs_set_floats(a, x->name, x->v, x->n, err);
+    case LF_ATTR_M44D: return lf_attrs_set_m44d(a, x->name, x->m, err);
     }
-    return LF_ERR_PARAM;
+    return lf_error_set(err, LF_ERR_PARAM, "attribute \"%s\": unknown type %d", x->name ? x->name : "", (int)x->type);
 }
 
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name)
@@ -224,7 +229,7 @@ static int attrs_move(lf_attrs *dst, lf_attrs *src)
     for (size_t i = 0; i < src->count; i++) {
         lf_attr *at = &src->items[i];
         if (!rc)
-            rc = attrs_put(dst, at->name, at); /* takes the payload */
+            rc = attrs_put(dst, at->name, at, NULL); /* takes the payload */
         else
             attr_free_value(at);
         free(at->name);

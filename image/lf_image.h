@@ -14,7 +14,7 @@
  * lf_image_write fails with LF_ERR_NUMERIC unless opts->allow_nonfinite.
  *
  *   lf_image img; lf_image_alloc(&img, 640, 480, 3, &err);
- *   lf_attrs a = {0}; lf_attrs_set_string(&a, "lensfield:camera", "perspective");
+ *   lf_attrs a = {0}; lf_attrs_set_string(&a, "lensfield:camera", "perspective", &err);
  *   lf_image_write("out/demo.exr", &img, &a, NULL, &err);
  *   lf_attrs_free(&a); lf_image_free(&img);
  */
@@ -67,15 +67,19 @@ typedef struct lf_attrs {
     size_t count, cap;
 } lf_attrs;
 
-/* Setters replace an attribute of the same name. Return 0 or LF_ERR_NOMEM. */
-int lf_attrs_set_string(lf_attrs *a, const char *name, const char *value);
-int lf_attrs_set_int(lf_attrs *a, const char *name, int value);
-int lf_attrs_set_float(lf_attrs *a, const char *name, float value);
-int lf_attrs_set_double(lf_attrs *a, const char *name, double value);
-int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *v, int n);
-int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16]);
+/* Setters replace an attribute of the same name.  Return 0, or an LF_ERR_*
+ * status with the message in err (may be NULL): LF_ERR_NOMEM ("out of
+ * memory for attribute \"NAME\""), or LF_ERR_PARAM for a missing list,
+ * name or value.  Callers that word the failure themselves (with the file
+ * being written, say) pass NULL. */
+int lf_attrs_set_string(lf_attrs *a, const char *name, const char *value, lf_error *err);
+int lf_attrs_set_int(lf_attrs *a, const char *name, int value, lf_error *err);
+int lf_attrs_set_float(lf_attrs *a, const char *name, float value, lf_error *err);
+int lf_attrs_set_double(lf_attrs *a, const char *name, double value, lf_error *err);
+int lf_attrs_set_floats(lf_attrs *a, const char *name, const float *v, int n, lf_error *err);
+int lf_attrs_set_m44d(lf_attrs *a, const char *name, const double m[16], lf_error *err);
 /* Sets a copy of attribute x (its name, type and value) in a. */
-int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x);
+int lf_attrs_set_copy(lf_attrs *a, const lf_attr *x, lf_error *err);
 const lf_attr *lf_attrs_get(const lf_attrs *a, const char *name);
 void lf_attrs_free(lf_attrs *a);
 

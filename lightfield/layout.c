@@ -324,39 +324,39 @@ int lf_lightfield_layout_to_attrs(const lf_lightfield_layout *lay, lf_attrs *a, 
     int r = 0;
     float v[4];
     if (lay->kind == LF_LIGHTFIELD_CAMERA_ARRAY) {
-        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_CAMERA_ARRAY));
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_CAMERA_ARRAY), NULL);
         v[0] = (float)lay->cams_x, v[1] = (float)lay->cams_y;
-        r |= lf_attrs_set_floats(a, LF_KEY_CAMERAS_PER_DIM, v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_CAMERAS_PER_DIM, v, 2, NULL);
         if (lay->have & LF_LIGHTFIELD_HAVE_BOUNDS) {
             for (int i = 0; i < 4; i++)
                 v[i] = (float)lay->grid_bounds[i];
-            r |= lf_attrs_set_floats(a, LF_KEY_CAMERA_GRID_BOUNDS, v, 4);
+            r |= lf_attrs_set_floats(a, LF_KEY_CAMERA_GRID_BOUNDS, v, 4, NULL);
         }
         if (lay->have & LF_LIGHTFIELD_HAVE_FOV)
-            r |= lf_attrs_set_double(a, LF_KEY_FOV_DEG, lay->fov_deg);
+            r |= lf_attrs_set_double(a, LF_KEY_FOV_DEG, lay->fov_deg, NULL);
         v[0] = (float)lay->tile_w, v[1] = (float)lay->tile_h;
-        r |= lf_attrs_set_floats(a, LF_KEY_TILE_SIZE, v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_TILE_SIZE, v, 2, NULL);
         if (lay->have & LF_LIGHTFIELD_HAVE_CONVERGENCE)
-            r |= lf_attrs_set_double(a, LF_KEY_CONVERGENCE_DISTANCE, lay->convergence_m);
+            r |= lf_attrs_set_double(a, LF_KEY_CONVERGENCE_DISTANCE, lay->convergence_m, NULL);
     } else if (lay->kind == LF_LIGHTFIELD_PLENOPTIC) {
-        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_PLENOPTIC));
-        r |= lf_attrs_set_string(a, LF_KEY_GRID, lf_lightfield_grid_name(lay->grid));
-        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_PX, lay->pitch_px);
-        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_ROTATION_RAD, lay->rotation_rad);
+        r |= lf_attrs_set_string(a, LF_KEY_KIND, lf_lightfield_kind_name(LF_LIGHTFIELD_PLENOPTIC), NULL);
+        r |= lf_attrs_set_string(a, LF_KEY_GRID, lf_lightfield_grid_name(lay->grid), NULL);
+        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_PX, lay->pitch_px, NULL);
+        r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_ROTATION_RAD, lay->rotation_rad, NULL);
         v[0] = (float)lay->offset_px[0], v[1] = (float)lay->offset_px[1];
-        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_OFFSET_PX, v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_OFFSET_PX, v, 2, NULL);
         v[0] = (float)lay->lens_x, v[1] = (float)lay->lens_y;
-        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_COUNT, v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_MICROLENS_COUNT, v, 2, NULL);
         if (lay->have & LF_LIGHTFIELD_HAVE_MAIN_LENS) {
-            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FOCAL_MM, lay->main_focal_mm);
-            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FSTOP, lay->main_fstop);
-            r |= lf_attrs_set_double(a, LF_KEY_MLA_DISTANCE_MM, lay->mla_distance_mm);
-            r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_UM, lay->pitch_um);
+            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FOCAL_MM, lay->main_focal_mm, NULL);
+            r |= lf_attrs_set_double(a, LF_KEY_MAIN_FSTOP, lay->main_fstop, NULL);
+            r |= lf_attrs_set_double(a, LF_KEY_MLA_DISTANCE_MM, lay->mla_distance_mm, NULL);
+            r |= lf_attrs_set_double(a, LF_KEY_MICROLENS_PITCH_UM, lay->pitch_um, NULL);
         }
     }
     if (lay->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) {
         v[0] = (float)lay->disp_min, v[1] = (float)lay->disp_max;
-        r |= lf_attrs_set_floats(a, LF_KEY_DISPARITY_RANGE, v, 2);
+        r |= lf_attrs_set_floats(a, LF_KEY_DISPARITY_RANGE, v, 2, NULL);
     }
     return r ? lf_error_set(err, LF_ERR_NOMEM, "out of memory writing layout attributes") : LF_OK;
 }

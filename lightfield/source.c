@@ -232,7 +232,7 @@ int lf_lightfield_write_refocused(const char *path, const lf_image *img, double 
                           lf_error *err)
 {
     lf_attrs a = {0};
-    int rc = lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, disparity_px)
+    int rc = lf_attrs_set_double(&a, LF_KEY_REFOCUS_DISPARITY_PX, disparity_px, NULL)
                  ? lf_error_set(err, LF_ERR_NOMEM, "cannot write '%s': out of memory", path)
                  : lf_image_write(path, img, &a, wo, err);
     lf_attrs_free(&a);
@@ -253,9 +253,10 @@ int lf_lightfield_write_disparity(const char *path, const lf_image *disp, double
     }
     lf_attrs a = {0};
     float range[2] = {(float)d0, (float)d1};
-    if (lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2) ||
+    if (lf_attrs_set_floats(&a, LF_KEY_DISPARITY_SEARCH_RANGE, range, 2, NULL) ||
         lf_attrs_set_string(&a, LF_KEY_DISPARITY_CONVENTION,
-                            "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step"))
+                            "I_centre(x, y) = I_(iu,iv)(x - d (iu - iu_c), y - d (iv - iv_c)), px per view step",
+                            NULL))
         rc = lf_error_set(err, LF_ERR_NOMEM, "cannot write '%s': out of memory", path);
     else
         rc = lf_image_write(path, disp, &a, wo, err);

@@ -115,12 +115,13 @@ int lf_render_merge(const char *const *paths, int n, lf_image *out, lf_attrs *me
                 if (strncmp(x->name, LF_KEY_PREFIX, sizeof LF_KEY_PREFIX - 1) != 0 || !strcmp(x->name, LF_KEY_PART) ||
                     !strcmp(x->name, LF_KEY_SPP_BEGIN) || !strcmp(x->name, LF_KEY_SPP_END))
                     continue;
-                oom |= lf_attrs_set_copy(meta, x);
+                oom |= lf_attrs_set_copy(meta, x, NULL);
             }
             float b[4] = {(float)bx0, (float)bx1, (float)by0, (float)by1};
-            oom |= lf_attrs_set_int(meta, LF_KEY_SPP, spp_total) | lf_attrs_set_int(meta, LF_KEY_MERGED_PARTS, n) |
-                   lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, seconds) |
-                   lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, b, 4);
+            oom |= lf_attrs_set_int(meta, LF_KEY_SPP, spp_total, NULL) |
+                   lf_attrs_set_int(meta, LF_KEY_MERGED_PARTS, n, NULL) |
+                   lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, seconds, NULL) |
+                   lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, b, 4, NULL);
             if (oom) {
                 lf_image_free(out);
                 rc = lf_error_set(err, LF_ERR_NOMEM, "merge: out of memory for the merged image's attributes");

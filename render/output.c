@@ -25,12 +25,12 @@ int lf_render_write_disparity(lf_renderer *r, const char *out, lf_attrs *meta, c
     for (size_t i = 0; i < (size_t)d.width * d.height; i++)
         range[0] = fminf(range[0], d.data[i]), range[1] = fmaxf(range[1], d.data[i]);
     lf_attrs a = {0};
-    rc = lf_attrs_set_string(meta, LF_KEY_DISPARITY_FILE, base) |
-         lf_attrs_set_floats(meta, LF_KEY_DISPARITY_RANGE, range, 2);
+    rc = lf_attrs_set_string(meta, LF_KEY_DISPARITY_FILE, base, NULL) |
+         lf_attrs_set_floats(meta, LF_KEY_DISPARITY_RANGE, range, 2, NULL);
     for (size_t k = 0; k < meta->count && !rc; k++)
-        rc = lf_attrs_set_copy(&a, &meta->items[k]);
+        rc = lf_attrs_set_copy(&a, &meta->items[k], NULL);
     if (!rc)
-        rc = lf_attrs_set_string(&a, LF_KEY_AOV, "disparity");
+        rc = lf_attrs_set_string(&a, LF_KEY_AOV, "disparity", NULL);
     if (rc)
         rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the disparity AOV's attributes");
     else

@@ -1052,15 +1052,15 @@ static void render_tiles(void *arg, int k0, int k1, int tid)
 
 static void sink_string(void *ctx, const char *name, const char *value)
 {
-    lf_attrs_set_string(ctx, name, value);
+    lf_attrs_set_string(ctx, name, value, NULL);
 }
 static void sink_int(void *ctx, const char *name, int value)
 {
-    lf_attrs_set_int(ctx, name, value);
+    lf_attrs_set_int(ctx, name, value, NULL);
 }
 static void sink_double(void *ctx, const char *name, double value)
 {
-    lf_attrs_set_double(ctx, name, value);
+    lf_attrs_set_double(ctx, name, value, NULL);
 }
 static void sink_doubles(void *ctx, const char *name, const double *v, int n)
 {
@@ -1069,7 +1069,7 @@ static void sink_doubles(void *ctx, const char *name, const double *v, int n)
         n = 64;
     for (int i = 0; i < n; i++)
         tmp[i] = (float)v[i];
-    lf_attrs_set_floats(ctx, name, tmp, n);
+    lf_attrs_set_floats(ctx, name, tmp, n, NULL);
 }
 
 int lf_renderer_disparity(lf_renderer *r, lf_image *out, lf_error *err)
@@ -1161,14 +1161,14 @@ static void done_tiles_hex(const job *jb, const unsigned char *done, char *buf, 
 
 static void part_attrs(const lf_renderer *r, lf_attrs *meta)
 {
-    lf_attrs_set_string(meta, LF_KEY_SETTINGS, r->settings);
-    lf_attrs_set_int(meta, LF_KEY_SPP_BEGIN, r->spp_begin);
-    lf_attrs_set_int(meta, LF_KEY_SPP_END, r->spp_end);
-    lf_attrs_set_int(meta, LF_KEY_SPP_TOTAL, r->sampler.spp);
+    lf_attrs_set_string(meta, LF_KEY_SETTINGS, r->settings, NULL);
+    lf_attrs_set_int(meta, LF_KEY_SPP_BEGIN, r->spp_begin, NULL);
+    lf_attrs_set_int(meta, LF_KEY_SPP_END, r->spp_end, NULL);
+    lf_attrs_set_int(meta, LF_KEY_SPP_TOTAL, r->sampler.spp, NULL);
     float res[2] = {(float)r->xres, (float)r->yres};
-    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
+    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2, NULL);
     float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
-    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
+    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4, NULL);
 }
 
 static int write_checkpoint(const lf_renderer *r, const job *jb, lf_error *err)
@@ -1199,8 +1199,8 @@ static int write_checkpoint(const lf_renderer *r, const job *jb, lf_error *err)
     }
     done_tiles_hex(jb, done, hex, (size_t)total / 4 + 2);
     free(done);
-    lf_attrs_set_string(&a, LF_KEY_DONE_TILES, hex);
-    lf_attrs_set_int(&a, LF_KEY_CHECKPOINT, 1);
+    lf_attrs_set_string(&a, LF_KEY_DONE_TILES, hex, err);
+    lf_attrs_set_int(&a, LF_KEY_CHECKPOINT, 1, err);
     free(hex);
     lf_write_opts wo = {0};
     int rc = lf_image_write(r->opts.checkpoint_path, &ck, &a, &wo, err);
@@ -1298,53 +1298,56 @@ static int render_watched(lf_renderer *r, job *jb, int total, lf_error *err)
 }
 
 /* What the image's lensfield:* attributes record of this render. */
-static void render_attrs(const lf_renderer *r, lf_attrs *meta)
+/* The render's lensfield:* metadata; LF_ERR_NOMEM (in err) if an attribute
+ * could not be stored. */
+static int render_attrs(const lf_renderer *r, lf_attrs *meta, lf_error *err)
 {
-    lf_attrs_set_string(meta, LF_KEY_VERSION, LF_VERSION_STRING);
-    lf_attrs_set_string(meta, LF_KEY_CAMERA, r->camera_name);
+    lf_attrs_set_string(meta, LF_KEY_VERSION, LF_VERSION_STRING, err);
+    lf_attrs_set_string(meta, LF_KEY_CAMERA, r->camera_name, err);
     if (r->scene_path)
-        lf_attrs_set_string(meta, LF_KEY_SCENE, r->scene_path);
-    lf_attrs_set_int(meta, LF_KEY_SPP, r->spp_end - r->spp_begin);
-    lf_attrs_set_string(meta, LF_KEY_SCENE_HASH, r->scene_hash);
-    lf_attrs_set_int(meta, LF_KEY_SAVEFP16, r->save_half);
+        lf_attrs_set_string(meta, LF_KEY_SCENE, r->scene_path, err);
+    lf_attrs_set_int(meta, LF_KEY_SPP, r->spp_end - r->spp_begin, err);
+    lf_attrs_set_string(meta, LF_KEY_SCENE_HASH, r->scene_hash, err);
+    lf_attrs_set_int(meta, LF_KEY_SAVEFP16, r->save_half, err);
     if (r->opts.part) {
-        lf_attrs_set_int(meta, LF_KEY_PART, 1);
+        lf_attrs_set_int(meta, LF_KEY_PART, 1, err);
         part_attrs(r, meta);
     }
-    lf_attrs_set_int(meta, LF_KEY_SEED, (int)r->sampler.seed);
-    lf_attrs_set_string(meta, LF_KEY_SAMPLER, r->sampler_name);
-    lf_attrs_set_string(meta, LF_KEY_FILTER, r->filter_name);
-    lf_attrs_set_int(meta, LF_KEY_MAXDEPTH, r->integrator.max_depth);
-    lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, r->stats.seconds);
-    lf_attrs_set_int(meta, LF_KEY_THREADS, r->threads);
+    lf_attrs_set_int(meta, LF_KEY_SEED, (int)r->sampler.seed, err);
+    lf_attrs_set_string(meta, LF_KEY_SAMPLER, r->sampler_name, err);
+    lf_attrs_set_string(meta, LF_KEY_FILTER, r->filter_name, err);
+    lf_attrs_set_int(meta, LF_KEY_MAXDEPTH, r->integrator.max_depth, err);
+    lf_attrs_set_double(meta, LF_KEY_RENDER_TIME_S, r->stats.seconds, err);
+    lf_attrs_set_int(meta, LF_KEY_THREADS, r->threads, err);
     float res[2] = {(float)r->xres, (float)r->yres};
-    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2);
+    lf_attrs_set_floats(meta, LF_KEY_FULL_RESOLUTION, res, 2, err);
     float crop[4] = {(float)r->px0, (float)r->px1, (float)r->py0, (float)r->py1};
-    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4);
-    lf_attrs_set_double(meta, LF_KEY_FILM_DIAGONAL_MM, r->diagonal_mm);
-    lf_attrs_set_double(meta, LF_KEY_SHUTTER_OPEN, r->shutter_open);
-    lf_attrs_set_double(meta, LF_KEY_SHUTTER_CLOSE, r->shutter_close);
-    lf_attrs_set_double(meta, LF_KEY_IMAGING_RATIO, r->imaging_ratio);
-    lf_attrs_set_int(meta, LF_KEY_NONFINITE_SAMPLES, (int)r->stats.nonfinite_samples);
+    lf_attrs_set_floats(meta, LF_KEY_PIXEL_BOUNDS, crop, 4, err);
+    lf_attrs_set_double(meta, LF_KEY_FILM_DIAGONAL_MM, r->diagonal_mm, err);
+    lf_attrs_set_double(meta, LF_KEY_SHUTTER_OPEN, r->shutter_open, err);
+    lf_attrs_set_double(meta, LF_KEY_SHUTTER_CLOSE, r->shutter_close, err);
+    lf_attrs_set_double(meta, LF_KEY_IMAGING_RATIO, r->imaging_ratio, err);
+    lf_attrs_set_int(meta, LF_KEY_NONFINITE_SAMPLES, (int)r->stats.nonfinite_samples, err);
     double m[16];
     for (int i = 0; i < 16; i++)
         m[i] = r->world_to_camera.m[i / 4][i % 4];
-    lf_attrs_set_m44d(meta, LF_KEY_WORLD_TO_CAMERA, m);
+    lf_attrs_set_m44d(meta, LF_KEY_WORLD_TO_CAMERA, m, err);
     if (r->white)
-        lf_attrs_set_int(meta, LF_KEY_WHITE, 1);
-    lf_attrs_set_string(meta, LF_KEY_SHUTTER, r->rolling ? "rolling" : "global");
+        lf_attrs_set_int(meta, LF_KEY_WHITE, 1, err);
+    lf_attrs_set_string(meta, LF_KEY_SHUTTER, r->rolling ? "rolling" : "global", err);
     if (r->rolling) {
-        lf_attrs_set_double(meta, LF_KEY_READOUT_TIME, r->readout);
+        lf_attrs_set_double(meta, LF_KEY_READOUT_TIME, r->readout, err);
         lf_attrs_set_string(meta, LF_KEY_READOUT_DIRECTION,
-                            (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir]);
+                            (const char *[]){"toptobottom", "bottomtotop", "lefttoright", "righttoleft"}[r->readout_dir], err);
     }
     if (r->has_curve)
-        lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean);
-    lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed);
+        lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean, err);
+    lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed, err);
     if (r->camera_type->metadata) {
         lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
         r->camera_type->metadata(r->camera, &sink);
     }
+    return err ? err->code : 0;
 }
 
 int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *err)
@@ -1411,7 +1414,7 @@ int lf_renderer_render(lf_renderer *r, lf_image *img, lf_attrs *meta, lf_error *
     r->stats.camera_paths = jb.paths;
     r->stats.nonfinite_samples = jb.nonfinite;
     r->stats.zero_weight_camera_rays = jb.zero_weight;
-    if (meta)
-        render_attrs(r, meta);
+    if (meta && render_attrs(r, meta, err))
+        return err->code;
     return 0;
 }

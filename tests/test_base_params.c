@@ -99,7 +99,7 @@ static void test_lookups(void)
     CHECK(lf_params_bool(&ps, "nobool", 1) == 1);
     const char *const *strs = lf_params_strings(&ps, "filename", &cnt);
     CHECK(strs && cnt == 1 && strcmp(strs[0], "out.exr") == 0);
-    CHECK(ps.error.code == LF_OK);
+    CHECK(lf_params_error(&ps)->code == LF_OK);
 
     /* Everything was read: finish succeeds. */
     lf_error err = {0};
@@ -126,9 +126,9 @@ static void test_type_mismatch(void)
     add_nums(&ps, LF_PT_INTEGER, "fov", &fov, 1, 3, 14);
     add_nums(&ps, LF_PT_FLOAT, "lensradius", two, 2, 4, 8);
     CHECK_NEAR(lf_params_float(&ps, "fov", 90), 90, 0); /* default on mismatch */
-    CHECK(ps.error.code == LF_ERR_PARAM);
-    CHECK_MSG(strcmp(ps.error.msg, "scene.pbrt:3:14: parameter \"fov\" is declared integer, expected float") == 0, "%s",
-              ps.error.msg);
+    CHECK(lf_params_error(&ps)->code == LF_ERR_PARAM);
+    const char *msg = lf_params_error(&ps)->msg;
+    CHECK_MSG(strcmp(msg, "scene.pbrt:3:14: parameter \"fov\" is declared integer, expected float") == 0, "%s", msg);
     /* Only the first error is kept, but a wrong count is an error too. */
     CHECK_NEAR(lf_params_float(&ps, "lensradius", 0.5), 0.5, 0);
     lf_error err = {0};
@@ -139,14 +139,15 @@ static void test_type_mismatch(void)
     lf_paramset q = {0};
     add_nums(&q, LF_PT_FLOAT, "lensradius", two, 2, 4, 8);
     CHECK_NEAR(lf_params_float(&q, "lensradius", 0.5), 0.5, 0);
-    CHECK_MSG(strstr(q.error.msg, "scene.pbrt:4:8:") && strstr(q.error.msg, "expects 1 value, got 2"), "%s",
-              q.error.msg);
+    msg = lf_params_error(&q)->msg;
+    CHECK_MSG(strstr(msg, "scene.pbrt:4:8:") && strstr(msg, "expects 1 value, got 2"), "%s", msg);
     lf_params_free(&q);
 
     lf_paramset s = {0};
     add_str(&s, LF_PT_STRING, "fov", "wide", 5, 2);
     CHECK(lf_params_int(&s, "fov", 3) == 3);
-    CHECK_MSG(strstr(s.error.msg, "declared string, expected integer") != NULL, "%s", s.error.msg);
+    msg = lf_params_error(&s)->msg;
+    CHECK_MSG(strstr(msg, "declared string, expected integer") != NULL, "%s", msg);
     lf_params_free(&s);
 }
 
@@ -325,7 +326,7 @@ static void test_params_rgb(void)
     CHECK_NEAR(c.z, 1.442, 1e-3);
     CHECK(lf_params_rgb(&ps, "absent", LF_SPECTRUM_ALBEDO, def, &c) == 0);
     CHECK(c.x == 9.f);
-    CHECK(ps.error.code == LF_OK);
+    CHECK(lf_params_error(&ps)->code == LF_OK);
     lf_error err = {0};
     CHECK(lf_params_finish(&ps, "Material \"diffuse\"", &err) == LF_OK);
     lf_params_free(&ps);
@@ -335,39 +336,133 @@ static void test_params_rgb(void)
     add_str(&bad, LF_PT_SPECTRUM, "eta", "metal-Xx-eta", 7, 12);
     CHECK(lf_params_rgb(&bad, "eta", LF_SPECTRUM_UNBOUNDED, def, &c) == 1);
     CHECK(c.x == 9.f);
-    CHECK_MSG(strstr(bad.error.msg, "scene.pbrt:7:12:") && strstr(bad.error.msg, "\"metal-Xx-eta\""), "%s",
-              bad.error.msg);
+    const char *msg = lf_params_error(&bad)->msg;
+    CHECK_MSG(!strcmp(msg, "scene.pbrt:7:12: spectrum parameter \"eta\": unknown named spectrum \"metal-Xx-eta\" "
+                           "(the scene parser reads spectrum files)"),
+              "%s", msg);
     lf_params_free(&bad);
 
     lf_paramset hi = {0};
     double over[3] = {1.5, 0.2, 0.2};
     add_nums(&hi, LF_PT_RGB, "reflectance", over, 3, 2, 5);
     lf_params_rgb(&hi, "reflectance", LF_SPECTRUM_ALBEDO, def, &c);
-    CHECK_MSG(strstr(hi.error.msg, "greater than 1") != NULL, "%s", hi.error.msg);
+    CHECK_MSG(strstr(lf_params_error(&hi)->msg, "greater than 1") != NULL, "%s", lf_params_error(&hi)->msg);
     lf_params_free(&hi);
     lf_paramset hi2 = {0};
     add_nums(&hi2, LF_PT_RGB, "L", over, 3, 2, 5);
     CHECK(lf_params_rgb(&hi2, "L", LF_SPECTRUM_ILLUMINANT, def, &c) == 1 && c.x == 1.5f);
-    CHECK(hi2.error.code == LF_OK);
+    CHECK(lf_params_error(&hi2)->code == LF_OK);
     lf_params_free(&hi2);
 
     lf_paramset dec = {0};
     double back[4] = {700, 1, 400, 1};
     add_nums(&dec, LF_PT_SPECTRUM, "s", back, 4, 1, 1);
     lf_params_rgb(&dec, "s", LF_SPECTRUM_ALBEDO, def, &c);
-    CHECK_MSG(strstr(dec.error.msg, "wavelengths must increase") != NULL, "%s", dec.error.msg);
+    msg = lf_params_error(&dec)->msg;
+    CHECK_MSG(!strcmp(msg, "scene.pbrt:1:1: spectrum parameter \"s\": wavelengths must increase (400 after 700)"), "%s",
+              msg);
     lf_params_free(&dec);
 
     lf_paramset wrong = {0};
     add_str(&wrong, LF_PT_STRING, "reflectance", "red", 3, 3);
     lf_params_rgb(&wrong, "reflectance", LF_SPECTRUM_ALBEDO, def, &c);
-    CHECK_MSG(strstr(wrong.error.msg, "scene.pbrt:3:3: parameter \"reflectance\" is declared string") != NULL, "%s",
-              wrong.error.msg);
+    msg = lf_params_error(&wrong)->msg;
+    CHECK_MSG(strstr(msg, "scene.pbrt:3:3: parameter \"reflectance\" is declared string") != NULL, "%s", msg);
     lf_params_free(&wrong);
+}
+
+/* base/lf_error.h: the one location formatter, errors with a place, and the
+ * one warning channel, against the formats its header documents. */
+static void test_loc_format(void)
+{
+    char b[64];
+    lf_loc full = {"scene.pbrt", 3, 7}, nocol = {"scene.pbrt", 3, 0}, noline = {"scene.pbrt", 0, 5},
+           nofile = {NULL, 2, 1};
+    CHECK(lf_loc_format(b, sizeof b, &full) == 14 && !strcmp(b, "scene.pbrt:3:7"));
+    CHECK(lf_loc_format(b, sizeof b, &nocol) == 12 && !strcmp(b, "scene.pbrt:3"));
+    CHECK(lf_loc_format(b, sizeof b, &noline) == 10 && !strcmp(b, "scene.pbrt"));
+    CHECK(lf_loc_format(b, sizeof b, &nofile) == 13 && !strcmp(b, "<unknown>:2:1"));
+    CHECK(lf_loc_format(b, sizeof b, NULL) == 9 && !strcmp(b, "<unknown>"));
+    /* snprintf semantics: truncated to n bytes, the full length returned */
+    CHECK(lf_loc_format(b, 6, &full) == 14 && !strcmp(b, "scene"));
+}
+
+static void test_error_at(void)
+{
+    lf_error e = {0};
+    lf_loc at = {"a.pbrt", 12, 4};
+    CHECK(lf_error_at(&e, LF_ERR_PARSE, &at, "unknown directive \"%s\"", "Foo") == LF_ERR_PARSE);
+    CHECK(e.code == LF_ERR_PARSE && !strcmp(e.msg, "a.pbrt:12:4: unknown directive \"Foo\""));
+    /* the first error is kept: the root cause is what the caller sees */
+    CHECK(lf_error_at(&e, LF_ERR_PARAM, &at, "later") == LF_ERR_PARAM);
+    CHECK(e.code == LF_ERR_PARSE && !strcmp(e.msg, "a.pbrt:12:4: unknown directive \"Foo\""));
+    CHECK(lf_error_set(&e, LF_ERR_IO, "also later") == LF_ERR_IO && e.code == LF_ERR_PARSE);
+
+    lf_error_clear(&e);
+    CHECK(e.code == LF_OK && e.msg[0] == '\0');
+    CHECK(lf_error_at(&e, LF_ERR_IO, NULL, "no place %d", 5) == LF_ERR_IO && !strcmp(e.msg, "no place 5"));
+    lf_error_clear(&e);
+    lf_loc col0 = {"b.pbrt", 9, 0}, line0 = {"b.pbrt", 0, 0}, nofile = {NULL, 1, 2};
+    lf_error_at(&e, LF_ERR_PARAM, &col0, "x");
+    CHECK(!strcmp(e.msg, "b.pbrt:9: x"));
+    lf_error_clear(&e);
+    lf_error_at(&e, LF_ERR_PARAM, &line0, "x");
+    CHECK(!strcmp(e.msg, "b.pbrt: x"));
+    lf_error_clear(&e);
+    lf_error_at(&e, LF_ERR_PARAM, &nofile, "x");
+    CHECK(!strcmp(e.msg, "<unknown>:1:2: x"));
+    /* a NULL error is allowed and still returns the code */
+    CHECK(lf_error_at(NULL, LF_ERR_NOMEM, &at, "x") == LF_ERR_NOMEM);
+}
+
+static void test_warnings(void)
+{
+    lf_warnings w = {0};
+    CHECK(lf_warnings_text(&w) == NULL && w.count == 0);
+    lf_loc at = {"s.pbrt", 3, 1}, col0 = {"s.pbrt", 4, 0}, nofile = {NULL, 5, 6};
+    lf_warn_at(&w, &at, "\"%s\" is ignored", "x");
+    CHECK(w.count == 1 && !strcmp(lf_warnings_text(&w), "s.pbrt:3:1: warning: \"x\" is ignored\n"));
+    lf_warn_at(&w, NULL, "plain");
+    lf_warn_at(&w, &col0, "c");
+    lf_warn_at(&w, &nofile, "n");
+    CHECK(w.count == 4);
+    CHECK(!strcmp(lf_warnings_text(&w), "s.pbrt:3:1: warning: \"x\" is ignored\nwarning: plain\n"
+                                        "s.pbrt:4: warning: c\n<unknown>:5:6: warning: n\n"));
+    lf_warnings_free(&w);
+    CHECK(lf_warnings_text(&w) == NULL && w.count == 0 && w.len == 0);
+
+    /* lf_warn_text: lines as they are, a newline added when missing, one
+     * warning per line */
+    lf_warn_text(&w, "a.pbrt:1:1: warning: one\nb.pbrt:2:2: warning: two\nthree");
+    CHECK(w.count == 3 && !strcmp(lf_warnings_text(&w), "a.pbrt:1:1: warning: one\nb.pbrt:2:2: warning: two\nthree\n"));
+    lf_warn_text(&w, "");
+    lf_warn_text(&w, NULL);
+    CHECK(w.count == 3);
+    lf_warnings_free(&w);
+
+    /* many warnings grow the buffer past its first allocation; none lost */
+    char expect[64];
+    for (int i = 0; i < 1000; i++)
+        lf_warn_at(&w, &at, "number %d", i);
+    CHECK(w.count == 1000 && w.lost == 0 && w.cap > 256 && w.len == strlen(w.text));
+    const char *t = lf_warnings_text(&w);
+    snprintf(expect, sizeof expect, "s.pbrt:3:1: warning: number %d\n", 0);
+    CHECK(!strncmp(t, expect, strlen(expect)));
+    snprintf(expect, sizeof expect, "s.pbrt:3:1: warning: number %d\n", 999);
+    CHECK(w.len >= strlen(expect) && !strcmp(t + w.len - strlen(expect), expect));
+    int lines = 0;
+    for (const char *c = t; *c; c++)
+        lines += *c == '\n';
+    CHECK(lines == 1000);
+    lf_warnings_free(&w);
+    lf_warn_at(NULL, &at, "ignored"); /* a NULL channel is allowed */
 }
 
 int main(void)
 {
+    test_loc_format();
+    test_error_at();
+    test_warnings();
     test_type_names();
     test_lookups();
     test_type_mismatch();

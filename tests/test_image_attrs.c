@@ -13,11 +13,17 @@ int main(void)
     double m[16];
     for (int i = 0; i < 16; i++)
         m[i] = i * 0.5;
-    CHECK(lf_attrs_set_string(&a, "s", "text") == 0 && lf_attrs_set_int(&a, "i", -7) == 0);
-    CHECK(lf_attrs_set_float(&a, "f", 0.25f) == 0 && lf_attrs_set_double(&a, "d", 1e-300) == 0);
-    CHECK(lf_attrs_set_floats(&a, "v", v, 3) == 0 && lf_attrs_set_m44d(&a, "m", m) == 0);
+    CHECK(lf_attrs_set_string(&a, "s", "text", NULL) == 0 && lf_attrs_set_int(&a, "i", -7, NULL) == 0);
+    CHECK(lf_attrs_set_float(&a, "f", 0.25f, NULL) == 0 && lf_attrs_set_double(&a, "d", 1e-300, NULL) == 0);
+    CHECK(lf_attrs_set_floats(&a, "v", v, 3, NULL) == 0 && lf_attrs_set_m44d(&a, "m", m, NULL) == 0);
     for (size_t k = 0; k < a.count; k++)
-        CHECK(lf_attrs_set_copy(&b, &a.items[k]) == 0);
+        CHECK(lf_attrs_set_copy(&b, &a.items[k], NULL) == 0);
+    CHECK(b.count == 6);
+    /* failures are an LF_ERR_* status with the library's message */
+    lf_error e = {0};
+    CHECK(lf_attrs_set_floats(&b, "bad", NULL, 3, &e) == LF_ERR_PARAM && !strcmp(e.msg, "attribute \"bad\": 3 values"));
+    lf_error_clear(&e);
+    CHECK(lf_attrs_set_int(NULL, "x", 1, &e) == LF_ERR_PARAM && e.code == LF_ERR_PARAM);
     CHECK(b.count == 6);
     const lf_attr *x;
     CHECK((x = lf_attrs_get(&b, "s")) && x->type == LF_ATTR_STRING && !strcmp(x->s, "text"));

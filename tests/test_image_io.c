@@ -248,15 +248,15 @@ static const float test_floats[5] = {0.5f, -1.25f, 3e10f, 1e-30f, 0.1f};
 
 static void set_test_attrs(lf_attrs *a)
 {
-    CHECK(lf_attrs_set_string(a, "lensfield:camera", "realistic") == 0);
-    CHECK(lf_attrs_set_string(a, "lensfield:empty", "") == 0);
-    CHECK(lf_attrs_set_int(a, "lensfield:spp", -123456) == 0);
-    CHECK(lf_attrs_set_float(a, "lensfield:fstop", 2.8f) == 0);
-    CHECK(lf_attrs_set_double(a, "lensfield:focus_distance", 1.0 / 3.0) == 0);
-    CHECK(lf_attrs_set_floats(a, "lensfield:weights", test_floats, 5) == 0);
-    CHECK(lf_attrs_set_m44d(a, "lensfield:camera_to_world", test_m44) == 0);
+    CHECK(lf_attrs_set_string(a, "lensfield:camera", "realistic", NULL) == 0);
+    CHECK(lf_attrs_set_string(a, "lensfield:empty", "", NULL) == 0);
+    CHECK(lf_attrs_set_int(a, "lensfield:spp", -123456, NULL) == 0);
+    CHECK(lf_attrs_set_float(a, "lensfield:fstop", 2.8f, NULL) == 0);
+    CHECK(lf_attrs_set_double(a, "lensfield:focus_distance", 1.0 / 3.0, NULL) == 0);
+    CHECK(lf_attrs_set_floats(a, "lensfield:weights", test_floats, 5, NULL) == 0);
+    CHECK(lf_attrs_set_m44d(a, "lensfield:camera_to_world", test_m44, NULL) == 0);
     /* Longer than the 31 bytes of a classic EXR name. */
-    CHECK(lf_attrs_set_int(a, "lensfield:a_rather_long_attribute_name_over_31", 7) == 0);
+    CHECK(lf_attrs_set_int(a, "lensfield:a_rather_long_attribute_name_over_31", 7, NULL) == 0);
 }
 
 static void check_test_attrs(const lf_attrs *a)
@@ -286,17 +286,17 @@ static void test_attrs_api(void)
     check_test_attrs(&a);
     size_t n = a.count;
     /* Setting an existing name replaces it, even with another type. */
-    CHECK(lf_attrs_set_int(&a, "lensfield:camera", 5) == 0);
+    CHECK(lf_attrs_set_int(&a, "lensfield:camera", 5, NULL) == 0);
     CHECK(a.count == n);
     const lf_attr *at = lf_attrs_get(&a, "lensfield:camera");
     CHECK(at && at->type == LF_ATTR_INT && at->i == 5);
     CHECK(lf_attrs_get(&a, "missing") == NULL);
-    CHECK(lf_attrs_set_floats(&a, "empty_vector", NULL, 0) == 0);
-    CHECK(lf_attrs_set_floats(&a, "bad", NULL, 3) != 0);
+    CHECK(lf_attrs_set_floats(&a, "empty_vector", NULL, 0, NULL) == 0);
+    CHECK(lf_attrs_set_floats(&a, "bad", NULL, 3, NULL) != 0);
     for (int i = 0; i < 100; i++) { /* growth */
         char name[32];
         snprintf(name, sizeof name, "k%d", i);
-        CHECK(lf_attrs_set_double(&a, name, i) == 0);
+        CHECK(lf_attrs_set_double(&a, name, i, NULL) == 0);
     }
     at = lf_attrs_get(&a, "k99");
     CHECK(at && at->d == 99.0);
@@ -435,7 +435,7 @@ static void test_exr_bad_attrs(void)
     CHECK(lf_image_alloc(&img, 4, 4, 3, &err) == 0);
     lf_attrs a = {0};
     /* "compression" is a required attribute of another type. */
-    lf_attrs_set_string(&a, "compression", "zip");
+    lf_attrs_set_string(&a, "compression", "zip", NULL);
     char p[512];
     path_in(p, sizeof p, "badattr.exr");
     int rc = lf_image_write(p, &img, &a, NULL, &err);

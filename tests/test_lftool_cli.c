@@ -78,10 +78,10 @@ int main(void)
     make_raw(&raw);
     lf_attrs a = {0};
     float cams[2] = {NC, NC}, bounds[4] = {(float)-B, (float)B, (float)-B, (float)B};
-    lf_attrs_set_string(&a, "lensfield:kind", "camera-array");
-    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2);
-    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4);
-    lf_attrs_set_double(&a, "lensfield:fov_deg", FOV);
+    lf_attrs_set_string(&a, "lensfield:kind", "camera-array", NULL);
+    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2, NULL);
+    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4, NULL);
+    lf_attrs_set_double(&a, "lensfield:fov_deg", FOV, NULL);
     CHECK_MSG(lf_image_write(raw_path, &raw, &a, NULL, &err) == 0, "%s", err.msg);
     CHECK(lf_image_write(plain_path, &raw, NULL, NULL, &err) == 0);
 

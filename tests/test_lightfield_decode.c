@@ -282,11 +282,11 @@ static void test_layouts(void)
     CHECK(strstr(err.msg, "lensfield:kind") && strstr(err.msg, "--camsperdim") && strstr(err.msg, "--pitch"));
     lf_error_clear(&err);
     /* camera-array attributes, as lfrender writes them */
-    lf_attrs_set_string(&a, "lensfield:kind", "camera-array");
+    lf_attrs_set_string(&a, "lensfield:kind", "camera-array", NULL);
     float cams[2] = {4, 3}, bounds[4] = {-0.3f, 0.3f, -0.2f, 0.2f};
-    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2);
-    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4);
-    lf_attrs_set_double(&a, "lensfield:fov_deg", 30);
+    lf_attrs_set_floats(&a, "lensfield:cameras_per_dim", cams, 2, NULL);
+    lf_attrs_set_floats(&a, "lensfield:camera_grid_bounds", bounds, 4, NULL);
+    lf_attrs_set_double(&a, "lensfield:fov_deg", 30, NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == 0);
     CHECK(lf_lightfield_layout_resolve(&file, &flags, 80, 45, &out, &err) == 0);
     CHECK(out.tile_w == 20 && out.tile_h == 15);
@@ -319,7 +319,7 @@ static void test_layouts(void)
     CHECK(back.cams_x == 4 && back.cams_y == 3 && back.tile_w == 20 && fabs(back.fov_deg - 30) < 1e-9);
     CHECK(fabs(back.grid_bounds[2] + 0.2) < 1e-6);
     /* wrong types are parse errors */
-    lf_attrs_set_string(&a, "lensfield:kind", "hologram");
+    lf_attrs_set_string(&a, "lensfield:kind", "hologram", NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &file, &err) == LF_ERR_PARSE);
     lf_error_clear(&err);
     lf_attrs_free(&a);
@@ -352,11 +352,11 @@ static void test_layout_attr_decoding(void)
     CHECK(la.kind.state == LF_LAYOUT_ATTR_ABSENT && la.fov_deg.state == LF_LAYOUT_ATTR_ABSENT);
     CHECK(la.kind_id == LF_LIGHTFIELD_KIND_UNKNOWN && !la.grid_known);
     float two[2] = {35, 40}, three[3] = {1, 2, 3};
-    lf_attrs_set_int(&a, "lensfield:kind", 1);
-    lf_attrs_set_int(&a, "lensfield:microlens_pitch_px", 9);
-    lf_attrs_set_floats(&a, "lensfield:fov_deg", two, 2);
-    lf_attrs_set_floats(&a, "lensfield:tile_size", three, 3);
-    lf_attrs_set_string(&a, "lensfield:grid", "triangle");
+    lf_attrs_set_int(&a, "lensfield:kind", 1, NULL);
+    lf_attrs_set_int(&a, "lensfield:microlens_pitch_px", 9, NULL);
+    lf_attrs_set_floats(&a, "lensfield:fov_deg", two, 2, NULL);
+    lf_attrs_set_floats(&a, "lensfield:tile_size", three, 3, NULL);
+    lf_attrs_set_string(&a, "lensfield:grid", "triangle", NULL);
     lf_layout_attrs_decode(&a, &la);
     CHECK(la.kind.state == LF_LAYOUT_ATTR_MALFORMED);
     CHECK(la.microlens_pitch_px.state == LF_LAYOUT_ATTR_SET && la.microlens_pitch_px.v[0] == 9);
@@ -369,18 +369,18 @@ static void test_layout_attr_decoding(void)
     lf_error err = {0};
     CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE && strstr(err.msg, "lensfield:kind"));
     lf_error_clear(&err);
-    lf_attrs_set_string(&a, "lensfield:kind", "plenoptic");
+    lf_attrs_set_string(&a, "lensfield:kind", "plenoptic", NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE);
     CHECK(!strcmp(err.msg, "attribute lensfield:fov_deg: expected a number"));
     lf_error_clear(&err);
-    lf_attrs_set_double(&a, "lensfield:fov_deg", 35);
+    lf_attrs_set_double(&a, "lensfield:fov_deg", 35, NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE);
     CHECK(!strcmp(err.msg, "attribute lensfield:tile_size: expected 2 floats"));
     lf_error_clear(&err);
-    lf_attrs_set_floats(&a, "lensfield:tile_size", two, 2);
+    lf_attrs_set_floats(&a, "lensfield:tile_size", two, 2, NULL);
     CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == LF_ERR_PARSE && strstr(err.msg, "lensfield:grid"));
     lf_error_clear(&err);
-    lf_attrs_set_string(&a, "lensfield:grid", "hex");
+    lf_attrs_set_string(&a, "lensfield:grid", "hex", NULL);
     lf_layout_attrs_decode(&a, &la);
     CHECK(la.kind_id == LF_LIGHTFIELD_PLENOPTIC && la.grid_known && la.grid_id == LF_LIGHTFIELD_GRID_HEX);
     CHECK(lf_lightfield_layout_from_attrs(&a, &lay, &err) == 0);

@@ -46,9 +46,9 @@ static int write_raw(const char *path, float nan_at, const char *disp_file, int 
     lf_attrs a = {0};
     int rc = lf_lightfield_layout_to_attrs(&lay, &a, &err);
     if (disp_file)
-        lf_attrs_set_string(&a, LF_KEY_DISPARITY_FILE, disp_file);
+        lf_attrs_set_string(&a, LF_KEY_DISPARITY_FILE, disp_file, NULL);
     if (with_range)
-        lf_attrs_set_double(&a, LF_KEY_DISP_MIN, -1.5), lf_attrs_set_double(&a, LF_KEY_DISP_MAX, 2.5);
+        lf_attrs_set_double(&a, LF_KEY_DISP_MIN, -1.5, NULL), lf_attrs_set_double(&a, LF_KEY_DISP_MAX, 2.5, NULL);
     lf_write_opts wo = {.allow_nonfinite = 1};
     if (!rc)
         rc = lf_image_write(path, &raw, &a, &wo, &err);

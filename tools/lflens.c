@@ -62,9 +62,10 @@ static int analyse(const char *path, lf_lens *L, lf_lens_report *r)
         return 1;
     }
     if (opt.aperture_mm > 0) {
-        char warn[1024] = "";
-        if (lf_lens_set_stop_diameter(L, opt.aperture_mm, warn, sizeof warn))
-            fprintf(stderr, "lflens: warning: %s\n", warn);
+        lf_warnings warn = {0};
+        if (lf_lens_set_stop_diameter(L, opt.aperture_mm, &warn))
+            fprintf(stderr, "lflens: %s", lf_warnings_text(&warn)); /* "warning: ...\n" */
+        lf_warnings_free(&warn);
         if (L->stop < 0)
             fprintf(stderr, "lflens: warning: %s has no aperture stop row; --aperture ignored\n", path);
     }

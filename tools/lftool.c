@@ -655,8 +655,8 @@ static int cmd_calibrate(int n, char **pos)
     int rc = EXIT_INPUT;
     if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
-    else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1))
-        fprintf(stderr, "lftool: out of memory\n");
+    else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1, &err))
+        fail(&err, NULL);
     else if (!(rc = write_image(o->output, &white, &a))) {
         char buf[1024];
         lf_lightfield_layout_describe(&lay, buf, sizeof buf);

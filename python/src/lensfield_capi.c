@@ -218,17 +218,17 @@ LFPY_API int lfpy_attrs_set(lf_attrs *a, const char *name, int type, const char 
 {
     switch (type) {
     case LF_ATTR_STRING:
-        return lf_attrs_set_string(a, name, s);
+        return lf_attrs_set_string(a, name, s, NULL);
     case LF_ATTR_INT:
-        return lf_attrs_set_int(a, name, i);
+        return lf_attrs_set_int(a, name, i, NULL);
     case LF_ATTR_FLOAT:
-        return lf_attrs_set_float(a, name, (float)d);
+        return lf_attrs_set_float(a, name, (float)d, NULL);
     case LF_ATTR_DOUBLE:
-        return lf_attrs_set_double(a, name, d);
+        return lf_attrs_set_double(a, name, d, NULL);
     case LF_ATTR_FLOATS:
-        return lf_attrs_set_floats(a, name, v, n);
+        return lf_attrs_set_floats(a, name, v, n, NULL);
     case LF_ATTR_M44D:
-        return lf_attrs_set_m44d(a, name, m);
+        return lf_attrs_set_m44d(a, name, m, NULL);
     }
     return LF_ERR_PARAM;
 }

@@ -12,7 +12,7 @@ static void print_usage(FILE *f, const lf_tool *tool, const lf_command *cmd)
     free(u);
 }
 
-int lf_cli_main(const lf_tool *tool, int argc, char **argv)
+int lf_cli_main(const lf_tool *tool, void *opts, int argc, char **argv)
 {
     const lf_command *fallback = lf_args_find(tool, NULL); /* the command run without a name */
     int named = tool->n_commands > (fallback ? 1 : 0);
@@ -66,7 +66,7 @@ int lf_cli_main(const lf_tool *tool, int argc, char **argv)
         rc = 2;
         break;
     default:
-        rc = cmd->run(n_pos, pos);
+        rc = cmd->run(opts, n_pos, pos);
         break;
     }
     free(pos);

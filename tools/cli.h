@@ -1,7 +1,9 @@
 /* cli.h - the one way every lensfield tool runs its command table
  * (base/lf_args.h): picks the subcommand, parses its flags, answers --help,
  * --version and --man, prints usage errors (exit 2), then calls the
- * command's handler and returns its exit code. */
+ * command's handler with the tool's options and returns its exit code.
+ * The flag tables point into the options, which main() owns: no tool keeps
+ * its flags in file-scope state. */
 #ifndef LF_TOOLS_CLI_H
 #define LF_TOOLS_CLI_H
 
@@ -11,6 +13,6 @@
 #define LF_VERSION "unknown"
 #endif
 
-int lf_cli_main(const lf_tool *tool, int argc, char **argv);
+int lf_cli_main(const lf_tool *tool, void *opts, int argc, char **argv);
 
 #endif

@@ -13,6 +13,10 @@
 #define LF_VERSION "unknown"
 #endif
 
+/* Exit codes, the same in every tool (each tool's --help says what 1 means
+ * for it). */
+enum { LF_EXIT_OK = 0, LF_EXIT_FAIL = 1, LF_EXIT_USAGE = 2, LF_EXIT_INTERRUPTED = 130 };
+
 int lf_cli_main(const lf_tool *tool, void *opts, int argc, char **argv);
 
 #endif

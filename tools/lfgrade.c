@@ -14,8 +14,6 @@
 #include "cli.h"
 #include "grade/lf_grade.h"
 
-enum { EXIT_OK = 0, EXIT_GRADER = 1, EXIT_USAGE = 2 };
-
 typedef struct flags {
     const char *report, *cache;
     int json, threads;
@@ -35,23 +33,23 @@ static int run_grade(void *ctx, int n, char **pos)
     lf_error err = {0};
     if (lf_grade_find_assignment(assignment, adir, sizeof adir, &err)) {
         fprintf(stderr, "lfgrade: %s\n", err.msg);
-        return EXIT_USAGE;
+        return LF_EXIT_USAGE;
     }
     o.report_dir = f->report;
     lf_grade_ctx *g;
     if (lf_grade_ctx_new(adir, &o, &g, &err)) {
         fprintf(stderr, "lfgrade: %s\n", err.msg);
-        return EXIT_GRADER;
+        return LF_EXIT_FAIL;
     }
     lf_grade_result *res = calloc((size_t)nsubs, sizeof *res);
-    int rc = res ? EXIT_OK : EXIT_GRADER, graded = 0;
+    int rc = res ? LF_EXIT_OK : LF_EXIT_FAIL, graded = 0;
     for (int i = 0; i < nsubs && res; i++) {
         lf_error e = {0};
         if (lf_grade_submission(g, subs[i], &res[graded], &e)) {
             /* a grader-side failure: say so, keep going with the others */
             fprintf(stderr, "[%d/%d] %s: GRADER ERROR: %s\n", i + 1, nsubs, subs[i], e.msg);
             lf_grade_result_free(&res[graded]);
-            rc = EXIT_GRADER;
+            rc = LF_EXIT_FAIL;
             continue;
         }
         const lf_grade_result *r = &res[graded++];
@@ -72,7 +70,7 @@ static int run_grade(void *ctx, int n, char **pos)
     if (f->report && graded) {
         if (lf_grade_write_gradebook(f->report, res, graded, &err)) {
             fprintf(stderr, "lfgrade: %s\n", err.msg);
-            rc = EXIT_GRADER;
+            rc = LF_EXIT_FAIL;
         } else {
             fprintf(stderr, "lfgrade: reports in %s (gradebook.csv, gradebook.json, <student>/index.html)\n",
                     f->report);

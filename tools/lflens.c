@@ -37,11 +37,11 @@ static int analyse(const flags *f, const char *path, lf_lens *L, lf_lens_report 
     double w, h;
     if (f->sensor && f->diagonal_mm > 0) {
         fprintf(stderr, "lflens: give --sensor or --diagonal, not both\n");
-        return 2;
+        return LF_EXIT_USAGE;
     }
     if (f->sensor && lf_lens_sensor_size(f->sensor, &w, &h)) {
         fprintf(stderr, "lflens: unknown sensor \"%s\" (known: %s)\n", f->sensor, lf_lens_sensor_names());
-        return 2;
+        return LF_EXIT_USAGE;
     }
     if (!f->sensor && f->diagonal_mm > 0)
         w = f->diagonal_mm * 3.0 / sqrt(13.0), h = f->diagonal_mm * 2.0 / sqrt(13.0);
@@ -49,7 +49,7 @@ static int analyse(const flags *f, const char *path, lf_lens *L, lf_lens_report 
         lf_lens_sensor_size("fullframe", &w, &h);
     if (lf_lens_load(path, L, &err)) {
         fprintf(stderr, "lflens: %s\n", err.msg);
-        return 1;
+        return LF_EXIT_FAIL;
     }
     if (f->aperture_mm > 0) {
         char warn[1024] = "";
@@ -61,9 +61,9 @@ static int analyse(const flags *f, const char *path, lf_lens *L, lf_lens_report 
     if (lf_lens_report_compute(L, w, h, f->focus_m, r, &err)) {
         fprintf(stderr, "lflens: %s\n", err.msg);
         lf_lens_free(L);
-        return 1;
+        return LF_EXIT_FAIL;
     }
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static void print_json(const lf_lens *L, const lf_lens_report *r)
@@ -137,7 +137,7 @@ static int run_info(void *ctx, int n, char **pos)
     else
         print_text(f, &L, &r);
     lf_lens_free(&L);
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static int write_plot(const lf_plot *plot, const char *path, lf_error *err)
@@ -167,7 +167,7 @@ static int run_plot(void *ctx, int n, char **pos)
     const char *dot = strrchr(f->out, '.');
     if (!dot || (strcmp(dot, ".svg") && strcmp(dot, ".png"))) {
         fprintf(stderr, "lflens plot: -o wants OUT.svg or OUT.png, got \"%s\"\n", f->out);
-        return 2;
+        return LF_EXIT_USAGE;
     }
     lf_lens L;
     lf_lens_report r;
@@ -181,7 +181,7 @@ static int run_plot(void *ctx, int n, char **pos)
         fprintf(stderr, "lflens: %s\n", err.msg);
     lf_plot_free(&plot);
     lf_lens_free(&L);
-    return rc ? 1 : 0;
+    return rc ? LF_EXIT_FAIL : LF_EXIT_OK;
 }
 
 /* The flag tables point into f, the options the command gets. */

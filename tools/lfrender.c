@@ -69,9 +69,9 @@ static int run_merge(void *ctx, int n, char **parts)
     lf_attrs_free(&meta);
     if (rc) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
-        return 1;
+        return LF_EXIT_FAIL;
     }
-    return 0;
+    return LF_EXIT_OK;
 }
 
 /* The render options from the flags; 0, or 2 after a usage message. */
@@ -85,14 +85,14 @@ static int render_opts_from_flags(const flags *f, lf_render_opts *o)
     if (f->have_crop) {
         if (f->crop[1] <= f->crop[0] || f->crop[3] <= f->crop[2]) {
             fprintf(stderr, "lfrender: --crop x0 x1 y0 y1 needs x0 < x1 and y0 < y1\n");
-            return 2;
+            return LF_EXIT_USAGE;
         }
         memcpy(o->crop, f->crop, sizeof f->crop);
     }
     if (f->have_spp_range) {
         if (f->spp_range[1] <= f->spp_range[0]) {
             fprintf(stderr, "lfrender: --spp-range A B needs A < B\n");
-            return 2;
+            return LF_EXIT_USAGE;
         }
         o->spp_begin = f->spp_range[0], o->spp_end = f->spp_range[1], o->part = 1;
     }
@@ -101,11 +101,11 @@ static int render_opts_from_flags(const flags *f, lf_render_opts *o)
         char extra;
         if (sscanf(f->tile, "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn) {
             fprintf(stderr, "lfrender: --tile wants I/N with 0 <= I < N, got \"%s\"\n", f->tile);
-            return 2;
+            return LF_EXIT_USAGE;
         }
         o->tile_index = ti, o->tile_count = tn, o->part = 1;
     }
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static int run_render(void *ctx, int n, char **pos)
@@ -121,7 +121,7 @@ static int run_render(void *ctx, int n, char **pos)
         char msg[1024]; /* the camera plugin ABI's convention (camera/lf_camera.h) */
         if (lf_camera_load_plugin(f->plugins[i], msg, sizeof msg)) {
             fprintf(stderr, "lfrender: %s\n", msg);
-            return 1;
+            return LF_EXIT_FAIL;
         }
     }
     if (o.checkpoint_every > 0 || o.resume || checkpoint) {
@@ -151,7 +151,7 @@ static int run_render(void *ctx, int n, char **pos)
         else if (count > 1)
             fprintf(stderr, "lfrender: %d errors in %s; nothing written\n", count, scene);
         free(errors);
-        return 1;
+        return LF_EXIT_FAIL;
     }
     o.scene_path = scene;
     lf_progress pr;
@@ -161,7 +161,7 @@ static int run_render(void *ctx, int n, char **pos)
     if (lf_renderer_create(&desc, &o, &r, &err)) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
         lf_scene_desc_free(&desc);
-        return 1;
+        return LF_EXIT_FAIL;
     }
     if (lf_renderer_warnings(r))
         fputs(lf_renderer_warnings(r), stderr);
@@ -173,18 +173,18 @@ static int run_render(void *ctx, int n, char **pos)
         else
             fprintf(stderr, "lfrender: out of memory for the effect plan\n");
         free(plan);
-        rc = plan ? 0 : 1;
+        rc = plan ? LF_EXIT_OK : LF_EXIT_FAIL;
     }
     if (!out)
         out = lf_renderer_film_filename(r);
     if (rc < 0 && o.part && !lf_path_has_ext(out, ".exr")) {
         fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
-        rc = 2;
+        rc = LF_EXIT_USAGE;
     }
     if (rc < 0 && f->aov && (o.part || !lf_path_has_ext(out, ".exr"))) {
         fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
                         "--spp-range)\n");
-        rc = 2;
+        rc = LF_EXIT_USAGE;
     }
     char ckpath[4200];
     if (rc < 0 && (o.checkpoint_every > 0 || o.resume || checkpoint)) {
@@ -198,7 +198,7 @@ static int run_render(void *ctx, int n, char **pos)
     }
     if (rc < 0 && lf_file_check_writable(out, &err)) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
-        rc = 1;
+        rc = LF_EXIT_FAIL;
     }
     if (rc >= 0) {
         lf_renderer_free(r);
@@ -241,7 +241,7 @@ static int run_render(void *ctx, int n, char **pos)
     lf_attrs_free(&meta);
     lf_renderer_free(r);
     lf_scene_desc_free(&desc);
-    return rc == LF_ERR_INTERRUPTED ? 130 : (rc ? 1 : 0);
+    return rc == LF_ERR_INTERRUPTED ? LF_EXIT_INTERRUPTED : (rc ? LF_EXIT_FAIL : LF_EXIT_OK);
 }
 
 /* The flag tables point into f, the options the command gets. */

@@ -21,8 +21,6 @@
 #include "lightfield/lf_source.h"
 #include "web/lf_web.h"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
-
 /* ---------- flags (one table per command; `lftool COMMAND --help`) ---------- */
 
 typedef struct opts {
@@ -55,7 +53,7 @@ typedef struct opts {
 static int usage(const opts *o, const char *msg)
 {
     fprintf(stderr, "lftool: %s\n(lftool %s --help for its flags)\n", msg, o->cmd ? o->cmd : "COMMAND");
-    return EXIT_USAGE;
+    return LF_EXIT_USAGE;
 }
 
 #define R_MIN(lo) .min = (lo), .flags = LF_ARG_HAS_MIN
@@ -176,7 +174,7 @@ static int fail(const lf_error *err, const char *name)
         fprintf(stderr, "lftool: %s: %s\n", name, err->msg);
     else
         fprintf(stderr, "lftool: %s\n", err->msg);
-    return EXIT_INPUT;
+    return LF_EXIT_FAIL;
 }
 
 /* Reads the raw (or folder of views) and resolves its layout (attributes +
@@ -190,14 +188,14 @@ static int load(const opts *o, lf_lightfield_source *s, int layout_only)
     if (!s->folder.dir && s->lf.nonfinite)
         fprintf(stderr, "lftool: %s: warning: %zu non-finite pixel values excluded as missing samples\n", o->input,
                 s->lf.nonfinite);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 static int write_image(const opts *o, const char *path, const lf_image *img, const lf_attrs *a)
 {
     lf_error err = {0};
     lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
-    return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+    return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
 }
 
 /* ---------- commands ---------- */
@@ -213,7 +211,7 @@ static int cmd_info(void *ctx, int n, char **pos)
     lf_lightfield_source_describe(&s, buf, sizeof buf);
     fputs(buf, stdout);
     lf_lightfield_close(&s);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 /* The HCI benchmark layout, with the centre view's ground truth when known. */
@@ -228,7 +226,7 @@ static int decode_hci(const opts *o, const lf_lightfield_source *s)
     if (no_centre)
         fprintf(stderr, "lftool: %s: note: %d x %d views have no centre view; gt_disp_lowres.pfm not written\n",
                 o->input, lf->nu, lf->nv);
-    int rc = lf_lightfield_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : EXIT_OK;
+    int rc = lf_lightfield_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc)
         printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu, lf->nv,
                lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
@@ -267,7 +265,7 @@ static int focus_disparity(const opts *o, const lf_lightfield *lf, double *d)
     if ((o->have_alpha && lf_lightfield_alpha_to_disparity(lf, o->alpha, d, &err)) ||
         (o->have_depth && lf_lightfield_depth_to_disparity(lf, o->depth, d, &err)))
         return fail(&err, o->input);
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static lf_lightfield_refocus_opts aperture_opts(const opts *o)
@@ -362,7 +360,7 @@ static int cmd_stack(void *ctx, int n, char **pos)
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
         lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
-        rc = lf_lightfield_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+        rc = lf_lightfield_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
         lf_image_free(&out);
     }
     if (!rc)
@@ -435,7 +433,7 @@ static int cmd_depth(void *ctx, int n, char **pos)
     if (lf_lightfield_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
         goto failed;
     lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
-    rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+    rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o, o->confidence, &conf, NULL);
     if (!rc)
@@ -490,7 +488,7 @@ static int cmd_view(void *ctx, int n, char **pos)
         goto done;
     }
     if (!plane && o->calibrate_views && calibrate_for_view(o, &s.lf, &dm, &cm, &err))
-        rc = EXIT_INPUT;
+        rc = LF_EXIT_FAIL;
     else if (plane)
         rc = lf_lightfield_view_at(&s.lf, o->u, o->v, d, &out, &err);
     else {
@@ -567,7 +565,7 @@ static int cmd_calibrate(void *ctx, int n, char **pos)
     lf_lightfield_layout_init(&lay);
     if (o->flags.have & LF_LIGHTFIELD_HAVE_GRID)
         lay.grid = o->flags.grid, lay.have |= LF_LIGHTFIELD_HAVE_GRID;
-    int rc = EXIT_INPUT;
+    int rc = LF_EXIT_FAIL;
     if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
     else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1))
@@ -607,14 +605,14 @@ static int cmd_export_web(void *ctx, int n, char **pos)
     if (lf_web_export(&s.lf, o->output, &wo, &info, &err)) {
         fprintf(stderr, "lftool: export-web: %s: %s\n", o->input, err.msg);
         lf_lightfield_close(&s);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
     printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
            "(%.1f KiB, %.2f s CPU)\n",
            o->input, s.lf.nu, s.lf.nv, s.lf.ns, s.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
            info.page_bytes / 1024.0, (double)(clock() - c0) / CLOCKS_PER_SEC);
     lf_lightfield_close(&s);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 static volatile sig_atomic_t serve_stop;
@@ -631,7 +629,7 @@ static int cmd_serve(void *ctx, int n, char **pos)
     lf_error err = {0};
     if (lf_web_server_open(o->input, o->port, &srv, &err)) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
     struct sigaction sa = {0};
     sa.sa_handler = serve_on_signal; /* no SA_RESTART: accept() returns EINTR */
@@ -644,10 +642,10 @@ static int cmd_serve(void *ctx, int n, char **pos)
     lf_web_server_close(srv);
     if (rc) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
     printf("stopped\n");
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 #define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, fn, desc}

@@ -72,3 +72,19 @@ int lf_cli_main(const lf_tool *tool, void *opts, int argc, char **argv)
     free(pos);
     return rc;
 }
+
+static volatile sig_atomic_t stop_requested; /* a signal handler's only way out */
+static void on_stop_signal(int sig)
+{
+    stop_requested = sig; /* non-zero: stop */
+}
+
+volatile sig_atomic_t *lf_cli_stop_on_signals(void)
+{
+    struct sigaction sa = {0};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    return &stop_requested;
+}

@@ -7,16 +7,20 @@
 #ifndef LF_TOOLS_CLI_H
 #define LF_TOOLS_CLI_H
 
+#include <signal.h>
+
 #include "base/lf_args.h"
 
 #ifndef LF_VERSION
 #define LF_VERSION "unknown"
 #endif
 
-/* Exit codes, the same in every tool (each tool's --help says what 1 means
- * for it). */
+/* Exit codes, the same in every tool (its --help says what 1 means there). */
 enum { LF_EXIT_OK = 0, LF_EXIT_FAIL = 1, LF_EXIT_USAGE = 2, LF_EXIT_INTERRUPTED = 130 };
 
 int lf_cli_main(const lf_tool *tool, void *opts, int argc, char **argv);
+
+/* From now on SIGINT/SIGTERM set the returned flag (no SA_RESTART: accept() returns EINTR). */
+volatile sig_atomic_t *lf_cli_stop_on_signals(void);
 
 #endif

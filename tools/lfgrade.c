@@ -83,7 +83,6 @@ static int run_grade(void *ctx, int n, char **pos)
     return rc;
 }
 
-/* The flag tables point into f, the options the command gets. */
 int main(int argc, char **argv)
 {
     flags f = {0};
@@ -95,7 +94,6 @@ int main(int argc, char **argv)
         {"--threads", NULL, LF_ARG_INT, &f.threads, "N", "render threads (default 0: all cores)", .min = 0, .max = 1024,
          .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
     };
-
     const lf_command commands[] = {
         {NULL, "ASSIGNMENT SUBMISSION... [--report DIR] [--json] [--cache DIR] [--threads N]",
          "grade assignment submissions against reference renders", grade_args, LF_ARRAY_LEN(grade_args), 2, -1,
@@ -104,7 +102,6 @@ int main(int argc, char **argv)
          "with the requested images (PNG or EXR) and Submission.md. Nothing in a submission is executed; its commands "
          "are read as data."},
     };
-
     const lf_tool tool = {"lfgrade", "grade course assignments built on lensfield", LF_VERSION, commands,
                           LF_ARRAY_LEN(commands),
                           "Exit status: 0 grading ran (whatever the scores); 1 a grader-side error (bad rubric, "

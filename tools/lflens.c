@@ -184,7 +184,7 @@ static int run_plot(void *ctx, int n, char **pos)
     return rc ? LF_EXIT_FAIL : LF_EXIT_OK;
 }
 
-/* The flag tables point into f, the options the command gets. */
+/* The flag tables (and LENS_FLAGS) point into f, the options the command gets. */
 int main(int argc, char **argv)
 {
     flags f = {.focus_m = INFINITY};
@@ -207,7 +207,6 @@ int main(int argc, char **argv)
          "cross-section with traced ray fans, spot diagrams and the distortion curve", plot_args,
          LF_ARRAY_LEN(plot_args), 1, 1, run_plot, NULL},
     };
-
     const lf_tool tool = {"lflens", "analyse and draw real lens prescriptions (pbrt .dat files)", LF_VERSION,
                           commands, LF_ARRAY_LEN(commands),
                           "Exit status: 0 success; 1 bad lens file or impossible request; 2 bad command line."};

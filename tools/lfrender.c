@@ -3,14 +3,13 @@
  *   lfrender SCENE.pbrt [-o OUT.exr|OUT.png] [options]   (`lfrender --help`)
  *   lfrender merge PART.exr... -o OUT.exr
  *
- * Exit codes: 0 success; 1 the scene or the render failed (message names
- * file:line:column; a scene with several errors gets each, up to 20, and
- * something lensfield cannot render is an error unless --allow-unsupported);
- * 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
+ * Exit codes (tools/cli.h): 0 success; 1 the scene or the render failed
+ * (message names file:line:column; a scene with several errors gets each, up
+ * to 20, and something lensfield cannot render is an error unless
+ * --allow-unsupported); 2 bad command line; 130 interrupted (SIGINT/SIGTERM)
  * after writing a checkpoint that --resume continues from.  No output file is
  * written on failure, and outputs are replaced atomically.
  */
-#include <signal.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,14 +44,6 @@ static void on_progress(void *ctx, long done, long total)
     }
 }
 
-static volatile int stop_requested;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    stop_requested = 1;
-}
-
 static int run_merge(void *ctx, int n, char **parts)
 {
     const flags *f = ctx;
@@ -67,11 +58,9 @@ static int run_merge(void *ctx, int n, char **parts)
         lf_image_free(&img);
     }
     lf_attrs_free(&meta);
-    if (rc) {
+    if (rc)
         fprintf(stderr, "lfrender: %s\n", err.msg);
-        return LF_EXIT_FAIL;
-    }
-    return LF_EXIT_OK;
+    return rc ? LF_EXIT_FAIL : LF_EXIT_OK;
 }
 
 /* The render options from the flags; 0, or 2 after a usage message. */
@@ -108,114 +97,78 @@ static int render_opts_from_flags(const flags *f, lf_render_opts *o)
     return LF_EXIT_OK;
 }
 
-static int run_render(void *ctx, int n, char **pos)
+/* Parses the scene; prints every problem the parser found, one per line. */
+static int parse_scene(const flags *f, const char *scene, lf_scene_desc *desc)
 {
-    (void)n;
-    const flags *f = ctx;
-    const char *scene = pos[0], *out = f->out, *checkpoint = f->checkpoint;
-    lf_render_opts o;
-    int rc = render_opts_from_flags(f, &o);
-    if (rc)
-        return rc;
-    for (int i = 0; i < f->n_plugins; i++) {
-        char msg[1024]; /* the camera plugin ABI's convention (camera/lf_camera.h) */
-        if (lf_camera_load_plugin(f->plugins[i], msg, sizeof msg)) {
-            fprintf(stderr, "lfrender: %s\n", msg);
-            return LF_EXIT_FAIL;
-        }
-    }
-    if (o.checkpoint_every > 0 || o.resume || checkpoint) {
-        /* from here on, SIGINT/SIGTERM stop the render and save a checkpoint */
-        struct sigaction sa;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_signal;
-        sigaction(SIGINT, &sa, NULL);
-        sigaction(SIGTERM, &sa, NULL);
-    }
     lf_error err = {0};
-    lf_scene_desc desc;
     lf_parse_opts popts = {f->allow_unsupported, 0};
     char *errors = NULL;
-    if (lf_scene_parse_file_ex(scene, &popts, &desc, &err, &errors)) {
-        /* every problem the parser found, one per line */
-        int count = 0;
-        for (const char *line = errors; line && *line;) {
-            const char *nl = strchr(line, '\n');
-            int len = nl ? (int)(nl - line) : (int)strlen(line);
-            fprintf(stderr, "lfrender: %.*s\n", len, line);
-            count += line[0] != '(';
-            line += len + (nl != NULL);
-        }
-        if (!errors)
-            fprintf(stderr, "lfrender: %s\n", err.msg);
-        else if (count > 1)
-            fprintf(stderr, "lfrender: %d errors in %s; nothing written\n", count, scene);
-        free(errors);
-        return LF_EXIT_FAIL;
+    if (!lf_scene_parse_file_ex(scene, &popts, desc, &err, &errors))
+        return LF_EXIT_OK;
+    int count = 0;
+    for (const char *line = errors; line && *line;) {
+        const char *nl = strchr(line, '\n');
+        int len = nl ? (int)(nl - line) : (int)strlen(line);
+        fprintf(stderr, "lfrender: %.*s\n", len, line);
+        count += line[0] != '(';
+        line += len + (nl != NULL);
     }
-    o.scene_path = scene;
-    lf_progress pr;
-    o.progress = !f->quiet && isatty(2) ? on_progress : NULL;
-    o.progress_ctx = &pr;
-    lf_renderer *r;
-    if (lf_renderer_create(&desc, &o, &r, &err)) {
+    if (!errors)
         fprintf(stderr, "lfrender: %s\n", err.msg);
-        lf_scene_desc_free(&desc);
-        return LF_EXIT_FAIL;
-    }
-    if (lf_renderer_warnings(r))
-        fputs(lf_renderer_warnings(r), stderr);
-    rc = -1;
+    else if (count > 1)
+        fprintf(stderr, "lfrender: %d errors in %s; nothing written\n", count, scene);
+    free(errors);
+    return LF_EXIT_FAIL;
+}
+
+/* Before rendering: --explain, then the output's checks.  -1 to render,
+ * else the exit code. */
+static int check_output(const flags *f, lf_renderer *r, const lf_render_opts *o, const char **out)
+{
     if (f->explain) {
         char *plan = lf_renderer_explain(r);
         if (plan)
             fputs(plan, stdout);
         else
             fprintf(stderr, "lfrender: out of memory for the effect plan\n");
+        int rc = plan ? LF_EXIT_OK : LF_EXIT_FAIL;
         free(plan);
-        rc = plan ? LF_EXIT_OK : LF_EXIT_FAIL;
-    }
-    if (!out)
-        out = lf_renderer_film_filename(r);
-    if (rc < 0 && o.part && !lf_path_has_ext(out, ".exr")) {
-        fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", out);
-        rc = LF_EXIT_USAGE;
-    }
-    if (rc < 0 && f->aov && (o.part || !lf_path_has_ext(out, ".exr"))) {
-        fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
-                        "--spp-range)\n");
-        rc = LF_EXIT_USAGE;
-    }
-    char ckpath[4200];
-    if (rc < 0 && (o.checkpoint_every > 0 || o.resume || checkpoint)) {
-        if (!checkpoint) {
-            snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
-            checkpoint = ckpath;
-        }
-        o.checkpoint_path = checkpoint;
-        o.stop = &stop_requested;
-        lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
-    }
-    if (rc < 0 && lf_file_check_writable(out, &err)) {
-        fprintf(stderr, "lfrender: %s\n", err.msg);
-        rc = LF_EXIT_FAIL;
-    }
-    if (rc >= 0) {
-        lf_renderer_free(r);
-        lf_scene_desc_free(&desc);
         return rc;
     }
+    if (!*out)
+        *out = lf_renderer_film_filename(r);
+    if (o->part && !lf_path_has_ext(*out, ".exr")) {
+        fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", *out);
+        return LF_EXIT_USAGE;
+    }
+    if (f->aov && (o->part || !lf_path_has_ext(*out, ".exr"))) {
+        fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
+                        "--spp-range)\n");
+        return LF_EXIT_USAGE;
+    }
+    lf_error err = {0};
+    if (lf_file_check_writable(*out, &err)) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
+        return LF_EXIT_FAIL;
+    }
+    return -1;
+}
+
+/* Renders, then writes OUT (and the disparity AOV); an LF_ERR_* status. */
+static int render_and_write(const flags *f, lf_renderer *r, const lf_render_opts *o, const char *out, lf_progress *pr)
+{
     lf_image img;
     lf_attrs meta = {0};
-    lf_progress_start(&pr);
-    rc = lf_renderer_render(r, &img, &meta, &err);
+    lf_error err = {0};
+    lf_progress_start(pr);
+    int rc = lf_renderer_render(r, &img, &meta, &err);
     if (!rc) {
         lf_render_stats st = lf_renderer_stats(r);
         if (st.nonfinite_samples)
             fprintf(stderr, "lfrender: warning: %lld samples had NaN/Inf radiance and were dropped "
                             "(recorded as lensfield:nonfinite_samples)\n", st.nonfinite_samples);
         lf_write_opts wo = lf_write_opts_picture(f->exposure, f->tonemap);
-        wo.half = !o.part && lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
+        wo.half = !o->part && lf_renderer_film_half(r); /* parts carry exact sums: 32-bit floats */
         if (wo.half && !lf_image_fits_half(&img)) { /* half floats top out at 65504: keep bright renders exact */
             fprintf(stderr, "lfrender: note: values above 65504 do not fit Film \"savefp16\"; "
                             "writing 32-bit float channels\n");
@@ -236,15 +189,62 @@ static int run_render(void *ctx, int n, char **pos)
     }
     if (rc)
         fprintf(stderr, "lfrender: %s\n", err.msg);
-    else if (o.checkpoint_path)
-        remove(o.checkpoint_path); /* finished: the checkpoint is no longer needed */
+    else if (o->checkpoint_path)
+        remove(o->checkpoint_path); /* finished: the checkpoint is no longer needed */
     lf_attrs_free(&meta);
-    lf_renderer_free(r);
-    lf_scene_desc_free(&desc);
-    return rc == LF_ERR_INTERRUPTED ? LF_EXIT_INTERRUPTED : (rc ? LF_EXIT_FAIL : LF_EXIT_OK);
+    return rc;
 }
 
-/* The flag tables point into f, the options the command gets. */
+static int run_render(void *ctx, int n, char **pos)
+{
+    (void)n;
+    const flags *f = ctx;
+    const char *scene = pos[0], *out = f->out;
+    lf_render_opts o;
+    int rc = render_opts_from_flags(f, &o);
+    if (rc)
+        return rc;
+    for (int i = 0; i < f->n_plugins; i++) {
+        char msg[1024]; /* the camera plugin ABI's convention (camera/lf_camera.h) */
+        if (lf_camera_load_plugin(f->plugins[i], msg, sizeof msg)) {
+            fprintf(stderr, "lfrender: %s\n", msg);
+            return LF_EXIT_FAIL;
+        }
+    }
+    /* from here on, SIGINT/SIGTERM stop the render and save a checkpoint */
+    volatile sig_atomic_t *stop = o.checkpoint_every > 0 || o.resume || f->checkpoint ? lf_cli_stop_on_signals() : NULL;
+    lf_scene_desc desc;
+    if ((rc = parse_scene(f, scene, &desc)))
+        return rc;
+    o.scene_path = scene;
+    lf_progress pr;
+    o.progress = !f->quiet && isatty(2) ? on_progress : NULL;
+    o.progress_ctx = &pr;
+    lf_renderer *r;
+    lf_error err = {0};
+    if (lf_renderer_create(&desc, &o, &r, &err)) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
+        lf_scene_desc_free(&desc);
+        return LF_EXIT_FAIL;
+    }
+    if (lf_renderer_warnings(r))
+        fputs(lf_renderer_warnings(r), stderr);
+    char ckpath[4200];
+    if ((rc = check_output(f, r, &o, &out)) < 0) {
+        if (stop) {
+            snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
+            o.checkpoint_path = f->checkpoint ? f->checkpoint : ckpath;
+            o.stop = stop;
+            lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
+        }
+        rc = render_and_write(f, r, &o, out, &pr);
+        rc = rc == LF_ERR_INTERRUPTED ? LF_EXIT_INTERRUPTED : (rc ? LF_EXIT_FAIL : LF_EXIT_OK);
+    }
+    lf_renderer_free(r);
+    lf_scene_desc_free(&desc);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     flags f = {0};
@@ -254,8 +254,9 @@ int main(int argc, char **argv)
          "Film's \"filename\")"},
         {"--spp", NULL, LF_ARG_INT, &f.spp, "N", "samples per pixel (default: the Sampler's \"pixelsamples\")",
          .min = 1, .max = 1 << 24, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
-        {"--threads", NULL, LF_ARG_INT, &f.threads, "N", "render threads (default: all cores); never changes the result",
-         .min = 1, .max = 1024, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
+        {"--threads", NULL, LF_ARG_INT, &f.threads, "N",
+         "render threads (default: all cores); never changes the result", .min = 1, .max = 1024,
+         .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
         {"--seed", NULL, LF_ARG_LONG, &f.seed, "S", "sampler seed (default: the Sampler's \"seed\", 0)", .min = 0,
          .max = 4294967295.0, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX, .given = &f.have_seed},
         {"--crop", NULL, LF_ARG_INT, f.crop, "X0 X1 Y0 Y1", "render only pixels [X0,X1) x [Y0,Y1) of the film",
@@ -290,16 +291,15 @@ int main(int argc, char **argv)
     const lf_arg merge_args[] = {
         {"--output", "-o", LF_ARG_STRING, &f.out, "OUT.exr", "the merged image", .flags = LF_ARG_REQUIRED},
     };
-
     const lf_command commands[] = {
         {NULL, "SCENE.pbrt [-o OUT.exr|OUT.png] [options]", "render a pbrt-v4 scene", render_args,
          LF_ARRAY_LEN(render_args), 1, 1, run_render,
-         "Renders SCENE through lensfield's camera pack. The same seed gives the same image, bit for bit, on any number "
-         "of threads; parts of a split render merge into exactly the unsplit image."},
-        {"merge", "PART.exr... -o OUT.exr", "sum parts (--spp-range, --tile, --part) into the unsplit image, bit for bit",
-         merge_args, LF_ARRAY_LEN(merge_args), 1, -1, run_merge, NULL},
+         "Renders SCENE through lensfield's camera pack. The same seed gives the same image, bit for bit, on any "
+         "number of threads; parts of a split render merge into exactly the unsplit image."},
+        {"merge", "PART.exr... -o OUT.exr",
+         "sum parts (--spp-range, --tile, --part) into the unsplit image, bit for bit", merge_args,
+         LF_ARRAY_LEN(merge_args), 1, -1, run_merge, NULL},
     };
-
     const lf_tool tool = {"lfrender", "render pbrt-v4 scenes through lensfield's camera pack", LF_VERSION, commands,
                           LF_ARRAY_LEN(commands),
                           "Exit status: 0 success; 1 the scene or the render failed (the message names "

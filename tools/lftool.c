@@ -7,7 +7,6 @@
  * Exit codes: 0 ok, 1 bad input (the message names the file and what is
  * missing or wrong), 2 usage.
  */
-#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -27,21 +26,16 @@ typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
     const char *confidence, *dispmap, *geometry; /* depth, view, synth */
     lf_lightfield_layout flags;
-    int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to;
+    int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
-    int have_u, have_v;
     int views[4], steps, threads, allow_nonfinite, calibrate_views;
-    /* synth */
     lf_lightfield_synth_opts synth;
-    int have_outfov, have_outdim, have_pos, have_focal;
-    /* export-web, serve */
-    int port, have_steps;
-    /* 8-bit outputs */
-    double exposure;
+    int have_outfov, have_outdim, have_pos, have_focal; /* synth */
+    int port, have_steps;                               /* export-web, serve */
+    double exposure;                                    /* 8-bit outputs */
     const char *tonemap;
-    /* the layout (CS348B names) and the synth camera: gathered first, turned
-     * into flags and synth by apply_flags() */
-    struct {
+    /* the layout (CS348B names) and synth camera, turned into flags and synth by apply_flags() */
+    struct gathered_flags {
         const char *kind, *grid;
         int cams[2], tile[2], lenses[2], outdim[2], spp;
         double griddim[4], fov, pitch, rotation, offset[2], mainlens[4], pos[3], rot[3], focal, outfov, lensradius;
@@ -75,7 +69,8 @@ static int usage(const opts *o, const char *msg)
          .count = 2, .given = &o.fl.g_tile},                                                                         \
         {"--grid", NULL, LF_ARG_CHOICE, &o.fl.grid, "GRID", "layout: microlens grid square or hex",                  \
          .choices = "square|hex", .given = &o.fl.g_grid},                                                            \
-        {"--pitch", NULL, LF_ARG_DOUBLE, &o.fl.pitch, "PX", "layout: microlens pitch (px)", R_POS, .given = &o.fl.g_pitch}, \
+        {"--pitch", NULL, LF_ARG_DOUBLE, &o.fl.pitch, "PX", "layout: microlens pitch (px)", R_POS,               \
+         .given = &o.fl.g_pitch},                                                                                  \
         {"--rotation", NULL, LF_ARG_DOUBLE, &o.fl.rotation, "RAD", "layout: microlens grid rotation",                \
          .given = &o.fl.g_rot},                                                                                      \
         {"--offset", NULL, LF_ARG_DOUBLE, o.fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,     \
@@ -112,45 +107,45 @@ static int usage(const opts *o, const char *msg)
         {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "slices between them", R_IN(lo, 4096),                     \
          .given = &o.have_steps}
 
-
 /* Turns the gathered layout and synth flags (o->fl) into o->flags and o->synth. */
 static void apply_flags(opts *o)
 {
+    const struct gathered_flags *fl = &o->fl;
     lf_lightfield_layout *f = &o->flags;
     lf_lightfield_layout_init(f);
     const struct {
         int given;
         unsigned have;
-    } given[] = {{o->fl.g_kind, LF_LIGHTFIELD_HAVE_KIND},   {o->fl.g_cams, LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_KIND},
-                 {o->fl.g_griddim, LF_LIGHTFIELD_HAVE_BOUNDS}, {o->fl.g_fov, LF_LIGHTFIELD_HAVE_FOV},
-                 {o->fl.g_tile, LF_LIGHTFIELD_HAVE_TILE},    {o->fl.g_grid, LF_LIGHTFIELD_HAVE_GRID},
-                 {o->fl.g_pitch, LF_LIGHTFIELD_HAVE_PITCH},  {o->fl.g_rot, LF_LIGHTFIELD_HAVE_ROTATION},
-                 {o->fl.g_offset, LF_LIGHTFIELD_HAVE_OFFSET}, {o->fl.g_lenses, LF_LIGHTFIELD_HAVE_LENS_COUNT},
-                 {o->fl.g_main, LF_LIGHTFIELD_HAVE_MAIN_LENS}};
+    } given[] = {{fl->g_kind, LF_LIGHTFIELD_HAVE_KIND},   {fl->g_cams, LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_KIND},
+                 {fl->g_griddim, LF_LIGHTFIELD_HAVE_BOUNDS}, {fl->g_fov, LF_LIGHTFIELD_HAVE_FOV},
+                 {fl->g_tile, LF_LIGHTFIELD_HAVE_TILE},    {fl->g_grid, LF_LIGHTFIELD_HAVE_GRID},
+                 {fl->g_pitch, LF_LIGHTFIELD_HAVE_PITCH},  {fl->g_rot, LF_LIGHTFIELD_HAVE_ROTATION},
+                 {fl->g_offset, LF_LIGHTFIELD_HAVE_OFFSET}, {fl->g_lenses, LF_LIGHTFIELD_HAVE_LENS_COUNT},
+                 {fl->g_main, LF_LIGHTFIELD_HAVE_MAIN_LENS}};
     for (size_t i = 0; i < LF_ARRAY_LEN(given); i++)
         if (given[i].given)
             f->have |= given[i].have;
-    f->kind = o->fl.g_cams || (o->fl.g_kind && strcmp(o->fl.kind, "plenoptic")) ? LF_LIGHTFIELD_CAMERA_ARRAY : LF_LIGHTFIELD_PLENOPTIC;
-    f->grid = o->fl.g_grid && !strcmp(o->fl.grid, "hex") ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
-    f->cams_x = o->fl.cams[0], f->cams_y = o->fl.cams[1];
-    memcpy(f->grid_bounds, o->fl.griddim, sizeof f->grid_bounds);
-    f->fov_deg = o->fl.fov, f->pitch_px = o->fl.pitch, f->rotation_rad = o->fl.rotation;
-    f->tile_w = o->fl.tile[0], f->tile_h = o->fl.tile[1];
-    f->offset_px[0] = o->fl.offset[0], f->offset_px[1] = o->fl.offset[1];
-    f->lens_x = o->fl.lenses[0], f->lens_y = o->fl.lenses[1];
-    f->main_focal_mm = o->fl.mainlens[0], f->main_fstop = o->fl.mainlens[1];
-    f->mla_distance_mm = o->fl.mainlens[2], f->pitch_um = o->fl.mainlens[3];
+    f->kind = fl->g_cams || (fl->g_kind && strcmp(fl->kind, "plenoptic")) ? LF_LIGHTFIELD_CAMERA_ARRAY : LF_LIGHTFIELD_PLENOPTIC;
+    f->grid = fl->g_grid && !strcmp(fl->grid, "hex") ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
+    f->cams_x = fl->cams[0], f->cams_y = fl->cams[1];
+    memcpy(f->grid_bounds, fl->griddim, sizeof f->grid_bounds);
+    f->fov_deg = fl->fov, f->pitch_px = fl->pitch, f->rotation_rad = fl->rotation;
+    f->tile_w = fl->tile[0], f->tile_h = fl->tile[1];
+    f->offset_px[0] = fl->offset[0], f->offset_px[1] = fl->offset[1];
+    f->lens_x = fl->lenses[0], f->lens_y = fl->lenses[1];
+    f->main_focal_mm = fl->mainlens[0], f->main_fstop = fl->mainlens[1];
+    f->mla_distance_mm = fl->mainlens[2], f->pitch_um = fl->mainlens[3];
     lf_lightfield_synth_opts *s = &o->synth;
     *s = lf_lightfield_synth_defaults();
     s->threads = o->threads;
-    if (o->fl.g_spp)
-        s->spp = o->fl.spp;
-    if (o->fl.g_seed)
-        s->seed = (uint32_t)o->fl.seed;
-    s->focal_distance = o->fl.focal, s->lens_radius = o->fl.lensradius, s->fov_deg = o->fl.outfov;
-    memcpy(s->pos, o->fl.pos, sizeof s->pos);
-    memcpy(s->rot_deg, o->fl.rot, sizeof s->rot_deg);
-    s->width = o->fl.outdim[0], s->height = o->fl.outdim[1];
+    if (fl->g_spp)
+        s->spp = fl->spp;
+    if (fl->g_seed)
+        s->seed = (uint32_t)fl->seed;
+    s->focal_distance = fl->focal, s->lens_radius = fl->lensradius, s->fov_deg = fl->outfov;
+    memcpy(s->pos, fl->pos, sizeof s->pos);
+    memcpy(s->rot_deg, fl->rot, sizeof s->rot_deg);
+    s->width = fl->outdim[0], s->height = fl->outdim[1];
 }
 
 /* ---------- helpers ---------- */
@@ -159,8 +154,7 @@ static void apply_flags(opts *o)
 static const opts *begin(void *ctx, const char *cmd, int n, char **pos)
 {
     opts *o = ctx;
-    o->cmd = cmd;
-    o->input = pos[0];
+    o->cmd = cmd, o->input = pos[0];
     if (n > 1)
         o->output = pos[1];
     apply_flags(o);
@@ -170,10 +164,7 @@ static const opts *begin(void *ctx, const char *cmd, int n, char **pos)
 /* Prints a library error (after the input's name when given): exit 1. */
 static int fail(const lf_error *err, const char *name)
 {
-    if (name)
-        fprintf(stderr, "lftool: %s: %s\n", name, err->msg);
-    else
-        fprintf(stderr, "lftool: %s\n", err->msg);
+    fprintf(stderr, "lftool: %s%s%s\n", name ? name : "", name ? ": " : "", err->msg);
     return LF_EXIT_FAIL;
 }
 
@@ -615,13 +606,6 @@ static int cmd_export_web(void *ctx, int n, char **pos)
     return LF_EXIT_OK;
 }
 
-static volatile sig_atomic_t serve_stop;
-static void serve_on_signal(int sig)
-{
-    (void)sig;
-    serve_stop = 1;
-}
-
 static int cmd_serve(void *ctx, int n, char **pos)
 {
     const opts *o = begin(ctx, "serve", n, pos);
@@ -631,14 +615,10 @@ static int cmd_serve(void *ctx, int n, char **pos)
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
         return LF_EXIT_FAIL;
     }
-    struct sigaction sa = {0};
-    sa.sa_handler = serve_on_signal; /* no SA_RESTART: accept() returns EINTR */
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    volatile sig_atomic_t *stop = lf_cli_stop_on_signals();
     printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", lf_web_server_root(srv), lf_web_server_port(srv));
     fflush(stdout);
-    int rc = lf_web_server_run(srv, &serve_stop, &err);
+    int rc = lf_web_server_run(srv, stop, &err);
     lf_web_server_close(srv);
     if (rc) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
@@ -650,7 +630,7 @@ static int cmd_serve(void *ctx, int n, char **pos)
 
 #define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, fn, desc}
 
-/* The flag tables point into o, the options every command gets. */
+/* The flag tables (and the *_FLAGS macros) point into o, the options every command gets. */
 int main(int argc, char **argv)
 {
     opts o = {.steps = 9, .oversample = 2, .port = 8000};
@@ -707,7 +687,8 @@ int main(int argc, char **argv)
     };
     const lf_arg synth_args[] = {
         LAYOUT_FLAGS, PICTURE_FLAGS,
-        {"--samplesperpixel", NULL, LF_ARG_INT, &o.fl.spp, "N", "samples per pixel", R_IN(1, 1 << 20), .given = &o.fl.g_spp},
+        {"--samplesperpixel", NULL, LF_ARG_INT, &o.fl.spp, "N", "samples per pixel", R_IN(1, 1 << 20),
+         .given = &o.fl.g_spp},
         {"--focaldistance", NULL, LF_ARG_DOUBLE, &o.fl.focal, "D", "virtual focal plane distance", R_POS,
          .given = &o.have_focal},
         {"--camerapos", NULL, LF_ARG_DOUBLE, o.fl.pos, "X Y Z", "virtual camera position", .count = 3,
@@ -735,7 +716,6 @@ int main(int argc, char **argv)
     const lf_arg serve_args[] = {
         {"--port", NULL, LF_ARG_INT, &o.port, "P", "port on 127.0.0.1 (default 8000; 0: any free)", R_IN(0, 65535)},
     };
-
     const lf_command commands[] = {
         CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
         CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
@@ -762,11 +742,11 @@ int main(int argc, char **argv)
             "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
         CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),
     };
-
     const lf_tool tool = {
         "lftool", "decode, refocus and re-view light fields", LF_VERSION, commands, LF_ARRAY_LEN(commands),
         "IN is a light-field raw (EXR with lensfield:* attributes, or any image plus layout flags) or a folder of "
-        "views: the HCI layout (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC.png|exr (docs/lightfield-format.md). "
+        "views: the HCI layout (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC.png|exr "
+        "(docs/lightfield-format.md). "
         "Exit status: 0 success; 1 bad input (the message names the file); 2 bad command line."};
     return lf_cli_main(&tool, &o, argc, argv);
 }

@@ -21,13 +21,13 @@ typedef struct flags {
 } flags;
 
 #define LENS_FLAGS                                                                                                 \
-    {"--aperture", NULL, LF_ARG_DOUBLE, &f.aperture_mm, "MM", "stop diameter (default: the file's full stop)",  \
-     .min = 0, .flags = LF_ARG_MIN_OPEN},                                                                         \
-        {"--focus", NULL, LF_ARG_DOUBLE, &f.focus_m, "M", "focus distance from the film in metres (default inf)", \
-         .min = 0, .flags = LF_ARG_MIN_OPEN | LF_ARG_INF_OK},                                                     \
-        {"--sensor", NULL, LF_ARG_STRING, &f.sensor, "NAME",                                                    \
+    {"--aperture", NULL, LF_ARG_DOUBLE, &f.aperture_mm, "MM", "stop diameter (default: the file's full stop)",     \
+     .min = 0, .flags = LF_ARG_MIN_OPEN},                                                                          \
+        {"--focus", NULL, LF_ARG_DOUBLE, &f.focus_m, "M", "focus distance from the film in metres (default inf)",  \
+         .min = 0, .flags = LF_ARG_MIN_OPEN | LF_ARG_INF_OK},                                                      \
+        {"--sensor", NULL, LF_ARG_STRING, &f.sensor, "NAME",                                                       \
          "fullframe, apsc, apsh, mediumformat, fourthirds, 1inch, 1/1.63in, 1/2.3in, 1/3.2in (default fullframe)"}, \
-        {"--diagonal", NULL, LF_ARG_DOUBLE, &f.diagonal_mm, "MM", "a film of this diagonal with a 3:2 aspect",   \
+        {"--diagonal", NULL, LF_ARG_DOUBLE, &f.diagonal_mm, "MM", "a film of this diagonal with a 3:2 aspect",     \
          .min = 0, .flags = LF_ARG_MIN_OPEN }
 
 /* Loads the lens and analyses it for the flags' sensor and focus. */

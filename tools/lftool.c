@@ -57,54 +57,54 @@ static int usage(const opts *o, const char *msg)
 /* Layout flags: for raws without lensfield:* attributes (they must agree
  * with the file otherwise). */
 #define LAYOUT_FLAGS                                                                                               \
-    {"--kind", NULL, LF_ARG_CHOICE, &o.fl.kind, "KIND", "layout: camera-array or plenoptic",                         \
-     .choices = "camera-array|plenoptic", .given = &o.fl.g_kind},                                                    \
-        {"--camsperdim", NULL, LF_ARG_INT, o.fl.cams, "NX NY", "layout: data cameras per row and column",           \
-         R_IN(1, 4096), .count = 2, .given = &o.fl.g_cams},                                                          \
-        {"--griddim", NULL, LF_ARG_DOUBLE, o.fl.griddim, "MINX MAXX MINY MAXY", "layout: camera grid bounds (m)",   \
-         .count = 4, .given = &o.fl.g_griddim},                                                                      \
-        {"--inputfov", NULL, LF_ARG_DOUBLE, &o.fl.fov, "DEG", "layout: the data cameras' field of view",            \
-         .min = 0, .max = 180, .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &o.fl.g_fov},                     \
+    {"--kind", NULL, LF_ARG_CHOICE, &o.fl.kind, "KIND", "layout: camera-array or plenoptic",                       \
+     .choices = "camera-array|plenoptic", .given = &o.fl.g_kind},                                                  \
+        {"--camsperdim", NULL, LF_ARG_INT, o.fl.cams, "NX NY", "layout: data cameras per row and column",          \
+         R_IN(1, 4096), .count = 2, .given = &o.fl.g_cams},                                                        \
+        {"--griddim", NULL, LF_ARG_DOUBLE, o.fl.griddim, "MINX MAXX MINY MAXY", "layout: camera grid bounds (m)",  \
+         .count = 4, .given = &o.fl.g_griddim},                                                                    \
+        {"--inputfov", NULL, LF_ARG_DOUBLE, &o.fl.fov, "DEG", "layout: the data cameras' field of view",           \
+         .min = 0, .max = 180, .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &o.fl.g_fov},                  \
         {"--tilesize", NULL, LF_ARG_INT, o.fl.tile, "W H", "layout: tile of one data camera (px)", R_IN(1, 1 << 20), \
-         .count = 2, .given = &o.fl.g_tile},                                                                         \
-        {"--grid", NULL, LF_ARG_CHOICE, &o.fl.grid, "GRID", "layout: microlens grid square or hex",                  \
-         .choices = "square|hex", .given = &o.fl.g_grid},                                                            \
-        {"--pitch", NULL, LF_ARG_DOUBLE, &o.fl.pitch, "PX", "layout: microlens pitch (px)", R_POS,               \
+         .count = 2, .given = &o.fl.g_tile},                                                                       \
+        {"--grid", NULL, LF_ARG_CHOICE, &o.fl.grid, "GRID", "layout: microlens grid square or hex",                \
+         .choices = "square|hex", .given = &o.fl.g_grid},                                                          \
+        {"--pitch", NULL, LF_ARG_DOUBLE, &o.fl.pitch, "PX", "layout: microlens pitch (px)", R_POS,                 \
          .given = &o.fl.g_pitch},                                                                                  \
-        {"--rotation", NULL, LF_ARG_DOUBLE, &o.fl.rotation, "RAD", "layout: microlens grid rotation",                \
-         .given = &o.fl.g_rot},                                                                                      \
-        {"--offset", NULL, LF_ARG_DOUBLE, o.fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,     \
-         .given = &o.fl.g_offset},                                                                                   \
-        {"--lenscount", NULL, LF_ARG_INT, o.fl.lenses, "NX NY", "layout: microlenses per row and column",           \
-         R_IN(1, 1 << 20), .count = 2, .given = &o.fl.g_lenses},                                                     \
-        {"--mainlens", NULL, LF_ARG_DOUBLE, o.fl.mainlens, "FOCAL_MM FSTOP MLA_DISTANCE_MM PITCH_UM",                \
-         "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &o.fl.g_main},    \
-        {"--threads", NULL, LF_ARG_INT, &o.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},       \
-        {"--allow-nonfinite", NULL, LF_ARG_FLAG, &o.allow_nonfinite, NULL,                                      \
+        {"--rotation", NULL, LF_ARG_DOUBLE, &o.fl.rotation, "RAD", "layout: microlens grid rotation",              \
+         .given = &o.fl.g_rot},                                                                                    \
+        {"--offset", NULL, LF_ARG_DOUBLE, o.fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,   \
+         .given = &o.fl.g_offset},                                                                                 \
+        {"--lenscount", NULL, LF_ARG_INT, o.fl.lenses, "NX NY", "layout: microlenses per row and column",          \
+         R_IN(1, 1 << 20), .count = 2, .given = &o.fl.g_lenses},                                                   \
+        {"--mainlens", NULL, LF_ARG_DOUBLE, o.fl.mainlens, "FOCAL_MM FSTOP MLA_DISTANCE_MM PITCH_UM",              \
+         "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &o.fl.g_main}, \
+        {"--threads", NULL, LF_ARG_INT, &o.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},         \
+        {"--allow-nonfinite", NULL, LF_ARG_FLAG, &o.allow_nonfinite, NULL,                                         \
          "treat NaN/Inf raw pixels as missing samples instead of failing"}
 
 #define OUTPUT_FLAG(what) {"--output", "-o", LF_ARG_STRING, &o.output, "OUT", what, .flags = LF_ARG_REQUIRED}
 #define PICTURE_FLAGS                                                                                              \
-    {"--exposure", NULL, LF_ARG_DOUBLE, &o.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",  \
-     R_IN(-64, 64)},                                                                                                \
-        {"--tonemap", NULL, LF_ARG_CHOICE, &o.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)", \
+    {"--exposure", NULL, LF_ARG_DOUBLE, &o.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",   \
+     R_IN(-64, 64)},                                                                                               \
+        {"--tonemap", NULL, LF_ARG_CHOICE, &o.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)",   \
          .choices = "clamp|filmic|aces"}
 #define FOCUS_FLAGS                                                                                                \
-    {"--alpha", NULL, LF_ARG_DOUBLE, &o.alpha, "A", "synthetic film at alpha F (Ng 2005)", R_POS,               \
-     .given = &o.have_alpha},                                                                                    \
-        {"--depth", NULL, LF_ARG_DOUBLE, &o.depth, "M", "the depth brought into focus (m)", R_POS,              \
-         .given = &o.have_depth},                                                                                \
-        {"--disparity", NULL, LF_ARG_DOUBLE, &o.disp, "PX", "the disparity brought into focus (px per view)",    \
+    {"--alpha", NULL, LF_ARG_DOUBLE, &o.alpha, "A", "synthetic film at alpha F (Ng 2005)", R_POS,                  \
+     .given = &o.have_alpha},                                                                                      \
+        {"--depth", NULL, LF_ARG_DOUBLE, &o.depth, "M", "the depth brought into focus (m)", R_POS,                 \
+         .given = &o.have_depth},                                                                                  \
+        {"--disparity", NULL, LF_ARG_DOUBLE, &o.disp, "PX", "the disparity brought into focus (px per view)",      \
          .given = &o.have_disp}
 #define APERTURE_FLAGS                                                                                             \
-    {"--aperture", NULL, LF_ARG_DOUBLE, &o.aperture, "R", "synthetic aperture radius (views from the centre)",   \
-     R_MIN(0), .given = &o.have_aperture},                                                                       \
-        {"--views", NULL, LF_ARG_INT, o.views, "U0 U1 V0 V1", "use only views [U0,U1] x [V0,V1]",                \
+    {"--aperture", NULL, LF_ARG_DOUBLE, &o.aperture, "R", "synthetic aperture radius (views from the centre)",     \
+     R_MIN(0), .given = &o.have_aperture},                                                                         \
+        {"--views", NULL, LF_ARG_INT, o.views, "U0 U1 V0 V1", "use only views [U0,U1] x [V0,V1]",                  \
          R_IN(0, 1 << 20), .count = 4, .given = &o.have_views}
 #define RANGE_FLAGS(lo)                                                                                            \
-    {"--from", NULL, LF_ARG_DOUBLE, &o.from, "D0", "lowest disparity (px per view)", .given = &o.have_from},   \
-        {"--to", NULL, LF_ARG_DOUBLE, &o.to, "D1", "highest disparity (px per view)", .given = &o.have_to},    \
-        {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "slices between them", R_IN(lo, 4096),                     \
+    {"--from", NULL, LF_ARG_DOUBLE, &o.from, "D0", "lowest disparity (px per view)", .given = &o.have_from},       \
+        {"--to", NULL, LF_ARG_DOUBLE, &o.to, "D1", "highest disparity (px per view)", .given = &o.have_to},        \
+        {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "slices between them", R_IN(lo, 4096),                        \
          .given = &o.have_steps}
 
 /* Turns the gathered layout and synth flags (o->fl) into o->flags and o->synth. */

@@ -80,7 +80,7 @@ typedef struct lf_command {
     const lf_arg *args;
     int n_args;
     int min_positional, max_positional; /* max -1: unlimited */
-    int (*run)(int n_positional, char **positional); /* the tool's handler */
+    int (*run)(void *opts, int n_positional, char **positional); /* the handler; opts: lf_cli_main's */
     const char *description;                          /* optional paragraph for --help and man */
 } lf_command;
 

@@ -925,195 +925,263 @@ static void measure(const compare_job *j, const lf_image *x, const lf_image *a, 
     (void)k;
 }
 
-/* Returns 0, or -2 on a grader-side failure (err filled). */
-static int compare(compare_job *j, submission *s, lf_error *err)
-{
-    lf_grade_check_result *r = j->res;
+/* What a variant is compared against: the submission x (8-bit or not) and
+ * the correct reference a; why and gerr carry a grader-side failure. */
+typedef struct subject {
+    const lf_image *x, *a;
+    int eight_bit;
+    int gerr;
     char why[700];
-    lf_image a = {0}, b = {0};
-    int rc = j->make(j, NULL, 0, &a, why, sizeof why);
-    if (!rc)
-        rc = j->make(j, NULL, 1, &b, why, sizeof why);
-    if (rc) {
-        lf_image_free(&a), lf_image_free(&b);
-        if (rc == -2)
-            return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
-        fail(r, "%s", why);
-        return 0;
+} subject;
+
+/* The ratio of search variant v at the factor exp(l) into *r; -1 (r
+ * untouched) when the variant cannot be instantiated. */
+static int ratio_at(compare_job *j, const lf_grade_variant *v, double l, subject *t, double *r)
+{
+    lf_grade_variant inst;
+    if (instantiate(v, v->base * exp(l), &inst))
+        return -1;
+    *r = variant_ratio(j, &inst, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr);
+    free_instance(&inst);
+    return 0;
+}
+
+enum { MAX_SEARCH_STEPS = 25 };
+
+/* A search's first stage: the ratio on a grid of log factors ll over
+ * [lo, hi], at 1/8 of the sample count (the bias dominates away from the
+ * best value).  Returns the best grid index, or -1. */
+static int search_grid(compare_job *j, const lf_grade_variant *v, subject *t, double *ll, double *rr, int *ns_out)
+{
+    double lf0 = log(v->lo), lf1 = log(v->hi);
+    int ns = (int)ceil((lf1 - lf0) / 0.04) + 1;
+    ns = ns > MAX_SEARCH_STEPS ? MAX_SEARCH_STEPS : ns < 3 ? 3 : ns;
+    double bestr = INFINITY;
+    int bi = -1, full_spp = j->spp;
+    j->spp = getenv("LF_GRADE_FULLSEARCH") ? full_spp : full_spp / 8 > 4 ? full_spp / 8 : 4 < full_spp ? 4 : full_spp;
+    for (int q = 0; q < ns && !t->gerr; q++) {
+        ll[q] = lf0 + (lf1 - lf0) * q / (ns - 1);
+        rr[q] = INFINITY;
+        if (fabs(ll[q]) >= 0.005)
+            ratio_at(j, v, ll[q], t, &rr[q]);
+        if (rr[q] < bestr)
+            bestr = rr[q], bi = q;
     }
-    sub_image *im = get_image(s, lf_grade_check_get(j->c, "image", j->c->id), a.width, a.height, why, sizeof why);
-    if (!im) {
-        fail(r, "%s", why);
-        lf_image_free(&a), lf_image_free(&b);
-        return 0;
-    }
-    int eight_bit = !strcmp(im->format, "png");
-    if (eight_bit)
-        lf_grade_quantize8(&a), lf_grade_quantize8(&b);
-    double max_ratio = atof(lf_grade_check_get(j->c, "max_ratio", "3"));
-    r->noise_ratio = lf_grade_noise_ratio(&im->img, &a, &a, &b);
-    r->ssim = lf_grade_ssim(&im->img, &a);
-    r->ssim_noise = lf_grade_ssim(&b, &a);
-    lf_image_psnr(&im->img, &a, &r->psnr_db, NULL);
-    if (j->student_dir) {
-        lf_image heat;
-        write_png(j->student_dir, j->c->id, "submission", &im->img);
-        write_png(j->student_dir, j->c->id, "reference", &a);
-        if (!lf_grade_heatmap(&im->img, &a, &b, &heat)) {
-            write_png(j->student_dir, j->c->id, "diff", &heat);
-            lf_image_free(&heat);
+    j->spp = full_spp;
+    *ns_out = ns;
+    return bi;
+}
+
+/* The vertex of the parabola through the best grid point and its
+ * neighbours (the grid point itself when that is not a minimum). */
+static double grid_vertex(const double *ll, const double *rr, int bi, int ns)
+{
+    double lbest = ll[bi];
+    if (bi > 0 && bi < ns - 1 && isfinite(rr[bi - 1]) && isfinite(rr[bi + 1])) {
+        double den = rr[bi - 1] - 2 * rr[bi] + rr[bi + 1];
+        if (den > 0) {
+            double t = 0.5 * (rr[bi - 1] - rr[bi + 1]) / den;
+            if (t > -1 && t < 1)
+                lbest += t * (ll[1] - ll[0]);
         }
     }
-    if (r->noise_ratio <= max_ratio) {
-        lf_image_free(&a), lf_image_free(&b);
-        return 0;
+    return fabs(lbest) < 0.005 ? ll[bi] : lbest;
+}
+
+/* A search's second stage, at the full sample count: lbest and half a grid
+ * step h either side, then the parabola's vertex (kept unless clearly
+ * worse).  Returns the best log factor, its ratio in *rfull. */
+static double refine_full_count(compare_job *j, const lf_grade_variant *v, subject *t, double lbest, double h,
+                                double *rfull)
+{
+    double rl[3];
+    for (int q = 0; q < 3 && !t->gerr; q++) {
+        rl[q] = INFINITY;
+        if (fabs(lbest + (q - 1) * h) >= 0.005)
+            ratio_at(j, v, lbest + (q - 1) * h, t, &rl[q]);
     }
-    /* which known mistake accounts for it?  Fixed variants first; then
-     * searches (a scene value scaled over a range: any focus error, any
-     * aperture, sensor size or shutter), each located on a grid at 1/8 of
-     * the sample count (the bias dominates away from the best value), then
-     * refined by a parabola and verified at the full count. */
-    r->variant_ratio = INFINITY;
-    const lf_grade_variant *best = NULL;
-    char best_reason[600] = "", found[700] = "";
-    size_t nfound = 0;
-    int gerr = 0;
+    double lfine = lbest;
+    *rfull = rl[1];
+    if (rl[0] < *rfull)
+        *rfull = rl[0], lfine = lbest - h;
+    if (rl[2] < *rfull)
+        *rfull = rl[2], lfine = lbest + h;
+    double den = rl[0] - 2 * rl[1] + rl[2];
+    if (isfinite(den) && den > 0) {
+        double s = 0.5 * (rl[0] - rl[2]) / den, r2;
+        if (s > -1 && s < 1 && fabs(lbest + s * h) >= 0.005 && !t->gerr && !ratio_at(j, v, lbest + s * h, t, &r2) &&
+            r2 <= *rfull * 1.1)
+            *rfull = fmin(r2, *rfull), lfine = lbest + s * h;
+    }
+    return lfine;
+}
+
+/* The fraction of an 8-bit image clipped at white in every colour channel. */
+static double clipped_fraction(const lf_image *x)
+{
+    size_t np = (size_t)x->width * x->height, nc = 0;
+    for (size_t i = 0; i < np; i++) {
+        const float *px = x->data + i * (size_t)x->channels;
+        int all = 1;
+        for (int ch = 0; ch < x->channels && ch < 3; ch++)
+            all &= px[ch] >= 0.999f;
+        nc += (size_t)all;
+    }
+    return np ? (double)nc / (double)np : 0;
+}
+
+/* The verdict on a failed comparison: the known mistake that matches best,
+ * what the searches measured. */
+typedef struct diagnosis {
+    const lf_grade_variant *best;
+    char best_reason[600], found[700];
+    size_t nfound;
+    double clipped;
+} diagnosis;
+
+/* Fixed variants, each with its own two seeds (its noise can differ: a
+ * pinhole is noisier).  Returns the lowest ratio among them. */
+static double match_fixed_variants(compare_job *j, subject *t, diagnosis *d)
+{
+    lf_grade_check_result *r = j->res;
     double fixed_ratio = INFINITY;
-    for (int k = 0; k < j->c->nvariants && !gerr; k++) {
+    for (int k = 0; k < j->c->nvariants && !t->gerr; k++) {
         const lf_grade_variant *v = &j->c->variants[k];
         if (!v->search) {
-            /* each variant with its own two seeds: its noise can differ (a pinhole is noisier) */
-            double rv = variant_ratio(j, v, &im->img, eight_bit, &a, why, sizeof why, &gerr);
+            double rv = variant_ratio(j, v, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr);
             if (rv < r->variant_ratio)
-                r->variant_ratio = rv, best = v, snprintf(best_reason, sizeof best_reason, "%s", v->reason);
+                r->variant_ratio = rv, d->best = v, snprintf(d->best_reason, sizeof d->best_reason, "%s", v->reason);
             fixed_ratio = fmin(fixed_ratio, rv);
         }
     }
-    int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
-    /* an 8-bit image clipped at white over much of its area: any larger
-     * exposure explains the clipped part, so no search is named */
-    double clipped = 0;
-    if (eight_bit) {
-        size_t np = (size_t)im->img.width * im->img.height, nc = 0;
-        for (size_t i = 0; i < np; i++) {
-            const float *px = im->img.data + i * (size_t)im->img.channels;
-            int all = 1;
-            for (int ch = 0; ch < im->img.channels && ch < 3; ch++)
-                all &= px[ch] >= 0.999f;
-            nc += (size_t)all;
-        }
-        clipped = np ? (double)nc / (double)np : 0;
-    }
-    int clip_blind = clipped > 0.2;
-    for (int k = 0; k < j->c->nvariants && !gerr && j->make == make_render; k++) {
+    return fixed_ratio;
+}
+
+/* Searches (a scene value scaled over a range: any focus error, aperture,
+ * sensor size or shutter): each located on a grid, refined, and named
+ * unless a fixed variant already explains the image or it is clipped. */
+static void search_variants(compare_job *j, subject *t, diagnosis *d, int named_ok)
+{
+    lf_grade_check_result *r = j->res;
+    for (int k = 0; k < j->c->nvariants && !t->gerr && j->make == make_render; k++) {
         const lf_grade_variant *v = &j->c->variants[k];
         if (!v->search)
             continue;
-        enum { MAXS = 25 };
-        double lf0 = log(v->lo), lf1 = log(v->hi);
-        int ns = (int)ceil((lf1 - lf0) / 0.04) + 1;
-        ns = ns > MAXS ? MAXS : ns < 3 ? 3 : ns;
-        double rr[MAXS], ll[MAXS], bestr = INFINITY;
-        int bi = -1, full_spp = j->spp;
-        j->spp = getenv("LF_GRADE_FULLSEARCH") ? full_spp : full_spp / 8 > 4 ? full_spp / 8 : 4 < full_spp ? 4 : full_spp;
-        for (int q = 0; q < ns && !gerr; q++) {
-            ll[q] = lf0 + (lf1 - lf0) * q / (ns - 1);
-            rr[q] = INFINITY;
-            if (fabs(ll[q]) < 0.005)
-                continue;
-            lf_grade_variant inst;
-            if (instantiate(v, v->base * exp(ll[q]), &inst))
-                continue;
-            rr[q] = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
-            free_instance(&inst);
-            if (rr[q] < bestr)
-                bestr = rr[q], bi = q;
-        }
-        j->spp = full_spp;
-        if (bi < 0 || gerr)
+        double rr[MAX_SEARCH_STEPS], ll[MAX_SEARCH_STEPS], rfull;
+        int ns, bi = search_grid(j, v, t, ll, rr, &ns);
+        if (bi < 0 || t->gerr)
             continue;
-        double lbest = ll[bi];
-        if (bi > 0 && bi < ns - 1 && isfinite(rr[bi - 1]) && isfinite(rr[bi + 1])) {
-            double den = rr[bi - 1] - 2 * rr[bi] + rr[bi + 1];
-            if (den > 0) {
-                double t = 0.5 * (rr[bi - 1] - rr[bi + 1]) / den;
-                if (t > -1 && t < 1)
-                    lbest += t * (ll[1] - ll[0]);
-            }
-        }
-        if (fabs(lbest) < 0.005)
-            lbest = ll[bi];
-        /* at the full sample count: lbest and half a step either side, then the parabola's vertex */
-        double h = 0.5 * (ll[1] - ll[0]), rl[3], rfull = INFINITY;
-        for (int q = 0; q < 3 && !gerr; q++) {
-            lf_grade_variant inst;
-            rl[q] = INFINITY;
-            if (fabs(lbest + (q - 1) * h) >= 0.005 && !instantiate(v, v->base * exp(lbest + (q - 1) * h), &inst)) {
-                rl[q] = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
-                free_instance(&inst);
-            }
-        }
-        double lfine = lbest;
-        rfull = rl[1];
-        if (rl[0] < rfull)
-            rfull = rl[0], lfine = lbest - h;
-        if (rl[2] < rfull)
-            rfull = rl[2], lfine = lbest + h;
-        double den = rl[0] - 2 * rl[1] + rl[2];
-        if (isfinite(den) && den > 0) {
-            double t = 0.5 * (rl[0] - rl[2]) / den;
-            if (t > -1 && t < 1 && fabs(lbest + t * h) >= 0.005) {
-                lf_grade_variant inst;
-                if (!gerr && !instantiate(v, v->base * exp(lbest + t * h), &inst)) {
-                    double r2 = variant_ratio(j, &inst, &im->img, eight_bit, &a, why, sizeof why, &gerr);
-                    free_instance(&inst);
-                    if (r2 <= rfull * 1.1) /* the vertex: the estimate, unless clearly worse */
-                        rfull = fmin(r2, rfull), lfine = lbest + t * h;
-                }
-            }
-        }
-        lbest = lfine;
-        if (v->measure[0] && nfound + 8 < sizeof found) {
+        double lbest = refine_full_count(j, v, t, grid_vertex(ll, rr, bi, ns), 0.5 * (ll[1] - ll[0]), &rfull);
+        if (v->measure[0] && d->nfound + 8 < sizeof d->found) {
             char m[400];
             search_text(v, v->measure, exp(lbest), m, sizeof m);
-            nfound += (size_t)snprintf(found + nfound, sizeof found - nfound, "; %s (%.1fx)", m, rfull);
-            if (nfound >= sizeof found)
-                nfound = sizeof found - 1;
+            d->nfound += (size_t)snprintf(d->found + d->nfound, sizeof d->found - d->nfound, "; %s (%.1fx)", m, rfull);
+            if (d->nfound >= sizeof d->found)
+                d->nfound = sizeof d->found - 1;
         }
-        if (!fixed_ok && !clip_blind && rfull < r->variant_ratio) {
-            r->variant_ratio = rfull, best = v;
-            search_text(v, v->reason, exp(lbest), best_reason, sizeof best_reason);
+        if (named_ok && rfull < r->variant_ratio) {
+            r->variant_ratio = rfull, d->best = v;
+            search_text(v, v->reason, exp(lbest), d->best_reason, sizeof d->best_reason);
         }
     }
-    if (gerr) {
-        lf_image_free(&a), lf_image_free(&b);
-        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, why);
-    }
-    measure(j, &im->img, &a, r->measurements, sizeof r->measurements);
-    if (clip_blind) {
+}
+
+/* The failure's reason: the matching mistake, or the measurements of an
+ * unrecognised one. */
+static void report_failure(compare_job *j, const sub_image *im, const lf_image *a, const diagnosis *d,
+                           double max_ratio)
+{
+    lf_grade_check_result *r = j->res;
+    measure(j, &im->img, a, r->measurements, sizeof r->measurements);
+    if (d->clipped > 0.2) {
         size_t l = strlen(r->measurements);
         snprintf(r->measurements + l, sizeof r->measurements - l,
                  "; %.0f%% of the pixels clipped at white (over-exposed: brightness and exposure cannot be measured "
                  "there)",
-                 100 * clipped);
+                 100 * d->clipped);
     }
-    if (found[0]) {
+    if (d->found[0]) {
         size_t l = strlen(r->measurements);
-        snprintf(r->measurements + l, sizeof r->measurements - l, "%s", found);
+        snprintf(r->measurements + l, sizeof r->measurements - l, "%s", d->found);
     }
-    if (best)
-        snprintf(r->best_variant, sizeof r->best_variant, "%s", best->name);
-    if (best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio)
+    if (d->best)
+        snprintf(r->best_variant, sizeof r->best_variant, "%s", d->best->name);
+    if (d->best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio)
         fail(r, "%s: %s (matches the reference for that mistake at %.2fx the Monte Carlo noise level; the correct "
                 "reference: %.1fx, pass <= %.1fx); measured: %s",
-             im->file, best_reason, r->variant_ratio, r->noise_ratio, max_ratio, r->measurements);
+             im->file, d->best_reason, r->variant_ratio, r->noise_ratio, max_ratio, r->measurements);
     else
         fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx); "
                 "unrecognised mistake, measured: %s%s",
              im->file, r->noise_ratio, j->spp, max_ratio, r->measurements,
-             best ? " (no known mistake accounts for it)" : "");
+             d->best ? " (no known mistake accounts for it)" : "");
+}
+
+/* The scores of x against the correct reference a (b: its second seed),
+ * and the report's pictures. */
+static void score(compare_job *j, const lf_image *x, const lf_image *a, const lf_image *b)
+{
+    lf_grade_check_result *r = j->res;
+    r->noise_ratio = lf_grade_noise_ratio(x, a, a, b);
+    r->ssim = lf_grade_ssim(x, a);
+    r->ssim_noise = lf_grade_ssim(b, a);
+    lf_image_psnr(x, a, &r->psnr_db, NULL);
+    if (j->student_dir) {
+        lf_image heat;
+        write_png(j->student_dir, j->c->id, "submission", x);
+        write_png(j->student_dir, j->c->id, "reference", a);
+        if (!lf_grade_heatmap(x, a, b, &heat)) {
+            write_png(j->student_dir, j->c->id, "diff", &heat);
+            lf_image_free(&heat);
+        }
+    }
+}
+
+/* Returns 0, or -2 on a grader-side failure (err filled).  A submission
+ * beyond the noise level goes on to the diagnosis: which known mistake
+ * accounts for it? */
+static int compare(compare_job *j, submission *s, lf_error *err)
+{
+    lf_grade_check_result *r = j->res;
+    subject t = {0};
+    lf_image a = {0}, b = {0};
+    int rc = j->make(j, NULL, 0, &a, t.why, sizeof t.why);
+    if (!rc)
+        rc = j->make(j, NULL, 1, &b, t.why, sizeof t.why);
+    if (rc) {
+        lf_image_free(&a), lf_image_free(&b);
+        if (rc == -2)
+            return lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, t.why);
+        fail(r, "%s", t.why);
+        return 0;
+    }
+    sub_image *im = get_image(s, lf_grade_check_get(j->c, "image", j->c->id), a.width, a.height, t.why, sizeof t.why);
+    if (!im) {
+        fail(r, "%s", t.why);
+        lf_image_free(&a), lf_image_free(&b);
+        return 0;
+    }
+    t.x = &im->img, t.a = &a, t.eight_bit = !strcmp(im->format, "png");
+    if (t.eight_bit)
+        lf_grade_quantize8(&a), lf_grade_quantize8(&b);
+    double max_ratio = atof(lf_grade_check_get(j->c, "max_ratio", "3"));
+    score(j, &im->img, &a, &b);
+    if (r->noise_ratio > max_ratio) {
+        diagnosis d = {0};
+        r->variant_ratio = INFINITY;
+        double fixed_ratio = match_fixed_variants(j, &t, &d);
+        int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
+        /* an 8-bit image clipped at white over much of its area: any larger
+         * exposure explains the clipped part, so no search is named */
+        d.clipped = t.eight_bit ? clipped_fraction(&im->img) : 0;
+        search_variants(j, &t, &d, !fixed_ok && d.clipped <= 0.2);
+        if (t.gerr)
+            rc = lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, t.why);
+        else
+            report_failure(j, im, &a, &d, max_ratio);
+    }
     lf_image_free(&a), lf_image_free(&b);
-    return 0;
+    return rc;
 }
 
 /* ---------- focus of a refocused plenoptic image, region by region ---------- */
@@ -1163,116 +1231,111 @@ static double depth_of_disparity(const lf_lightfield *lf, double d)
     return lf->disp_per_inv_m != 0 && den * lf->disp_per_inv_m > 0 ? lf->disp_per_inv_m / den : INFINITY;
 }
 
-/* kind focus (docs/grading.md): the submitted image must be the reference
- * plenoptic capture refocused at `depth`: the subject at that depth as sharp
- * as in the reference refocused there (>= min_sharpness of it), the others
- * no sharper than max_sharpness of theirs (a full aperture), the brightness
- * within max_brightness.  Failing, the reason gives the measurements and the
- * depth the image looks focused at (the refocus sweep of the reference whose
- * per-region sharpness matches best). */
-static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r, lf_error *err)
-{
+/* A focus check's state: its subjects, the depth asked and the reference
+ * capture; from the sweep, where the submission looks focused. */
+typedef struct focus_check {
     focus_subject sj[8];
-    char why[700];
-    int ns = parse_subjects(lf_grade_check_get(c, "subjects", ""), sj, 8, why, sizeof why);
-    if (ns < 0)
-        return lf_error_set(err, LF_ERR_PARSE, "check %s: %s", c->id, why);
-    double want = atof(lf_grade_check_get(c, "depth", "0"));
-    double min_sharp = atof(lf_grade_check_get(c, "min_sharpness", "0.6"));
-    double max_sharp = atof(lf_grade_check_get(c, "max_sharpness", "1.8"));
-    double max_bright = atof(lf_grade_check_get(c, "max_brightness", "1.2"));
-    double focus_tol = atof(lf_grade_check_get(c, "focus_tol", "0.1")); /* px/view */
-    int spp = atoi(lf_grade_check_get(c, "spp", "8"));
-    uint32_t seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
-    const lf_image *raw;
-    const lf_attrs *meta;
-    if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
-        return lf_error_set(err, err->code, "check %s: reference light field: %s", c->id, err->msg);
+    int ns, target;           /* target: the subject nearest the asked depth */
+    double want, d_want;      /* the asked depth (m) and its disparity (px/view) */
+    lf_lightfield lf;         /* the reference capture, decoded */
+    const sub_image *im;
+    int eight_bit;
+    double best_d;            /* the sweep's best match (px/view) */
+    double best_sweep[8];     /* its sharpness, subject by subject */
+} focus_check;
+
+/* The reference plenoptic capture (raw and its attributes), decoded into lf. */
+static int decode_reference(const lf_grade_check *c, const lf_image *raw, const lf_attrs *meta, lf_lightfield *lf,
+                            lf_error *err)
+{
     lf_lightfield_layout file, flags, lay;
     lf_lightfield_layout_init(&flags);
-    lf_lightfield lf;
-    memset(&lf, 0, sizeof lf);
     lf_error e = {0};
     if (lf_lightfield_layout_from_attrs(meta, &file, &e) ||
-        lf_lightfield_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) || lf_lightfield_decode(raw, &lay, NULL, &lf, &e)) {
-        lf_lightfield_free(&lf);
+        lf_lightfield_layout_resolve(&file, &flags, raw->width, raw->height, &lay, &e) ||
+        lf_lightfield_decode(raw, &lay, NULL, lf, &e)) {
+        lf_lightfield_free(lf);
         return lf_error_set(err, LF_ERR_INTERNAL, "check %s: reference light field: %s", c->id, e.msg);
     }
-    double d_want = 0;
-    if (lf_lightfield_depth_to_disparity(&lf, want, &d_want, &e)) {
-        lf_lightfield_free(&lf);
-        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: depth=%g: %s", c->id, want, e.msg);
-    }
-    int target = 0;
-    for (int k = 1; k < ns; k++)
-        if (fabs(sj[k].depth - want) < fabs(sj[target].depth - want))
-            target = k;
-    sub_image *im = get_image(s, lf_grade_check_get(c, "image", c->id), lf.ns, lf.nt, why, sizeof why);
-    if (!im) {
-        fail(r, "%s", why);
-        lf_lightfield_free(&lf);
-        return 0;
-    }
-    int eight_bit = !strcmp(im->format, "png");
-    /* the reference refocused as asked, and a sweep over the subjects' disparities */
-    double dmin = d_want, dmax = d_want;
-    for (int k = 0; k < ns; k++) {
+    return 0;
+}
+
+/* The reference refocused as asked (ref), and a sweep over the subjects'
+ * disparities: the step whose per-region sharpness matches the submission
+ * best, refined between steps by a parabola, goes in f->best_d. */
+static int focus_sweep(focus_check *f, int threads, lf_image *ref, lf_error *e)
+{
+    const focus_subject *sj = f->sj;
+    double dmin = f->d_want, dmax = f->d_want;
+    for (int k = 0; k < f->ns; k++) {
         double d;
-        if (!lf_lightfield_depth_to_disparity(&lf, sj[k].depth, &d, &e))
+        if (!lf_lightfield_depth_to_disparity(&f->lf, sj[k].depth, &d, e))
             dmin = fmin(dmin, d), dmax = fmax(dmax, d);
     }
     dmin -= 0.5, dmax += 0.5;
     enum { NSWEEP = 41 };
-    double ref_sharp[8], sub_sharp[8], best_err = INFINITY, best_d = 0, best_sweep[8] = {0}, errs[NSWEEP + 1];
+    double best_err = INFINITY, errs[NSWEEP + 1];
     int best_q = -1;
-    lf_image ref = {0};
     lf_lightfield_refocus_opts ro = lf_lightfield_refocus_defaults();
-    ro.threads = g->threads > 0 ? g->threads : 2;
-    ro.disparity_px = d_want;
-    int rc = lf_lightfield_refocus(&lf, &ro, &ref, &e);
+    ro.threads = threads > 0 ? threads : 2;
+    ro.disparity_px = f->d_want;
+    f->best_d = 0;
+    int rc = lf_lightfield_refocus(&f->lf, &ro, ref, e);
     for (int q = 0; !rc && q <= NSWEEP; q++) {
         lf_image sw = {0};
         /* the sweep, plus exactly zero (the unrefocused image) as the last step */
         ro.disparity_px = q < NSWEEP ? dmin + (dmax - dmin) * q / (NSWEEP - 1) : 0.0;
-        if ((rc = lf_lightfield_refocus(&lf, &ro, &sw, &e)))
+        if ((rc = lf_lightfield_refocus(&f->lf, &ro, &sw, e)))
             break;
-        if (eight_bit)
+        if (f->eight_bit)
             lf_grade_quantize8(&sw);
         double sum = 0, v[8];
-        for (int k = 0; k < ns; k++) {
+        for (int k = 0; k < f->ns; k++) {
             v[k] = lf_grade_sharpness(&sw, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
-            double a = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+            double a = lf_grade_sharpness(&f->im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
             double l = log((a + 1e-9) / (v[k] + 1e-9));
             sum += l * l;
         }
         errs[q] = sum;
         if (sum < best_err - 1e-12)
-            best_err = sum, best_d = ro.disparity_px, best_q = q, memcpy(best_sweep, v, sizeof v);
+            best_err = sum, f->best_d = ro.disparity_px, best_q = q, memcpy(f->best_sweep, v, sizeof v);
         lf_image_free(&sw);
     }
-    if (rc) {
-        lf_image_free(&ref), lf_lightfield_free(&lf);
-        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
-    }
+    if (rc)
+        return rc;
     /* between sweep steps: the vertex of the parabola through the best and its neighbours */
-    if (best_q > 0 && best_q < NSWEEP - 1 && fabs(best_d) > 1e-12) {
+    if (best_q > 0 && best_q < NSWEEP - 1 && fabs(f->best_d) > 1e-12) {
         double em = errs[best_q - 1], e0 = errs[best_q], ep = errs[best_q + 1], den = em - 2 * e0 + ep;
         if (den > 0) {
             double t = 0.5 * (em - ep) / den;
             if (t > -1 && t < 1)
-                best_d += t * (dmax - dmin) / (NSWEEP - 1);
+                f->best_d += t * (dmax - dmin) / (NSWEEP - 1);
         }
     }
-    if (eight_bit)
-        lf_grade_quantize8(&ref);
-    for (int k = 0; k < ns; k++) {
-        ref_sharp[k] = lf_grade_sharpness(&ref, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
-        sub_sharp[k] = lf_grade_sharpness(&im->img, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+    return 0;
+}
+
+/* The verdict against the reference refocused as asked (ref): sharpness
+ * region by region, the depth the image looks focused at, brightness. */
+static void focus_verdict(const focus_check *f, const lf_grade_check *c, lf_image *ref, lf_grade_check_result *r)
+{
+    double min_sharp = atof(lf_grade_check_get(c, "min_sharpness", "0.6"));
+    double max_sharp = atof(lf_grade_check_get(c, "max_sharpness", "1.8"));
+    double max_bright = atof(lf_grade_check_get(c, "max_brightness", "1.2"));
+    double focus_tol = atof(lf_grade_check_get(c, "focus_tol", "0.1")); /* px/view */
+    const focus_subject *sj = f->sj;
+    const lf_image *x = &f->im->img;
+    double ref_sharp[8], sub_sharp[8], best_d = f->best_d, want = f->want, d_want = f->d_want;
+    if (f->eight_bit)
+        lf_grade_quantize8(ref);
+    for (int k = 0; k < f->ns; k++) {
+        ref_sharp[k] = lf_grade_sharpness(ref, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
+        sub_sharp[k] = lf_grade_sharpness(x, sj[k].x0, sj[k].y0, sj[k].x1, sj[k].y1);
     }
-    lf_image_psnr(&im->img, &ref, &r->psnr_db, NULL);
-    r->ssim = lf_grade_ssim(&im->img, &ref);
-    double bright = lf_grade_mean(&im->img) / fmax(lf_grade_mean(&ref), 1e-12);
-    double z_est = depth_of_disparity(&lf, best_d);
+    lf_image_psnr(x, ref, &r->psnr_db, NULL);
+    r->ssim = lf_grade_ssim(x, ref);
+    double bright = lf_grade_mean(x) / fmax(lf_grade_mean(ref), 1e-12);
+    double z_est = depth_of_disparity(&f->lf, best_d);
     char looks[300], ztxt[48];
     if (isinf(z_est))
         snprintf(ztxt, sizeof ztxt, "beyond infinity");
@@ -1283,11 +1346,12 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     /* the measurements, for the report */
     char meas[600];
     int n = snprintf(meas, sizeof meas, "sharpness against the reference:");
-    for (int k = 0; k < ns && n < (int)sizeof meas; k++)
+    for (int k = 0; k < f->ns && n < (int)sizeof meas; k++)
         n += snprintf(meas + n, sizeof meas - (size_t)n, "%s %s %.2fx", k ? "," : "", sj[k].name,
                       sub_sharp[k] / fmax(ref_sharp[k], 1e-12));
     if (n < (int)sizeof meas)
         snprintf(meas + n, sizeof meas - (size_t)n, "; brightness %.2fx", bright);
+    int target = f->target;
     r->noise_ratio = NAN;
     r->variant_ratio = sub_sharp[target] / fmax(ref_sharp[target], 1e-12);
     snprintf(r->best_variant, sizeof r->best_variant, "focus %.3g m", z_est);
@@ -1295,31 +1359,249 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     /* how far the best full-aperture refocus is from the submission, region by region */
     int worst = 0;
     double worst_ratio = 1;
-    for (int k = 0; k < ns; k++) {
-        double q = (sub_sharp[k] + 1e-9) / (best_sweep[k] + 1e-9);
+    for (int k = 0; k < f->ns; k++) {
+        double q = (sub_sharp[k] + 1e-9) / (f->best_sweep[k] + 1e-9);
         if (q > worst_ratio)
             worst_ratio = q, worst = k;
     }
+    const char *file = f->im->file;
     if (worst_ratio > max_sharp) {
         fail(r, "%s: the %s at %g m is %.2fx sharper than any full-aperture refocus leaves it (the closest, focused at "
                 "%s, pass <= %.2fx): more depth of field than asked (a smaller --aperture or a single view?); %s",
-             im->file, sj[worst].name, sj[worst].depth, worst_ratio, ztxt, max_sharp, meas);
+             file, sj[worst].name, sj[worst].depth, worst_ratio, ztxt, max_sharp, meas);
     } else if (ratio_t < min_sharp) {
-        fail(r, "%s: the %s at %g m is not in focus: sharpness %.2fx the reference (pass >= %.2fx); %s; %s", im->file,
+        fail(r, "%s: the %s at %g m is not in focus: sharpness %.2fx the reference (pass >= %.2fx); %s; %s", file,
              sj[target].name, sj[target].depth, ratio_t, min_sharp, looks, meas);
     } else if (fabs(best_d - d_want) > focus_tol) {
         fail(r, "%s: focused near but not at the %s: %s; the focus is off by %+.2f px/view (pass within %.2f), %+.0f%% "
                 "in depth; %s",
-             im->file, sj[target].name, looks, best_d - d_want, focus_tol, 100.0 * (z_est / want - 1.0), meas);
+             file, sj[target].name, looks, best_d - d_want, focus_tol, 100.0 * (z_est / want - 1.0), meas);
     } else if (!(bright <= max_bright && bright >= 1 / max_bright)) {
-        fail(r, "%s: brightness %.2fx the reference (pass within %.2fx); %s", im->file, bright, max_bright, meas);
+        fail(r, "%s: brightness %.2fx the reference (pass within %.2fx); %s", file, bright, max_bright, meas);
     }
     snprintf(r->measurements, sizeof r->measurements, "%s; %s", meas, looks);
-    lf_image_free(&ref), lf_lightfield_free(&lf);
+}
+
+/* kind focus (docs/grading.md): the submitted image must be the reference
+ * plenoptic capture refocused at `depth`: the subject at that depth as sharp
+ * as in the reference refocused there (>= min_sharpness of it), the others
+ * no sharper than max_sharpness of theirs (a full aperture), the brightness
+ * within max_brightness.  Failing, the reason gives the measurements and the
+ * depth the image looks focused at (the refocus sweep of the reference whose
+ * per-region sharpness matches best). */
+static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r, lf_error *err)
+{
+    focus_check f;
+    memset(&f, 0, sizeof f);
+    char why[700];
+    f.ns = parse_subjects(lf_grade_check_get(c, "subjects", ""), f.sj, 8, why, sizeof why);
+    if (f.ns < 0)
+        return lf_error_set(err, LF_ERR_PARSE, "check %s: %s", c->id, why);
+    f.want = atof(lf_grade_check_get(c, "depth", "0"));
+    int spp = atoi(lf_grade_check_get(c, "spp", "8")), rc;
+    uint32_t seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
+    const lf_image *raw;
+    const lf_attrs *meta;
+    if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
+        return lf_error_set(err, err->code, "check %s: reference light field: %s", c->id, err->msg);
+    if ((rc = decode_reference(c, raw, meta, &f.lf, err)))
+        return rc;
+    lf_error e = {0};
+    if (lf_lightfield_depth_to_disparity(&f.lf, f.want, &f.d_want, &e)) {
+        lf_lightfield_free(&f.lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: depth=%g: %s", c->id, f.want, e.msg);
+    }
+    for (int k = 1; k < f.ns; k++)
+        if (fabs(f.sj[k].depth - f.want) < fabs(f.sj[f.target].depth - f.want))
+            f.target = k;
+    sub_image *im = get_image(s, lf_grade_check_get(c, "image", c->id), f.lf.ns, f.lf.nt, why, sizeof why);
+    if (!im) {
+        fail(r, "%s", why);
+        lf_lightfield_free(&f.lf);
+        return 0;
+    }
+    f.im = im, f.eight_bit = !strcmp(im->format, "png");
+    lf_image ref = {0};
+    if (focus_sweep(&f, g->threads, &ref, &e)) {
+        lf_image_free(&ref), lf_lightfield_free(&f.lf);
+        return lf_error_set(err, LF_ERR_INTERNAL, "check %s: refocusing the reference: %s", c->id, e.msg);
+    }
+    focus_verdict(&f, c, &ref, r);
+    lf_image_free(&ref), lf_lightfield_free(&f.lf);
     return 0;
 }
 
 /* ---------- checks ---------- */
+
+/* One check being run: the rubric's check c on submission s (md: its
+ * Submission.md, or NULL), the result r. */
+typedef struct check_run {
+    lf_grade_ctx *g;
+    const lf_grade_check *c;
+    submission *s;
+    const char *md, *student_dir;
+    lf_grade_check_result *r;
+    lf_error *err;
+} check_run;
+
+/* kind files: the listed images readable, Submission.md present */
+static int check_files(const check_run *k)
+{
+    char list[256], missing[900] = "";
+    snprintf(list, sizeof list, "%s", lf_grade_check_get(k->c, "images", ""));
+    if (!k->md)
+        snprintf(missing, sizeof missing, "%s", k->s->md_why);
+    for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
+        sub_image *im = find_image(k->s, t);
+        if (im && im->state < 0) {
+            size_t l = strlen(missing);
+            snprintf(missing + l, sizeof missing - l, "%s%s", l ? "; " : "", im->why);
+        }
+    }
+    if (missing[0])
+        fail(k->r, "%s", missing);
+    return 0;
+}
+
+/* kind sections: Submission.md has the required "## " sections, not empty */
+static int check_sections(const check_run *k)
+{
+    if (!k->md) {
+        fail(k->r, "%s", k->s->md_why);
+        return 0;
+    }
+    char list[256], bad[600] = "";
+    snprintf(list, sizeof list, "%s", lf_grade_check_get(k->c, "require", ""));
+    for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
+        int body = section_body(k->md, t, NULL, NULL);
+        if (body <= 0) {
+            size_t l = strlen(bad);
+            snprintf(bad + l, sizeof bad - l, "%s\"## %s\" %s", l ? "; " : "", t, body < 0 ? "missing" : "empty");
+        }
+    }
+    if (bad[0])
+        fail(k->r, "Submission.md: required sections: %s", bad);
+    return 0;
+}
+
+/* kind size: an image of the given width and height */
+static int check_size(const check_run *k)
+{
+    const lf_grade_check *c = k->c;
+    int w = atoi(lf_grade_check_get(c, "width", "0")), h = atoi(lf_grade_check_get(c, "height", "0"));
+    sub_image *im = find_image(k->s, lf_grade_check_get(c, "image", c->id));
+    if (!im)
+        fail(k->r, "too many images");
+    else if (im->state < 0)
+        fail(k->r, "%s", im->why);
+    else if (im->w != w || im->h != h)
+        fail(k->r, "%s: wrong size: %dx%d, expected %dx%d", im->file, im->w, im->h, w, h);
+    return 0;
+}
+
+/* kind answer: "KEY = VALUE" in Submission.md, within tol of the value */
+static int check_answer(const check_run *k)
+{
+    const lf_grade_check *c = k->c;
+    lf_grade_check_result *r = k->r;
+    const char *key = lf_grade_check_get(c, "key", "");
+    double want = atof(lf_grade_check_get(c, "value", "0")), tol = atof(lf_grade_check_get(c, "tol", "0"));
+    const char *at = k->md ? strstr(k->md, key) : NULL;
+    if (!k->md) {
+        fail(r, "%s", k->s->md_why);
+        return 0;
+    }
+    if (!at || !key[0]) {
+        fail(r, "Submission.md: no \"%s = VALUE\" answer", key);
+        return 0;
+    }
+    at += strlen(key);
+    while (*at == ' ' || *at == '=' || *at == ':' || *at == '*' || *at == '`')
+        at++;
+    char *end;
+    double got = strtod(at, &end);
+    if (end == at || !isfinite(got))
+        fail(r, "Submission.md: %s has no number", key);
+    else if (fabs(got - want) > tol)
+        fail(r, "Submission.md: %s = %g, expected %g +- %g", key, got, want, tol);
+    return 0;
+}
+
+/* kind constraint: a flag of the declared lftool command within bounds */
+static int check_constraint(const check_run *k)
+{
+    const lf_grade_check *c = k->c;
+    const char *cmd = lf_grade_check_get(c, "command", "synth"), *flag = lf_grade_check_get(c, "flag", "");
+    declared decl;
+    parse_declared(k->md, cmd, &decl);
+    if (!decl.ok) {
+        fail(k->r, "%s", decl.why);
+        return 0;
+    }
+    double v = atof(lf_grade_check_get(c, "default", "0"));
+    int have = declared_value(&decl, flag, &v);
+    const char *gt = lf_grade_check_get(c, "gt", NULL), *lt = lf_grade_check_get(c, "lt", NULL);
+    if ((gt && !(v > atof(gt))) || (lt && !(v < atof(lt))))
+        fail(k->r, "%s (--%s is %g%s; required %s %s)", lf_grade_check_get(c, "reason", "constraint violated"), flag,
+             v, have ? "" : ", the default", gt ? ">" : "<", gt ? gt : lt);
+    return 0;
+}
+
+static int check_focus(const check_run *k)
+{
+    return run_focus(k->g, k->c, k->s, k->r, k->err);
+}
+
+/* The comparison of a check's image against its references. */
+static void job_init(const check_run *k, compare_job *j)
+{
+    memset(j, 0, sizeof *j);
+    j->g = k->g, j->c = k->c, j->res = k->r, j->student_dir = k->student_dir;
+    j->spp = atoi(lf_grade_check_get(k->c, "spp", "16"));
+    j->seed = (uint32_t)strtoul(lf_grade_check_get(k->c, "seed", "1000"), NULL, 10);
+}
+
+/* kind render: the image against reference renders of the scene */
+static int check_render(const check_run *k)
+{
+    compare_job j;
+    job_init(k, &j);
+    j.make = make_render;
+    return compare(&j, k->s, k->err);
+}
+
+/* kinds synth and refocus: the image against the declared lftool command
+ * re-run on the reference light field */
+static int check_lightfield(const check_run *k)
+{
+    const lf_grade_check *c = k->c;
+    int refocus = !strcmp(c->kind, "refocus");
+    if (lf_grade_check_get(c, "optional", NULL)) {
+        sub_image *im = find_image(k->s, lf_grade_check_get(c, "image", c->id));
+        if (im && im->state < 0 && strstr(im->why, "missing:")) {
+            fail(k->r, "optional part not submitted");
+            return 0;
+        }
+    }
+    compare_job j;
+    job_init(k, &j);
+    parse_declared(k->md, refocus ? "refocus" : "synth", &j.decl);
+    if (!j.decl.ok) {
+        fail(k->r, "%s", j.decl.why);
+        return 0;
+    }
+    j.make = refocus ? make_refocus : make_synth;
+    return compare(&j, k->s, k->err);
+}
+
+static const struct {
+    const char *kind;
+    int (*run)(const check_run *k);
+} check_kinds[] = {
+    {"files", check_files},   {"sections", check_sections}, {"size", check_size},
+    {"answer", check_answer}, {"constraint", check_constraint}, {"focus", check_focus},
+    {"render", check_render}, {"synth", check_lightfield}, {"refocus", check_lightfield},
+};
 
 static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf_grade_check_result *r,
                      const char *student_dir, lf_error *err)
@@ -1330,118 +1612,10 @@ static int run_check(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     r->points = r->earned = c->points;
     r->status = LF_GRADE_PASS;
     r->noise_ratio = r->ssim = r->ssim_noise = r->psnr_db = r->variant_ratio = NAN;
-    const char *md = get_md(s);
-    if (!strcmp(c->kind, "files")) {
-        char list[256], missing[900] = "";
-        snprintf(list, sizeof list, "%s", lf_grade_check_get(c, "images", ""));
-        if (!md)
-            snprintf(missing, sizeof missing, "%s", s->md_why);
-        for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
-            sub_image *im = find_image(s, t);
-            if (im && im->state < 0) {
-                size_t l = strlen(missing);
-                snprintf(missing + l, sizeof missing - l, "%s%s", l ? "; " : "", im->why);
-            }
-        }
-        if (missing[0])
-            fail(r, "%s", missing);
-        return 0;
-    }
-    if (!strcmp(c->kind, "sections")) {
-        if (!md) {
-            fail(r, "%s", s->md_why);
-            return 0;
-        }
-        char list[256], bad[600] = "";
-        snprintf(list, sizeof list, "%s", lf_grade_check_get(c, "require", ""));
-        for (char *t = strtok(list, ","); t; t = strtok(NULL, ",")) {
-            int body = section_body(md, t, NULL, NULL);
-            if (body <= 0) {
-                size_t l = strlen(bad);
-                snprintf(bad + l, sizeof bad - l, "%s\"## %s\" %s", l ? "; " : "", t, body < 0 ? "missing" : "empty");
-            }
-        }
-        if (bad[0])
-            fail(r, "Submission.md: required sections: %s", bad);
-        return 0;
-    }
-    if (!strcmp(c->kind, "size")) {
-        int w = atoi(lf_grade_check_get(c, "width", "0")), h = atoi(lf_grade_check_get(c, "height", "0"));
-        sub_image *im = find_image(s, lf_grade_check_get(c, "image", c->id));
-        if (!im)
-            fail(r, "too many images");
-        else if (im->state < 0)
-            fail(r, "%s", im->why);
-        else if (im->w != w || im->h != h)
-            fail(r, "%s: wrong size: %dx%d, expected %dx%d", im->file, im->w, im->h, w, h);
-        return 0;
-    }
-    if (!strcmp(c->kind, "answer")) {
-        const char *key = lf_grade_check_get(c, "key", "");
-        double want = atof(lf_grade_check_get(c, "value", "0")), tol = atof(lf_grade_check_get(c, "tol", "0"));
-        const char *at = md ? strstr(md, key) : NULL;
-        if (!md) {
-            fail(r, "%s", s->md_why);
-            return 0;
-        }
-        if (!at || !key[0]) {
-            fail(r, "Submission.md: no \"%s = VALUE\" answer", key);
-            return 0;
-        }
-        at += strlen(key);
-        while (*at == ' ' || *at == '=' || *at == ':' || *at == '*' || *at == '`')
-            at++;
-        char *end;
-        double got = strtod(at, &end);
-        if (end == at || !isfinite(got))
-            fail(r, "Submission.md: %s has no number", key);
-        else if (fabs(got - want) > tol)
-            fail(r, "Submission.md: %s = %g, expected %g +- %g", key, got, want, tol);
-        return 0;
-    }
-    compare_job j;
-    memset(&j, 0, sizeof j);
-    j.g = g, j.c = c, j.res = r, j.student_dir = student_dir;
-    j.spp = atoi(lf_grade_check_get(c, "spp", "16"));
-    j.seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
-    if (!strcmp(c->kind, "constraint")) {
-        const char *cmd = lf_grade_check_get(c, "command", "synth"), *flag = lf_grade_check_get(c, "flag", "");
-        parse_declared(md, cmd, &j.decl);
-        if (!j.decl.ok) {
-            fail(r, "%s", j.decl.why);
-            return 0;
-        }
-        double v = atof(lf_grade_check_get(c, "default", "0"));
-        int have = declared_value(&j.decl, flag, &v);
-        const char *gt = lf_grade_check_get(c, "gt", NULL), *lt = lf_grade_check_get(c, "lt", NULL);
-        if ((gt && !(v > atof(gt))) || (lt && !(v < atof(lt))))
-            fail(r, "%s (--%s is %g%s; required %s %s)", lf_grade_check_get(c, "reason", "constraint violated"), flag,
-                 v, have ? "" : ", the default", gt ? ">" : "<", gt ? gt : lt);
-        return 0;
-    }
-    if (!strcmp(c->kind, "focus"))
-        return run_focus(g, c, s, r, err);
-    if (!strcmp(c->kind, "render")) {
-        j.make = make_render;
-        return compare(&j, s, err);
-    }
-    if (!strcmp(c->kind, "synth") || !strcmp(c->kind, "refocus")) {
-        int refocus = !strcmp(c->kind, "refocus");
-        if (lf_grade_check_get(c, "optional", NULL)) {
-            sub_image *im = find_image(s, lf_grade_check_get(c, "image", c->id));
-            if (im && im->state < 0 && strstr(im->why, "missing:")) {
-                fail(r, "optional part not submitted");
-                return 0;
-            }
-        }
-        parse_declared(md, refocus ? "refocus" : "synth", &j.decl);
-        if (!j.decl.ok) {
-            fail(r, "%s", j.decl.why);
-            return 0;
-        }
-        j.make = refocus ? make_refocus : make_synth;
-        return compare(&j, s, err);
-    }
+    check_run k = {g, c, s, get_md(s), student_dir, r, err};
+    for (size_t i = 0; i < sizeof check_kinds / sizeof check_kinds[0]; i++)
+        if (!strcmp(c->kind, check_kinds[i].kind))
+            return check_kinds[i].run(&k);
     return lf_error_set(err, LF_ERR_INTERNAL, "check %s: kind %s not implemented", c->id, c->kind);
 }
 

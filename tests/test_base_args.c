@@ -28,8 +28,9 @@ static const lf_arg refocus_args[] = {
 static const lf_arg synth_args[] = {
     {"--camerapos", NULL, LF_ARG_DOUBLE, o.pos, "X", "camera position", .count = 3},
 };
-static int run_nothing(int n, char **p)
+static int run_nothing(void *opts, int n, char **p)
 {
+    (void)opts;
     (void)n;
     (void)p;
     return 0;

@@ -12,27 +12,9 @@
 
 #include "image/lf_image.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 
 static char dir[256], log_text[8192];
-
-static int run(const char *fmt, ...)
-{
-    char cmd[4096], full[4600];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    snprintf(full, sizeof full, "%s > %s/log.txt 2>&1", cmd, dir);
-    int st = system(full);
-    char path[512];
-    snprintf(path, sizeof path, "%s/log.txt", dir);
-    FILE *f = fopen(path, "rb");
-    size_t n = f ? fread(log_text, 1, sizeof log_text - 1, f) : 0;
-    log_text[n] = '\0';
-    if (f)
-        fclose(f);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 /* Bit-identical float pixels? */
 static int same_pixels(const char *a, const char *b)
@@ -68,6 +50,7 @@ static const char *scene_text =
 
 int main(void)
 {
+    lf_test_run_setup(dir, 0, log_text, sizeof log_text);
     snprintf(dir, sizeof dir, "/tmp/lf_dist_XXXXXX");
     if (!mkdtemp(dir))
         return 1;

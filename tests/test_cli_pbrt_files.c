@@ -12,29 +12,11 @@
 
 #include "image/lf_image.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_subdiv.h"
 
 static char dir[256];
 static char out_text[65536];
-
-static int run(const char *fmt, ...)
-{
-    char cmd[4096], full[4600];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    snprintf(full, sizeof full, "cd %s && { %s ; } > log.txt 2>&1", dir, cmd);
-    int st = system(full);
-    char path[512];
-    snprintf(path, sizeof path, "%s/log.txt", dir);
-    FILE *f = fopen(path, "rb");
-    size_t n = f ? fread(out_text, 1, sizeof out_text - 1, f) : 0;
-    out_text[n] = '\0';
-    if (f)
-        fclose(f);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 static int exists(const char *rel)
 {
@@ -275,6 +257,7 @@ static void test_refused(void)
 
 int main(void)
 {
+    lf_test_run_setup(dir, 1, out_text, sizeof out_text);
     snprintf(dir, sizeof dir, "/tmp/lf_cli_pbrt_XXXXXX");
     if (!mkdtemp(dir)) {
         fprintf(stderr, "cannot make a temporary directory\n");

@@ -27,6 +27,7 @@
 
 #include "camera/lf_camera.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
@@ -522,28 +523,7 @@ static void test_plenoptic(void)
     must_refuse("plenoptic", &s2);
 }
 
-/* ---- renders ---- */
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "hardcase.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
+static const lf_test_scene hardcase = {.name = "hardcase.pbrt"};
 
 /* Furnace at scale k: camera at distance 4k, sphere of radius k. */
 static void test_furnace_scaled(double k)
@@ -561,7 +541,7 @@ static void test_furnace_scaled(double k)
              -4 * k, spp, L, L, L, albedo, albedo, albedo, k);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, &hardcase, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "HARD CASE: furnace at scale %g failed to render: %s", k, msg);
         return;
     }
@@ -608,7 +588,7 @@ static void test_denormal_radiance(void)
              L, L, L);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, &hardcase, &img, msg, sizeof msg)) {
         /* a clear refusal is allowed */
         CHECK_MSG(msg[0] != '\0', "denormal radiance: refused without a message");
         return;
@@ -641,7 +621,7 @@ static void test_grazing_plane(void)
              spp, L, L, L, albedo, albedo, albedo);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, &hardcase, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "HARD CASE: grazing plane failed to render: %s", msg);
         return;
     }

@@ -9,23 +9,10 @@
 #include <unistd.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 
 #define LFLENS LF_BINARY_DIR "/bin/lflens"
 #define LENSES LF_SOURCE_DIR "/scenes/lenses/"
-
-/* Runs a command; returns its exit code, stdout+stderr in out. */
-static int run(const char *cmd, char *out, size_t out_size)
-{
-    char full[2048];
-    snprintf(full, sizeof full, "%s 2>&1", cmd);
-    FILE *p = popen(full, "r");
-    if (!p)
-        return -1;
-    size_t n = fread(out, 1, out_size - 1, p);
-    out[n] = 0;
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 static double json_number(const char *text, const char *key)
 {
@@ -43,6 +30,12 @@ int main(void)
         return lf_test_end();
     }
     char out[16384], cmd[1024];
+    char logdir[] = "/tmp/lflens_cli_XXXXXX"; /* run()'s log */
+    if (!mkdtemp(logdir)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    lf_test_run_setup(logdir, 0, out, sizeof out);
     static const struct {
         const char *file;
         double efl;
@@ -50,7 +43,7 @@ int main(void)
                   {"fisheye.10mm.dat", 9.99}, {"dgauss.100mm.dat", 100.72}};
     for (size_t k = 0; k < sizeof lenses / sizeof lenses[0]; k++) {
         snprintf(cmd, sizeof cmd, LFLENS " info " LENSES "%s --json", lenses[k].file);
-        CHECK(run(cmd, out, sizeof out) == 0);
+        CHECK(run("%s", cmd) == 0);
         double efl = json_number(out, "efl_mm");
         CHECK_MSG(fabs(efl - lenses[k].efl) <= 0.005 * lenses[k].efl, "%s: %s", lenses[k].file, out);
         static const char *const keys[] = {"bfl_mm", "ffl_mm", "fnumber", "entrance_pupil_mm", "exit_pupil_mm",
@@ -59,13 +52,13 @@ int main(void)
             CHECK_MSG(isfinite(json_number(out, keys[i])), "%s missing in %s", keys[i], out);
     }
     /* Human-readable output and a focus distance. */
-    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --focus 2 --sensor apsc", out, sizeof out) == 0);
+    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --focus 2 --sensor apsc") == 0);
     CHECK(strstr(out, "effective focal length") != NULL);
     /* Usage errors: 2. */
-    CHECK(run(LFLENS, out, sizeof out) == 2);
-    CHECK(run(LFLENS " frobnicate x.dat", out, sizeof out) == 2);
-    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --sensor nosuch", out, sizeof out) == 2);
-    CHECK(run(LFLENS " plot " LENSES "dgauss.50mm.dat -o /tmp/x.jpg", out, sizeof out) == 2);
+    CHECK(run(LFLENS) == 2);
+    CHECK(run(LFLENS " frobnicate x.dat") == 2);
+    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --sensor nosuch") == 2);
+    CHECK(run(LFLENS " plot " LENSES "dgauss.50mm.dat -o /tmp/x.jpg") == 2);
     /* Bad input: 1, with file:line. */
     char tmpl[] = "/tmp/lflens_cli_XXXXXX";
     int fd = mkstemp(tmpl);
@@ -75,20 +68,20 @@ int main(void)
         CHECK(write(fd, bad, strlen(bad)) == (ssize_t)strlen(bad));
         close(fd);
         snprintf(cmd, sizeof cmd, LFLENS " info %s", tmpl);
-        CHECK(run(cmd, out, sizeof out) == 1);
+        CHECK(run("%s", cmd) == 1);
         char want[256];
         snprintf(want, sizeof want, "%s:3: expected 4 or 5 columns", tmpl);
         CHECK_MSG(strstr(out, want) != NULL, "%s", out);
         unlink(tmpl);
     }
-    CHECK(run(LFLENS " info " LENSES "no-such.dat", out, sizeof out) == 1);
-    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --focus 0.1", out, sizeof out) == 1);
+    CHECK(run(LFLENS " info " LENSES "no-such.dat") == 1);
+    CHECK(run(LFLENS " info " LENSES "dgauss.50mm.dat --focus 0.1") == 1);
     CHECK(strstr(out, "closer than") != NULL);
     /* Plots: SVG and PNG, written whole. */
     char dir[] = "/tmp/lflens_plot_XXXXXX";
     if (mkdtemp(dir)) {
         snprintf(cmd, sizeof cmd, LFLENS " plot " LENSES "fisheye.10mm.dat -o %s/f.svg", dir);
-        CHECK(run(cmd, out, sizeof out) == 0);
+        CHECK(run("%s", cmd) == 0);
         snprintf(cmd, sizeof cmd, "%s/f.svg", dir);
         FILE *f = fopen(cmd, "r");
         CHECK(f != NULL);
@@ -101,11 +94,14 @@ int main(void)
             unlink(cmd);
         }
         snprintf(cmd, sizeof cmd, LFLENS " plot " LENSES "dgauss.50mm.dat -o %s/d.png", dir);
-        CHECK(run(cmd, out, sizeof out) == 0);
+        CHECK(run("%s", cmd) == 0);
         snprintf(cmd, sizeof cmd, "%s/d.png", dir);
         CHECK(access(cmd, R_OK) == 0);
         unlink(cmd);
         rmdir(dir);
     }
+    snprintf(cmd, sizeof cmd, "%s/log.txt", logdir);
+    unlink(cmd);
+    rmdir(logdir);
     return lf_test_end();
 }

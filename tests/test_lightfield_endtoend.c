@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "lightfield/lf_lightfield.h"
 #include "render/lf_render.h"
 
@@ -49,29 +50,6 @@ static const char *world =
     " Shape \"bilinearmesh\" \"point3 P\" [-0.5 -0.4 4  0.5 -0.4 4  -0.5 0.4 4  0.5 0.4 4]\n"
     "  \"point2 uv\" [0 0 1 0 0 1 1 1]\nAttributeEnd\n";
 
-static int render_text(const char *text, int white, lf_image *img, lf_attrs *meta, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "endtoend.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    o.white = white;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, meta, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
-
 int main(void)
 {
     char scene[8192], msg[1024];
@@ -87,7 +65,9 @@ int main(void)
              F_MM, FSTOP, FOCUS_M, NLX, SENSOR_W, SENSOR_H, W, H, world);
     lf_image raw, white;
     lf_attrs meta = {0}, wmeta = {0};
-    if (render_text(scene, 0, &raw, &meta, msg, sizeof msg) || render_text(scene, 1, &white, &wmeta, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.name = "endtoend.pbrt", .meta = &meta}, &raw, msg, sizeof msg) ||
+        render_text(scene, &(lf_test_scene){.name = "endtoend.pbrt", .white = 1, .meta = &wmeta}, &white, msg,
+                    sizeof msg)) {
         CHECK_MSG(0, "plenoptic render failed: %s", msg);
         return lf_test_end();
     }
@@ -185,7 +165,8 @@ int main(void)
              "Integrator \"path\" \"integer maxdepth\" [1]\n%s",
              F_MM, FSTOP, ZA, wt, wt * NLY / NLX, NLX, NLY, world);
     lf_image thin, thin_white;
-    if (render_text(scene, 0, &thin, NULL, msg, sizeof msg) || render_text(scene, 1, &thin_white, NULL, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.name = "endtoend.pbrt"}, &thin, msg, sizeof msg) ||
+        render_text(scene, &(lf_test_scene){.name = "endtoend.pbrt", .white = 1}, &thin_white, msg, sizeof msg)) {
         CHECK_MSG(0, "thin-lens render failed: %s", msg);
         return lf_test_end();
     }

@@ -35,31 +35,13 @@
 
 #include "image/lf_image.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 
 #define LFRENDER LF_BINARY_DIR "/bin/lfrender"
 #define LFTOOL LF_BINARY_DIR "/bin/lftool"
 
 static char dir[256];
 static char out_text[65536];
-
-static int run(const char *fmt, ...)
-{
-    char cmd[4096], full[4600];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    snprintf(full, sizeof full, "%s > %s/log.txt 2>&1", cmd, dir);
-    int st = system(full);
-    char path[512];
-    snprintf(path, sizeof path, "%s/log.txt", dir);
-    FILE *f = fopen(path, "rb");
-    size_t n = f ? fread(out_text, 1, sizeof out_text - 1, f) : 0;
-    out_text[n] = '\0';
-    if (f)
-        fclose(f);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 static char *slurp(const char *path)
 {
@@ -109,6 +91,7 @@ static double sharpness(const lf_image *im, int x0, int y0, int x1, int y1)
 
 int main(void)
 {
+    lf_test_run_setup(dir, 0, out_text, sizeof out_text);
     snprintf(dir, sizeof dir, "/tmp/lf_plenoptic_demo_XXXXXX");
     if (!mkdtemp(dir)) {
         perror("mkdtemp");

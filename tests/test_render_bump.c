@@ -18,34 +18,13 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 #include "shading/lf_shading.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 static double mean_g(const lf_image *img)
 {
@@ -77,7 +56,7 @@ static double render_plane(const char *material, const double l[3], char *msg, s
              "  \"point3 P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] \"point2 uv\" [0 0 1 0 1 1 0 1]\n",
              l[0], l[1], l[2], M_PI, M_PI, M_PI, 2 * tan(30 * M_PI / 180), 2 * tan(30 * M_PI / 180), material);
     lf_image img = {0};
-    if (render_text(scene, &img, msg, n))
+    if (render_text(scene, NULL, &img, msg, n))
         return -1;
     double v = mean_g(&img);
     lf_image_free(&img);
@@ -132,7 +111,7 @@ static void test_zero_curved(void)
                      "Integrator \"volpath\" \"integer maxdepth\" [1]\nPixelFilter \"box\"\nWorldBegin\n"
                      "LightSource \"distant\" \"point3 from\" [1 2 3] \"point3 to\" [0 0 0]\n%s\n%s",
                      mats[m], shapes[s]);
-            int rc = render_text(scene, &img[m], msg, sizeof msg);
+            int rc = render_text(scene, NULL, &img[m], msg, sizeof msg);
             CHECK_MSG(rc == 0, "%s", msg);
         }
         double worst = 0;

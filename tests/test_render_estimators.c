@@ -26,31 +26,8 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
-
-static int render_text(const char *text, uint32_t seed, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    o.seed = seed;
-    o.has_seed = 1;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 static double image_mean(const lf_image *img, int c)
 {
@@ -69,7 +46,7 @@ static int mean_over_seeds(const char *scene, int seeds, int c, double *mean, do
     for (int k = 0; k < seeds; k++) {
         lf_image img;
         char msg[1024];
-        if (render_text(scene, 11 + 7 * (uint32_t)k, &img, msg, sizeof msg)) {
+        if (render_text(scene, &(lf_test_scene){.seed = 11 + 7 * (uint32_t)k, .has_seed = 1}, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             return -1;
         }

@@ -12,6 +12,7 @@
 
 #include "camera/lf_camera.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
@@ -187,28 +188,6 @@ static void test_circular_default(void)
     CHECK(make(&badst, 300, 200, 35.0, err, sizeof err) == NULL && strstr(err, "fov"));
 }
 
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
-
 /* Under a uniform sky of radiance L the image is L inside the circle and 0
  * outside; with the box filter each pixel averages its area, so the image's
  * sum is L times the circle's area in pixels, pi R^2. */
@@ -225,7 +204,7 @@ static void test_render_circle(void)
              W, H, L, L, L);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -273,7 +252,7 @@ static void test_render_emitter(void)
                  maps[m], f, W, H, diag, p[0], p[1], p[2], rad);
         lf_image img;
         char msg[1024];
-        if (render_text(scene, &img, msg, sizeof msg)) {
+        if (render_text(scene, NULL, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             continue;
         }

@@ -9,38 +9,12 @@
 #include "camera/lens.h"
 #include "camera/lf_camera.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-/* Renders a scene given as text; meta may be NULL; crop[1] > crop[0] crops. */
-static int render_text(const char *text, int white, const int *crop, lf_image *img, lf_attrs *meta, char *msg,
-                       size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    o.white = white;
-    if (crop)
-        memcpy(o.crop, crop, sizeof o.crop);
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, meta, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 /* Emitters only (black surfaces that glow): a pixel's value depends only
  * on where its rays land, so differences are geometry, not light noise. */
@@ -95,7 +69,7 @@ static void test_array_matches_pinholes(void)
     lf_image arr;
     lf_attrs meta = {0};
     char msg[1024];
-    if (render_text(scene, 0, NULL, &arr, &meta, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.meta = &meta}, &arr, msg, sizeof msg)) {
         CHECK_MSG(0, "array render failed: %s", msg);
         return;
     }
@@ -124,7 +98,7 @@ static void test_array_matches_pinholes(void)
                      cx, cy, cx, cy, fov, x0, x0 + 2.0 * W / tw, y1 - 2.0 * H / th, y1, W, H, emitter_world);
             int crop[4] = {i * tw, (i + 1) * tw, j * th, (j + 1) * th};
             lf_image pin;
-            if (render_text(scene, 0, crop, &pin, NULL, msg, sizeof msg)) {
+            if (render_text(scene, &(lf_test_scene){.crop = crop}, &pin, msg, sizeof msg)) {
                 CHECK_MSG(0, "pinhole render failed: %s", msg);
                 continue;
             }
@@ -143,7 +117,7 @@ static void test_array_matches_pinholes(void)
                      "Sampler \"zsobol\" \"integer pixelsamples\" [256] \"integer seed\" [7]\nPixelFilter \"box\"\n"
                      "Integrator \"path\" \"integer maxdepth\" [1]\n%s",
                      cx, cy, cx, cy, fov, tw, th, emitter_world);
-            if (render_text(scene, 0, NULL, &pin, NULL, msg, sizeof msg)) {
+            if (render_text(scene, NULL, &pin, msg, sizeof msg)) {
                 CHECK_MSG(0, "pinhole render failed: %s", msg);
                 continue;
             }
@@ -176,7 +150,7 @@ static void test_plenoptic_white(void)
     lf_image img;
     lf_attrs meta = {0};
     char msg[1024];
-    if (render_text(scene, 1, NULL, &img, &meta, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.white = 1, .meta = &meta}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "white render failed: %s", msg);
         return;
     }
@@ -317,7 +291,7 @@ static void test_plenoptic_centre_view(int compound)
              main_lens, zo / 1000, nlx, W, H, world);
     lf_image plen, pin;
     char msg[1024];
-    if (render_text(scene, 0, NULL, &plen, NULL, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &plen, msg, sizeof msg)) {
         CHECK_MSG(0, "plenoptic render failed: %s", msg);
         return;
     }
@@ -327,7 +301,7 @@ static void test_plenoptic_centre_view(int compound)
              "Sampler \"zsobol\" \"integer pixelsamples\" [64]\nPixelFilter \"box\"\n"
              "Integrator \"path\" \"integer maxdepth\" [1]\n%s",
              pin_z, fov, nlx, nly, world);
-    if (render_text(scene, 0, NULL, &pin, NULL, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &pin, msg, sizeof msg)) {
         CHECK_MSG(0, "pinhole render failed: %s", msg);
         lf_image_free(&plen);
         return;

@@ -23,35 +23,12 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int render_text(const char *text, lf_image *img, char **explain, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        if (explain)
-            *explain = lf_renderer_explain(r);
-        rc = img ? lf_renderer_render(r, img, NULL, &err) : 0;
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 static void mean_rgb(const lf_image *img, double m[3])
 {
@@ -96,7 +73,7 @@ static void test_absorbing_slab(void)
                  box);
         lf_image img = {0};
         char msg[1024] = "";
-        int rc = render_text(scene, &img, NULL, msg, sizeof msg);
+        int rc = render_text(scene, NULL, &img, msg, sizeof msg);
         CHECK_MSG(rc == 0, "%s", msg);
         if (rc)
             continue;
@@ -141,7 +118,7 @@ static void test_single_scattering(void)
              sin(th), -cos(th), sa[0], sa[1], sa[2], ss[0], ss[1], ss[2], g, box);
     lf_image img = {0};
     char msg[1024] = "";
-    int rc = render_text(scene, &img, NULL, msg, sizeof msg);
+    int rc = render_text(scene, NULL, &img, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     if (rc)
         return;
@@ -179,7 +156,7 @@ static void test_furnace(void)
                         "Shape \"sphere\" \"float radius\" 1\nAttributeEnd\n";
     lf_image img = {0};
     char msg[1024] = "";
-    int rc = render_text(scene, &img, NULL, msg, sizeof msg);
+    int rc = render_text(scene, NULL, &img, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     if (rc)
         return;
@@ -211,7 +188,7 @@ static void test_camera_medium(void)
                         "AttributeEnd\n";
     lf_image img = {0};
     char msg[1024] = "";
-    int rc = render_text(scene, &img, NULL, msg, sizeof msg);
+    int rc = render_text(scene, NULL, &img, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     if (rc)
         return;
@@ -258,15 +235,14 @@ static void test_fast_path(void)
 {
     char *ex = NULL, msg[1024] = "";
     int rc = render_text("WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
-                         "Shape \"sphere\"\n",
-                         NULL, &ex, msg, sizeof msg);
+                         "Shape \"sphere\"\n", &(lf_test_scene){.explain = &ex}, NULL, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     CHECK_MSG(ex && !strstr(ex, "volumetric"), "%s", ex ? ex : "");
     free(ex);
     ex = NULL;
     rc = render_text("WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
                      "MediumInterface \"fog\" \"\"\nMaterial \"interface\"\nShape \"sphere\"\n",
-                     NULL, &ex, msg, sizeof msg);
+                     &(lf_test_scene){.explain = &ex}, NULL, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     CHECK_MSG(ex && strstr(ex, "volumetric"), "%s", ex ? ex : "");
     free(ex);

@@ -6,34 +6,13 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 #include "render/render_internal.h"
 
-static int render_text(const char *text, lf_image *img, char *msg, size_t n, char **explain)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "motion.pbrt", &d, &err)) {
-        snprintf(msg, n, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        if (explain)
-            *explain = lf_renderer_explain(r);
-        rc = lf_renderer_render(r, img, NULL, &err);
-        if (!rc && lf_renderer_warnings(r))
-            snprintf(msg, n, "%s", lf_renderer_warnings(r));
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, n, "%s", err.msg);
-    return rc;
-}
+/* errors name motion.pbrt; after a render, msg holds the renderer's warnings */
+#define MOTION_SCENE .name = "motion.pbrt", .warnings_in_msg = 1
+static const lf_test_scene motion_scene = {MOTION_SCENE};
 
 /* Orthographic camera looking along +z from z = -5: screen x in [-4, 4] over
  * 128 px (16 px per unit), y in [-1, 1] over 32 px; camera +x = world +x. */
@@ -86,7 +65,7 @@ static double streak(double shutter_close, double dx, int segments, char **expla
              head, dx, segments);
     lf_image img;
     char msg[2048] = "";
-    if (render_text(scene, &img, msg, sizeof msg, explain)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = explain}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return -1;
     }
@@ -130,7 +109,7 @@ static void test_camera_motion(void)
         "Shape \"sphere\" \"float radius\" [0.1]\nAttributeEnd\n";
     lf_image img;
     char msg[2048] = "";
-    if (render_text(scene, &img, msg, sizeof msg, NULL)) {
+    if (render_text(scene, &motion_scene, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -161,7 +140,7 @@ static void test_rolling_shutter(void)
     lf_image img;
     char msg[2048] = "";
     char *plan = NULL;
-    if (render_text(scene, &img, msg, sizeof msg, &plan)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = &plan}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         free(plan);
         return;
@@ -210,7 +189,7 @@ static void test_static_identical(void)
     char scene[2048], msg[2048] = "";
     char *plan = NULL;
     snprintf(scene, sizeof scene, static_scene, "");
-    if (render_text(scene, &ref, msg, sizeof msg, &plan)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = &plan}, &ref, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -218,7 +197,7 @@ static void test_static_identical(void)
     free(plan);
     for (int i = 0; i < 4; i++) {
         snprintf(scene, sizeof scene, static_scene, cams[i]);
-        if (render_text(scene, &img, msg, sizeof msg, NULL)) {
+        if (render_text(scene, &motion_scene, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             continue;
         }
@@ -264,7 +243,7 @@ static void test_hard_cases(void)
                  "Translate -2 0 0\nActiveTransform EndTime\nTranslate 3 0 0\nActiveTransform All\n"
                  "Shape \"sphere\" \"float radius\" [0.2]\nAttributeEnd\n",
                  head);
-        if (render_text(scene, &img, msg, sizeof msg, NULL)) {
+        if (render_text(scene, &motion_scene, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             continue;
         }
@@ -281,14 +260,14 @@ static void test_hard_cases(void)
     snprintf(head, sizeof head, camera_ortho, "");
     snprintf(scene, sizeof scene,
              "%sWorldBegin\nActiveTransform EndTime\nScale 0 0 0\nActiveTransform All\nShape \"sphere\"\n", head);
-    CHECK(render_text(scene, &img, msg, sizeof msg, NULL) != 0);
+    CHECK(render_text(scene, &motion_scene, &img, msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "singular") && strstr(msg, "motion.pbrt:"), "message: %s", msg);
     /* more segments than Embree's 129 time steps is a clear error, not a
      * silently static shape */
     snprintf(scene, sizeof scene,
              "%sWorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\nActiveTransform All\n"
              "Shape \"sphere\" \"integer motionsegments\" [129]\n", head);
-    CHECK(render_text(scene, &img, msg, sizeof msg, NULL) != 0);
+    CHECK(render_text(scene, &motion_scene, &img, msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "motionsegments") && strstr(msg, "motion.pbrt:10:"), "message: %s", msg);
     /* enormous motion, 180 degrees in one segment, readout longer than the
      * exposure, shutteropen > shutterclose: finite images */
@@ -307,7 +286,7 @@ static void test_hard_cases(void)
                  "ActiveTransform EndTime\n%s\nActiveTransform All\n"
                  "Shape \"trianglemesh\" \"point3 P\" [-0.5 -0.5 0 0.5 -0.5 0 0 0.5 0] %s\nAttributeEnd\n",
                  cases[3 * i], cases[3 * i + 1], cases[3 * i + 2]);
-        int rc = render_text(scene, &img, msg, sizeof msg, NULL);
+        int rc = render_text(scene, &motion_scene, &img, msg, sizeof msg);
         CHECK_MSG(rc == 0, "hard case %d failed: %s", i, msg);
         if (!rc) {
             CHECK(lf_image_count_nonfinite(&img) == 0);
@@ -612,7 +591,7 @@ static void test_instance_matches_keyframes(void)
     char msg[2048] = "";
     char *plan = NULL;
     snprintf(scene, sizeof scene, turning_scene, "", "");
-    if (render_text(scene, &inst, msg, sizeof msg, &plan)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = &plan}, &inst, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -622,7 +601,7 @@ static void test_instance_matches_keyframes(void)
     const char *segs128 = "\"integer motionsegments\" [128]";
     snprintf(scene, sizeof scene, turning_scene, segs128, segs128);
     plan = NULL;
-    if (render_text(scene, &keyed, msg, sizeof msg, &plan)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = &plan}, &keyed, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         lf_image_free(&inst);
         return;
@@ -633,7 +612,8 @@ static void test_instance_matches_keyframes(void)
     char scene2[4096];
     snprintf(scene2, sizeof scene2, "%.*s[16] \"integer seed\" [7]%s", (int)(seed2 - scene), scene, seed2 + 4);
     snprintf(scene, sizeof scene, turning_scene, "\"integer motionsegments\" [1]", "\"integer motionsegments\" [1]");
-    if (render_text(scene2, &keyed2, msg, sizeof msg, NULL) || render_text(scene, &coarse, msg, sizeof msg, NULL)) {
+    if (render_text(scene2, &motion_scene, &keyed2, msg, sizeof msg) ||
+        render_text(scene, &motion_scene, &coarse, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         lf_image_free(&inst);
         lf_image_free(&keyed);
@@ -673,7 +653,7 @@ static void test_object_instance_streaks(void)
     lf_image img;
     char msg[2048] = "";
     char *plan = NULL;
-    if (render_text(scene, &img, msg, sizeof msg, &plan)) {
+    if (render_text(scene, &(lf_test_scene){MOTION_SCENE, .explain = &plan}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         free(plan);
         return;

@@ -12,34 +12,14 @@
 
 #include "camera/lf_camera.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-/* Scene text parsed as if it were scenes/test.pbrt, so "lenses/x.dat" resolves. */
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, LF_SOURCE_DIR "/scenes/test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
+static const lf_test_scene realistic = {.name = LF_SOURCE_DIR "/scenes/test.pbrt"};
 
 /* RMS radius (pixels) of the green channel about its centroid. */
 static double blur_rms(const lf_image *img, double *total)
@@ -83,7 +63,7 @@ static void test_focus(void)
                  " Translate 0 0 1.0\n Shape \"sphere\" \"float radius\" [0.0005]\nAttributeEnd\n",
                  fd[k]);
         lf_image img;
-        if (render_text(scene, &img, msg, sizeof msg)) {
+        if (render_text(scene, &realistic, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             return;
         }
@@ -123,7 +103,7 @@ static int flat_field(const char *lens, double aperture_mm, int w, int h, double
              "WorldBegin\n"
              "LightSource \"infinite\" \"rgb L\" [1 1 1]\n",
              lens, aperture_mm, w, h, diag);
-    if (render_text(scene, img, msg, sizeof msg)) {
+    if (render_text(scene, &realistic, img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return -1;
     }

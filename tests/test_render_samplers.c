@@ -15,37 +15,12 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int render_text(const char *text, lf_image *img, char **warn, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        if (warn && lf_renderer_warnings(r)) {
-            *warn = malloc(strlen(lf_renderer_warnings(r)) + 1);
-            strcpy(*warn, lf_renderer_warnings(r));
-        }
-        rc = img ? lf_renderer_render(r, img, NULL, &err) : 0;
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 /* Form factor from the origin's surface element (normal +z) to the
  * rectangle [0,a] x [0,b] at height c, and its signed combination for any
@@ -112,7 +87,7 @@ static void test_known_integral(const char *sampler)
              cam[0], cam[1], cam[2], fov, RES, RES, sampler, -h, -h, c, h, -h, c, h, h, c, -h, h, c);
     lf_image img = {0};
     char msg[1024] = "";
-    int rc = render_text(scene, &img, NULL, msg, sizeof msg);
+    int rc = render_text(scene, NULL, &img, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s: %s", sampler, msg);
     if (rc)
         return;
@@ -137,7 +112,8 @@ int main(void)
     test_known_integral("\"independent\" \"integer seed\" 4");
 
     char *warn = NULL, msg[1024] = "";
-    int rc = render_text("Sampler \"pmj02bn\" \"integer pixelsamples\" 20\nWorldBegin\n", NULL, &warn, msg, sizeof msg);
+    int rc = render_text("Sampler \"pmj02bn\" \"integer pixelsamples\" 20\nWorldBegin\n",
+                         &(lf_test_scene){.warnings = &warn}, NULL, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     CHECK_MSG(warn && strstr(warn, "rounded up to 64"), "%s", warn ? warn : "(no warnings)");
     free(warn);

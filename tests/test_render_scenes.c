@@ -9,34 +9,14 @@
 
 #include "camera/lf_camera.h"
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
+
+static const lf_test_scene one_thread = {.threads = 1};
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-/* Renders a scene given as text; returns 0 and fills img. */
-static int render_text(const char *text, int threads, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = threads;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 static double pixel_mean(const lf_image *img, int x0, int x1, int y0, int y1, int c)
 {
@@ -108,7 +88,7 @@ static void test_projection(void)
                  pts[k][1], pts[k][2]);
         lf_image img;
         char msg[1024];
-        if (render_text(scene, 2, &img, msg, sizeof msg)) {
+        if (render_text(scene, &(lf_test_scene){.threads = 2}, &img, msg, sizeof msg)) {
             CHECK_MSG(0, "render failed: %s", msg);
             continue;
         }
@@ -150,7 +130,7 @@ static void test_furnace(double albedo, const char *sampler)
              sampler, L, L, L, albedo, albedo, albedo);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, 2, &img, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.threads = 2}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -204,7 +184,7 @@ static void test_irradiance(const char *light, double expected_E, const char *wh
              light, a, a, a);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, 2, &img, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.threads = 2}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "%s: render failed: %s", what, msg);
         return;
     }
@@ -272,7 +252,7 @@ static void test_light_samplers(void)
                      spp, names[k], a, a, a);
             lf_image img;
             char msg[1024];
-            if (render_text(scene, 2, &img, msg, sizeof msg)) {
+            if (render_text(scene, &(lf_test_scene){.threads = 2}, &img, msg, sizeof msg)) {
                 CHECK_MSG(0, "lightsampler %s: render failed: %s", names[k], msg);
                 return;
             }
@@ -311,9 +291,9 @@ static void test_thread_determinism(void)
         "Material \"dielectric\"\nTranslate 0 0.6 0\nShape \"sphere\" \"float radius\" [0.6]\n";
     lf_image a, b, c;
     char msg[1024];
-    int ra = render_text(scene, 1, &a, msg, sizeof msg);
-    int rb = render_text(scene, 2, &b, msg, sizeof msg);
-    int rc = render_text(scene, 5, &c, msg, sizeof msg);
+    int ra = render_text(scene, &(lf_test_scene){.threads = 1}, &a, msg, sizeof msg);
+    int rb = render_text(scene, &(lf_test_scene){.threads = 2}, &b, msg, sizeof msg);
+    int rc = render_text(scene, &(lf_test_scene){.threads = 5}, &c, msg, sizeof msg);
     CHECK_MSG(ra == 0 && rb == 0 && rc == 0, "%s", msg);
     if (ra || rb || rc)
         return;
@@ -340,7 +320,7 @@ static void test_plugin_camera(void)
                         "Translate 5 0 0\nShape \"sphere\" \"float radius\" [0.05]\n";
     lf_image img;
     char msg[1024];
-    if (render_text(scene, 2, &img, msg, sizeof msg)) {
+    if (render_text(scene, &(lf_test_scene){.threads = 2}, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "plugin render failed: %s", msg);
         return;
     }
@@ -360,19 +340,21 @@ static void test_errors(void)
 {
     lf_image img;
     char msg[1024] = "";
-    CHECK(render_text("Camera \"perspective\" \"float fvo\" [30]\nWorldBegin\n", 1, &img, msg, sizeof msg) != 0);
+    CHECK(render_text("Camera \"perspective\" \"float fvo\" [30]\nWorldBegin\n", &one_thread, &img, msg, sizeof msg) !=
+          0);
     CHECK_MSG(strstr(msg, "test.pbrt:1:") && strstr(msg, "fvo"), "message: %s", msg);
-    CHECK(render_text("Camera \"nosuchcamera\"\nWorldBegin\n", 1, &img, msg, sizeof msg) != 0);
+    CHECK(render_text("Camera \"nosuchcamera\"\nWorldBegin\n", &one_thread, &img, msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "nosuchcamera") && strstr(msg, "perspective"), "message: %s", msg);
-    CHECK(render_text("WorldBegin\nShape \"sphere\" \"float radius\" [-1]\n", 1, &img, msg, sizeof msg) != 0);
+    CHECK(render_text("WorldBegin\nShape \"sphere\" \"float radius\" [-1]\n", &one_thread, &img, msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "test.pbrt:2:"), "message: %s", msg);
     CHECK(render_text("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 5]\n",
-                      1, &img, msg, sizeof msg) != 0);
+                      &one_thread, &img, msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "out of range"), "message: %s", msg);
-    CHECK(render_text("WorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1] \"float scael\" [2]\n", 1, &img, msg,
-                      sizeof msg) != 0);
+    CHECK(render_text("WorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1] \"float scael\" [2]\n", &one_thread, &img,
+                      msg, sizeof msg) != 0);
     CHECK_MSG(strstr(msg, "scael"), "message: %s", msg);
-    CHECK(render_text("Integrator \"path\" \"string lightsampler\" \"tree\"\nWorldBegin\n", 1, &img, msg, sizeof msg) !=
+    CHECK(render_text("Integrator \"path\" \"string lightsampler\" \"tree\"\nWorldBegin\n", &one_thread, &img, msg,
+                      sizeof msg) !=
           0);
     CHECK_MSG(strstr(msg, "test.pbrt:1:") && strstr(msg, "lightsampler") && strstr(msg, "tree"), "message: %s", msg);
 }

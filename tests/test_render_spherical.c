@@ -11,33 +11,12 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 static void equal_area_inverse(const double d[3], double *u, double *v)
 {
@@ -71,7 +50,7 @@ static void check(const char *mapping, int W, int H, const double w0[3])
              mapping, W, H, w[0] * dist, w[1] * dist, w[2] * dist, rad);
     lf_image img = {0};
     char msg[1024] = "";
-    int rc = render_text(scene, &img, msg, sizeof msg);
+    int rc = render_text(scene, NULL, &img, msg, sizeof msg);
     CHECK_MSG(rc == 0, "%s", msg);
     if (rc)
         return;

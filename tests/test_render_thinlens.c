@@ -17,33 +17,12 @@
 #include <string.h>
 
 #include "lf_test.h"
+#include "lf_test_tools.h"
 #include "render/lf_render.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static int render_text(const char *text, lf_image *img, char *msg, size_t msg_size)
-{
-    lf_scene_desc d;
-    lf_error err = {0};
-    if (lf_scene_parse_string(text, "test.pbrt", &d, &err)) {
-        snprintf(msg, msg_size, "%s", err.msg);
-        return -1;
-    }
-    lf_render_opts o = lf_render_opts_default();
-    o.threads = 2;
-    lf_renderer *r;
-    int rc = lf_renderer_create(&d, &o, &r, &err);
-    if (!rc) {
-        rc = lf_renderer_render(r, img, NULL, &err);
-        lf_renderer_free(r);
-    }
-    lf_scene_desc_free(&d);
-    if (rc)
-        snprintf(msg, msg_size, "%s", err.msg);
-    return rc;
-}
 
 /* Flux (sum of pixel values) and plateau (mean over pixels whose whole
  * area lies within plateau_r of the centre (cx, cy), raster units). */
@@ -97,7 +76,7 @@ static void test_thinlens_defocus(double z, int spp, unsigned seed)
     snprintf(scene + n, sizeof scene - n, emitter_fmt, 0.0, 0.0, z, rho);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -131,7 +110,7 @@ static void test_perspective_defocus(double z, int spp, unsigned seed)
     snprintf(scene + n, sizeof scene - n, emitter_fmt, 0.0, 0.0, z, rho);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "render failed: %s", msg);
         return;
     }
@@ -204,7 +183,7 @@ static void check_pentagon(const char *what, const char *camera, int W, int H, i
     snprintf(scene + n, sizeof scene - n, emitter_fmt, 0.0, 0.0, z, rho_world);
     lf_image img;
     char msg[1024];
-    if (render_text(scene, &img, msg, sizeof msg)) {
+    if (render_text(scene, NULL, &img, msg, sizeof msg)) {
         CHECK_MSG(0, "%s: render failed: %s", what, msg);
         return;
     }
@@ -282,7 +261,7 @@ static int render_sky(double L, double N, double shutter, double iso, int spp, l
              "PixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" [1]\n"
              "WorldBegin\nLightSource \"infinite\" \"rgb L\" [%g %g %g]\n",
              N, shutter, iso, spp, L, L, L);
-    if (render_text(scene, img, msg, sizeof msg)) {
+    if (render_text(scene, NULL, img, msg, sizeof msg)) {
         CHECK_MSG(0, "sky render failed: %s", msg);
         return -1;
     }

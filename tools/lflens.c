@@ -14,67 +14,56 @@
 #include "cli.h"
 #include "image/lf_image.h"
 
-static struct {
+typedef struct flags {
     double aperture_mm, focus_m, diagonal_mm;
     const char *sensor, *out;
     int json;
-} opt = {.focus_m = INFINITY};
+} flags;
 
 #define LENS_FLAGS                                                                                                 \
-    {"--aperture", NULL, LF_ARG_DOUBLE, &opt.aperture_mm, "MM", "stop diameter (default: the file's full stop)",  \
-     .min = 0, .flags = LF_ARG_MIN_OPEN},                                                                         \
-        {"--focus", NULL, LF_ARG_DOUBLE, &opt.focus_m, "M", "focus distance from the film in metres (default inf)", \
-         .min = 0, .flags = LF_ARG_MIN_OPEN | LF_ARG_INF_OK},                                                     \
-        {"--sensor", NULL, LF_ARG_STRING, &opt.sensor, "NAME",                                                    \
+    {"--aperture", NULL, LF_ARG_DOUBLE, &f.aperture_mm, "MM", "stop diameter (default: the file's full stop)",     \
+     .min = 0, .flags = LF_ARG_MIN_OPEN},                                                                          \
+        {"--focus", NULL, LF_ARG_DOUBLE, &f.focus_m, "M", "focus distance from the film in metres (default inf)",  \
+         .min = 0, .flags = LF_ARG_MIN_OPEN | LF_ARG_INF_OK},                                                      \
+        {"--sensor", NULL, LF_ARG_STRING, &f.sensor, "NAME",                                                       \
          "fullframe, apsc, apsh, mediumformat, fourthirds, 1inch, 1/1.63in, 1/2.3in, 1/3.2in (default fullframe)"}, \
-        {"--diagonal", NULL, LF_ARG_DOUBLE, &opt.diagonal_mm, "MM", "a film of this diagonal with a 3:2 aspect",   \
+        {"--diagonal", NULL, LF_ARG_DOUBLE, &f.diagonal_mm, "MM", "a film of this diagonal with a 3:2 aspect",     \
          .min = 0, .flags = LF_ARG_MIN_OPEN }
 
-static const lf_arg info_args[] = {
-    LENS_FLAGS,
-    {"--json", NULL, LF_ARG_FLAG, &opt.json, NULL, "one JSON object (efl_mm, bfl_mm, fnumber, pupils, fov_deg, ...)"},
-};
-static const lf_arg plot_args[] = {
-    LENS_FLAGS,
-    {"--output", "-o", LF_ARG_STRING, &opt.out, "OUT.svg|OUT.png", "the drawing (PNG: the same, without text)",
-     .flags = LF_ARG_REQUIRED},
-};
-
 /* Loads the lens and analyses it for the flags' sensor and focus. */
-static int analyse(const char *path, lf_lens *L, lf_lens_report *r)
+static int analyse(const flags *f, const char *path, lf_lens *L, lf_lens_report *r)
 {
     lf_error err = {0};
     double w, h;
-    if (opt.sensor && opt.diagonal_mm > 0) {
+    if (f->sensor && f->diagonal_mm > 0) {
         fprintf(stderr, "lflens: give --sensor or --diagonal, not both\n");
-        return 2;
+        return LF_EXIT_USAGE;
     }
-    if (opt.sensor && lf_lens_sensor_size(opt.sensor, &w, &h)) {
-        fprintf(stderr, "lflens: unknown sensor \"%s\" (known: %s)\n", opt.sensor, lf_lens_sensor_names());
-        return 2;
+    if (f->sensor && lf_lens_sensor_size(f->sensor, &w, &h)) {
+        fprintf(stderr, "lflens: unknown sensor \"%s\" (known: %s)\n", f->sensor, lf_lens_sensor_names());
+        return LF_EXIT_USAGE;
     }
-    if (!opt.sensor && opt.diagonal_mm > 0)
-        w = opt.diagonal_mm * 3.0 / sqrt(13.0), h = opt.diagonal_mm * 2.0 / sqrt(13.0);
-    else if (!opt.sensor)
+    if (!f->sensor && f->diagonal_mm > 0)
+        w = f->diagonal_mm * 3.0 / sqrt(13.0), h = f->diagonal_mm * 2.0 / sqrt(13.0);
+    else if (!f->sensor)
         lf_lens_sensor_size("fullframe", &w, &h);
     if (lf_lens_load(path, L, &err)) {
         fprintf(stderr, "lflens: %s\n", err.msg);
-        return 1;
+        return LF_EXIT_FAIL;
     }
-    if (opt.aperture_mm > 0) {
+    if (f->aperture_mm > 0) {
         lf_warnings warn = {0};
-        if (lf_lens_set_stop_diameter(L, opt.aperture_mm, &warn))
-            fprintf(stderr, "lflens: %s", lf_warnings_text(&warn)); /* "warning: ...\n" */
-        lf_warnings_free(&warn);
+        if (lf_lens_set_stop_diameter(L, f->aperture_mm, &warn)) /* "warning: ...\n" */
+            fprintf(stderr, "lflens: %s", lf_warnings_text(&warn)), lf_warnings_free(&warn);
         if (L->stop < 0)
             fprintf(stderr, "lflens: warning: %s has no aperture stop row; --aperture ignored\n", path);
     }
-    if (lf_lens_report_compute(L, w, h, opt.focus_m, r, &err)) {
+    if (lf_lens_report_compute(L, w, h, f->focus_m, r, &err)) {
         fprintf(stderr, "lflens: %s\n", err.msg);
         lf_lens_free(L);
-        return 1;
+        return LF_EXIT_FAIL;
     }
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static void print_json(const lf_lens *L, const lf_lens_report *r)
@@ -99,7 +88,7 @@ static void print_json(const lf_lens *L, const lf_lens_report *r)
            isfinite(r->film_search_mm) ? r->film_search_mm : -1.0, r->closest_focus_m, L->has_abbe ? "true" : "false");
 }
 
-static void print_text(const lf_lens *L, const lf_lens_report *r)
+static void print_text(const flags *f, const lf_lens *L, const lf_lens_report *r)
 {
     const lf_lens_paraxial *p = &r->px;
     printf("lens:                  %s (%d surfaces, stop on line %d)%s\n", L->path, L->n, L->s[p->stop].line,
@@ -119,7 +108,7 @@ static void print_text(const lf_lens *L, const lf_lens_report *r)
     printf("f-number               f/%.3f at infinity; working f/%.3f at the focus distance\n", p->fnumber,
            r->working_fnumber);
     printf("sensor                 %.4g x %.4g mm (diagonal %.4g mm)%s%s\n", r->sensor_w_mm, r->sensor_h_mm,
-           r->diagonal_mm, opt.sensor ? ", " : "", opt.sensor ? opt.sensor : "");
+           r->diagonal_mm, f->sensor ? ", " : "", f->sensor ? f->sensor : "");
     printf("field of view          paraxial %.2f x %.2f deg (diagonal %.2f); traced %.2f x %.2f deg (diagonal %.2f)\n",
            r->fov_paraxial_deg[0], r->fov_paraxial_deg[1], r->fov_paraxial_deg[2], r->fov_traced_deg[0],
            r->fov_traced_deg[1], r->fov_traced_deg[2]);
@@ -134,20 +123,21 @@ static void print_text(const lf_lens *L, const lf_lens_report *r)
     printf("closest focus          %.4f m from the film (unit magnification, thick-lens model)\n", r->closest_focus_m);
 }
 
-static int run_info(int n, char **pos)
+static int run_info(void *ctx, int n, char **pos)
 {
     (void)n;
+    const flags *f = ctx;
     lf_lens L;
     lf_lens_report r;
-    int rc = analyse(pos[0], &L, &r);
+    int rc = analyse(f, pos[0], &L, &r);
     if (rc)
         return rc;
-    if (opt.json)
+    if (f->json)
         print_json(&L, &r);
     else
-        print_text(&L, &r);
+        print_text(f, &L, &r);
     lf_lens_free(&L);
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static int write_plot(const lf_plot *plot, const char *path, lf_error *err)
@@ -170,45 +160,55 @@ static int write_plot(const lf_plot *plot, const char *path, lf_error *err)
     return rc;
 }
 
-static int run_plot(int n, char **pos)
+static int run_plot(void *ctx, int n, char **pos)
 {
     (void)n;
-    const char *dot = strrchr(opt.out, '.');
+    const flags *f = ctx;
+    const char *dot = strrchr(f->out, '.');
     if (!dot || (strcmp(dot, ".svg") && strcmp(dot, ".png"))) {
-        fprintf(stderr, "lflens plot: -o wants OUT.svg or OUT.png, got \"%s\"\n", opt.out);
-        return 2;
+        fprintf(stderr, "lflens plot: -o wants OUT.svg or OUT.png, got \"%s\"\n", f->out);
+        return LF_EXIT_USAGE;
     }
     lf_lens L;
     lf_lens_report r;
-    int rc = analyse(pos[0], &L, &r);
+    int rc = analyse(f, pos[0], &L, &r);
     if (rc)
         return rc;
     lf_plot plot;
     lf_error err = {0};
-    rc = lf_lens_plot_build(&L, &r, &plot, &err) || write_plot(&plot, opt.out, &err);
+    rc = lf_lens_plot_build(&L, &r, &plot, &err) || write_plot(&plot, f->out, &err);
     if (rc)
         fprintf(stderr, "lflens: %s\n", err.msg);
     lf_plot_free(&plot);
     lf_lens_free(&L);
-    return rc ? 1 : 0;
+    return rc ? LF_EXIT_FAIL : LF_EXIT_OK;
 }
 
-static const lf_command commands[] = {
-    {"info", "LENS.dat [--aperture MM] [--focus M] [--sensor NAME|--diagonal MM] [--json]",
-     "paraxial analysis: focal lengths, principal planes, pupils, f-numbers, field of view, focus", info_args,
-     LF_ARRAY_LEN(info_args), 1, 1, run_info,
-     "Focal lengths and principal planes from a paraxial y-nu trace; the film position that focuses at --focus "
-     "(thick-lens estimate and exact best-focus search); the field of view of the sensor, paraxial and traced."},
-    {"plot", "LENS.dat -o OUT.svg|OUT.png [--aperture MM] [--focus M] [--sensor NAME|--diagonal MM]",
-     "cross-section with traced ray fans, spot diagrams and the distortion curve", plot_args,
-     LF_ARRAY_LEN(plot_args), 1, 1, run_plot, NULL},
-};
-
-static const lf_tool tool = {"lflens", "analyse and draw real lens prescriptions (pbrt .dat files)", LF_VERSION,
-                             commands, LF_ARRAY_LEN(commands),
-                             "Exit status: 0 success; 1 bad lens file or impossible request; 2 bad command line."};
-
+/* The flag tables (and LENS_FLAGS) point into f, the options the command gets. */
 int main(int argc, char **argv)
 {
-    return lf_cli_main(&tool, argc, argv);
+    flags f = {.focus_m = INFINITY};
+    const lf_arg info_args[] = {
+        LENS_FLAGS,
+        {"--json", NULL, LF_ARG_FLAG, &f.json, NULL, "one JSON object (efl_mm, bfl_mm, fnumber, pupils, fov_deg, ...)"},
+    };
+    const lf_arg plot_args[] = {
+        LENS_FLAGS,
+        {"--output", "-o", LF_ARG_STRING, &f.out, "OUT.svg|OUT.png", "the drawing (PNG: the same, without text)",
+         .flags = LF_ARG_REQUIRED},
+    };
+    const lf_command commands[] = {
+        {"info", "LENS.dat [--aperture MM] [--focus M] [--sensor NAME|--diagonal MM] [--json]",
+         "paraxial analysis: focal lengths, principal planes, pupils, f-numbers, field of view, focus", info_args,
+         LF_ARRAY_LEN(info_args), 1, 1, run_info,
+         "Focal lengths and principal planes from a paraxial y-nu trace; the film position that focuses at --focus "
+         "(thick-lens estimate and exact best-focus search); the field of view of the sensor, paraxial and traced."},
+        {"plot", "LENS.dat -o OUT.svg|OUT.png [--aperture MM] [--focus M] [--sensor NAME|--diagonal MM]",
+         "cross-section with traced ray fans, spot diagrams and the distortion curve", plot_args,
+         LF_ARRAY_LEN(plot_args), 1, 1, run_plot, NULL},
+    };
+    const lf_tool tool = {"lflens", "analyse and draw real lens prescriptions (pbrt .dat files)", LF_VERSION,
+                          commands, LF_ARRAY_LEN(commands),
+                          "Exit status: 0 success; 1 bad lens file or impossible request; 2 bad command line."};
+    return lf_cli_main(&tool, &f, argc, argv);
 }

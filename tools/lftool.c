@@ -7,7 +7,6 @@
  * Exit codes: 0 ok, 1 bad input (the message names the file and what is
  * missing or wrong), 2 usage.
  */
-#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -21,46 +20,34 @@
 #include "lightfield/lf_source.h"
 #include "web/lf_web.h"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
-
 /* ---------- flags (one table per command; `lftool COMMAND --help`) ---------- */
 
 typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
     const char *confidence, *dispmap, *geometry; /* depth, view, synth */
     lf_lightfield_layout flags;
-    int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to;
+    int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
-    int have_u, have_v;
     int views[4], steps, threads, allow_nonfinite, calibrate_views;
-    /* synth */
     lf_lightfield_synth_opts synth;
-    int have_outfov, have_outdim, have_pos, have_focal;
-    /* export-web, serve */
-    int port, have_steps;
-    /* 8-bit outputs */
-    double exposure;
+    int have_outfov, have_outdim, have_pos, have_focal; /* synth */
+    int port, have_steps;                               /* export-web, serve */
+    double exposure;                                    /* 8-bit outputs */
     const char *tonemap;
+    /* the layout (CS348B names) and synth camera, turned into flags and synth by apply_flags() */
+    struct gathered_flags {
+        const char *kind, *grid;
+        int cams[2], tile[2], lenses[2], outdim[2], spp;
+        double griddim[4], fov, pitch, rotation, offset[2], mainlens[4], pos[3], rot[3], focal, outfov, lensradius;
+        long long seed;
+        int g_kind, g_cams, g_griddim, g_fov, g_tile, g_grid, g_pitch, g_rot, g_offset, g_lenses, g_main, g_spp, g_seed;
+    } fl;
 } opts;
 
-static opts opt = {.steps = 9, .oversample = 2, .port = 8000};
-
-/* Flags whose values are gathered first and turned into opt's fields by
- * apply_flags(): the layout (CS348B names) and the synth camera. */
-static struct {
-    const char *kind, *grid;
-    int cams[2], tile[2], lenses[2], outdim[2], spp;
-    double griddim[4], fov, pitch, rotation, offset[2], mainlens[4], pos[3], rot[3], focal, outfov, lensradius;
-    long long seed;
-    int g_kind, g_cams, g_griddim, g_fov, g_tile, g_grid, g_pitch, g_rot, g_offset, g_lenses, g_main, g_spp, g_seed;
-} fl;
-
-static int usage(const char *fmt, const char *arg)
+static int usage(const opts *o, const char *msg)
 {
-    fprintf(stderr, "lftool: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\n(lftool %s --help for its flags)\n", opt.cmd ? opt.cmd : "COMMAND");
-    return EXIT_USAGE;
+    fprintf(stderr, "lftool: %s\n(lftool %s --help for its flags)\n", msg, o->cmd ? o->cmd : "COMMAND");
+    return LF_EXIT_USAGE;
 }
 
 #define R_MIN(lo) .min = (lo), .flags = LF_ARG_HAS_MIN
@@ -70,198 +57,115 @@ static int usage(const char *fmt, const char *arg)
 /* Layout flags: for raws without lensfield:* attributes (they must agree
  * with the file otherwise). */
 #define LAYOUT_FLAGS                                                                                               \
-    {"--kind", NULL, LF_ARG_CHOICE, &fl.kind, "KIND", "layout: camera-array or plenoptic",                         \
-     .choices = "camera-array|plenoptic", .given = &fl.g_kind},                                                    \
-        {"--camsperdim", NULL, LF_ARG_INT, fl.cams, "NX NY", "layout: data cameras per row and column",           \
-         R_IN(1, 4096), .count = 2, .given = &fl.g_cams},                                                          \
-        {"--griddim", NULL, LF_ARG_DOUBLE, fl.griddim, "MINX MAXX MINY MAXY", "layout: camera grid bounds (m)",   \
-         .count = 4, .given = &fl.g_griddim},                                                                      \
-        {"--inputfov", NULL, LF_ARG_DOUBLE, &fl.fov, "DEG", "layout: the data cameras' field of view",            \
-         .min = 0, .max = 180, .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &fl.g_fov},                     \
-        {"--tilesize", NULL, LF_ARG_INT, fl.tile, "W H", "layout: tile of one data camera (px)", R_IN(1, 1 << 20), \
-         .count = 2, .given = &fl.g_tile},                                                                         \
-        {"--grid", NULL, LF_ARG_CHOICE, &fl.grid, "GRID", "layout: microlens grid square or hex",                  \
-         .choices = "square|hex", .given = &fl.g_grid},                                                            \
-        {"--pitch", NULL, LF_ARG_DOUBLE, &fl.pitch, "PX", "layout: microlens pitch (px)", R_POS, .given = &fl.g_pitch}, \
-        {"--rotation", NULL, LF_ARG_DOUBLE, &fl.rotation, "RAD", "layout: microlens grid rotation",                \
-         .given = &fl.g_rot},                                                                                      \
-        {"--offset", NULL, LF_ARG_DOUBLE, fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,     \
-         .given = &fl.g_offset},                                                                                   \
-        {"--lenscount", NULL, LF_ARG_INT, fl.lenses, "NX NY", "layout: microlenses per row and column",           \
-         R_IN(1, 1 << 20), .count = 2, .given = &fl.g_lenses},                                                     \
-        {"--mainlens", NULL, LF_ARG_DOUBLE, fl.mainlens, "FOCAL_MM FSTOP MLA_DISTANCE_MM PITCH_UM",                \
-         "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &fl.g_main},    \
-        {"--threads", NULL, LF_ARG_INT, &opt.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},       \
-        {"--allow-nonfinite", NULL, LF_ARG_FLAG, &opt.allow_nonfinite, NULL,                                      \
+    {"--kind", NULL, LF_ARG_CHOICE, &o.fl.kind, "KIND", "layout: camera-array or plenoptic",                       \
+     .choices = "camera-array|plenoptic", .given = &o.fl.g_kind},                                                  \
+        {"--camsperdim", NULL, LF_ARG_INT, o.fl.cams, "NX NY", "layout: data cameras per row and column",          \
+         R_IN(1, 4096), .count = 2, .given = &o.fl.g_cams},                                                        \
+        {"--griddim", NULL, LF_ARG_DOUBLE, o.fl.griddim, "MINX MAXX MINY MAXY", "layout: camera grid bounds (m)",  \
+         .count = 4, .given = &o.fl.g_griddim},                                                                    \
+        {"--inputfov", NULL, LF_ARG_DOUBLE, &o.fl.fov, "DEG", "layout: the data cameras' field of view",           \
+         .min = 0, .max = 180, .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &o.fl.g_fov},                  \
+        {"--tilesize", NULL, LF_ARG_INT, o.fl.tile, "W H", "layout: tile of one data camera (px)", R_IN(1, 1 << 20), \
+         .count = 2, .given = &o.fl.g_tile},                                                                       \
+        {"--grid", NULL, LF_ARG_CHOICE, &o.fl.grid, "GRID", "layout: microlens grid square or hex",                \
+         .choices = "square|hex", .given = &o.fl.g_grid},                                                          \
+        {"--pitch", NULL, LF_ARG_DOUBLE, &o.fl.pitch, "PX", "layout: microlens pitch (px)", R_POS,                 \
+         .given = &o.fl.g_pitch},                                                                                  \
+        {"--rotation", NULL, LF_ARG_DOUBLE, &o.fl.rotation, "RAD", "layout: microlens grid rotation",              \
+         .given = &o.fl.g_rot},                                                                                    \
+        {"--offset", NULL, LF_ARG_DOUBLE, o.fl.offset, "X Y", "layout: first microlens centre (px)", .count = 2,   \
+         .given = &o.fl.g_offset},                                                                                 \
+        {"--lenscount", NULL, LF_ARG_INT, o.fl.lenses, "NX NY", "layout: microlenses per row and column",          \
+         R_IN(1, 1 << 20), .count = 2, .given = &o.fl.g_lenses},                                                   \
+        {"--mainlens", NULL, LF_ARG_DOUBLE, o.fl.mainlens, "FOCAL_MM FSTOP MLA_DISTANCE_MM PITCH_UM",              \
+         "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &o.fl.g_main}, \
+        {"--threads", NULL, LF_ARG_INT, &o.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},         \
+        {"--allow-nonfinite", NULL, LF_ARG_FLAG, &o.allow_nonfinite, NULL,                                         \
          "treat NaN/Inf raw pixels as missing samples instead of failing"}
 
-#define OUTPUT_FLAG(what) {"--output", "-o", LF_ARG_STRING, &opt.output, "OUT", what, .flags = LF_ARG_REQUIRED}
+#define OUTPUT_FLAG(what) {"--output", "-o", LF_ARG_STRING, &o.output, "OUT", what, .flags = LF_ARG_REQUIRED}
 #define PICTURE_FLAGS                                                                                              \
-    {"--exposure", NULL, LF_ARG_DOUBLE, &opt.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",  \
-     R_IN(-64, 64)},                                                                                                \
-        {"--tonemap", NULL, LF_ARG_CHOICE, &opt.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)", \
+    {"--exposure", NULL, LF_ARG_DOUBLE, &o.exposure, "EV", "8-bit outputs: scale by 2^EV before the tone curve",   \
+     R_IN(-64, 64)},                                                                                               \
+        {"--tonemap", NULL, LF_ARG_CHOICE, &o.tonemap, "CURVE", "8-bit outputs: the tone curve (default clamp)",   \
          .choices = "clamp|filmic|aces"}
 #define FOCUS_FLAGS                                                                                                \
-    {"--alpha", NULL, LF_ARG_DOUBLE, &opt.alpha, "A", "synthetic film at alpha F (Ng 2005)", R_POS,               \
-     .given = &opt.have_alpha},                                                                                    \
-        {"--depth", NULL, LF_ARG_DOUBLE, &opt.depth, "M", "the depth brought into focus (m)", R_POS,              \
-         .given = &opt.have_depth},                                                                                \
-        {"--disparity", NULL, LF_ARG_DOUBLE, &opt.disp, "PX", "the disparity brought into focus (px per view)",    \
-         .given = &opt.have_disp}
+    {"--alpha", NULL, LF_ARG_DOUBLE, &o.alpha, "A", "synthetic film at alpha F (Ng 2005)", R_POS,                  \
+     .given = &o.have_alpha},                                                                                      \
+        {"--depth", NULL, LF_ARG_DOUBLE, &o.depth, "M", "the depth brought into focus (m)", R_POS,                 \
+         .given = &o.have_depth},                                                                                  \
+        {"--disparity", NULL, LF_ARG_DOUBLE, &o.disp, "PX", "the disparity brought into focus (px per view)",      \
+         .given = &o.have_disp}
 #define APERTURE_FLAGS                                                                                             \
-    {"--aperture", NULL, LF_ARG_DOUBLE, &opt.aperture, "R", "synthetic aperture radius (views from the centre)",   \
-     R_MIN(0), .given = &opt.have_aperture},                                                                       \
-        {"--views", NULL, LF_ARG_INT, opt.views, "U0 U1 V0 V1", "use only views [U0,U1] x [V0,V1]",                \
-         R_IN(0, 1 << 20), .count = 4, .given = &opt.have_views}
+    {"--aperture", NULL, LF_ARG_DOUBLE, &o.aperture, "R", "synthetic aperture radius (views from the centre)",     \
+     R_MIN(0), .given = &o.have_aperture},                                                                         \
+        {"--views", NULL, LF_ARG_INT, o.views, "U0 U1 V0 V1", "use only views [U0,U1] x [V0,V1]",                  \
+         R_IN(0, 1 << 20), .count = 4, .given = &o.have_views}
 #define RANGE_FLAGS(lo)                                                                                            \
-    {"--from", NULL, LF_ARG_DOUBLE, &opt.from, "D0", "lowest disparity (px per view)", .given = &opt.have_from},   \
-        {"--to", NULL, LF_ARG_DOUBLE, &opt.to, "D1", "highest disparity (px per view)", .given = &opt.have_to},    \
-        {"--steps", NULL, LF_ARG_INT, &opt.steps, "N", "slices between them", R_IN(lo, 4096),                     \
-         .given = &opt.have_steps}
+    {"--from", NULL, LF_ARG_DOUBLE, &o.from, "D0", "lowest disparity (px per view)", .given = &o.have_from},       \
+        {"--to", NULL, LF_ARG_DOUBLE, &o.to, "D1", "highest disparity (px per view)", .given = &o.have_to},        \
+        {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "slices between them", R_IN(lo, 4096),                        \
+         .given = &o.have_steps}
 
-static const lf_arg info_args[] = {LAYOUT_FLAGS};
-static const lf_arg decode_args[] = {
-    OUTPUT_FLAG("folder of views (view_ROW_COL) and mosaic"), LAYOUT_FLAGS, PICTURE_FLAGS,
-    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "views as exr (default) or png", .choices = "exr|png"},
-    {"--white", NULL, LF_ARG_STRING, &opt.white, "WHITE.exr", "divide by a white image (devignetting)"},
-    {"--layout", NULL, LF_ARG_CHOICE, &opt.hci, "hci",
-     "write the HCI benchmark layout (input_CamNNN.png, parameters.cfg, gt_disp_lowres.pfm)", .choices = "hci"},
-};
-static const lf_arg calibrate_args[] = {
-    OUTPUT_FLAG("the white image with the estimated layout attributes"),
-    {"--grid", NULL, LF_ARG_CHOICE, &fl.grid, "GRID", "microlens grid square or hex (default: estimated)",
-     .choices = "square|hex", .given = &fl.g_grid},
-};
-static const lf_arg refocus_args[] = {
-    OUTPUT_FLAG("the refocused image"), FOCUS_FLAGS, APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
-    {"--white", NULL, LF_ARG_STRING, &opt.white, "WHITE.exr", "divide by a white image (devignetting)"},
-    {"--method", NULL, LF_ARG_CHOICE, &opt.method, "METHOD", "shift-and-add (default) or Fourier slice",
-     .choices = "shift|fourier"},
-    {"--oversample", NULL, LF_ARG_DOUBLE, &opt.oversample, "S", "Fourier slice: spectrum oversampling (default 2)",
-     R_IN(1, 8)},
-};
-static const lf_arg stack_args[] = {
-    OUTPUT_FLAG("folder of slices stack_NNN"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
-    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "slices as exr (default) or png", .choices = "exr|png"},
-};
-static const lf_arg allfocus_args[] = {
-    OUTPUT_FLAG("the all-in-focus image"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
-};
-static const lf_arg depth_args[] = {
-    OUTPUT_FLAG("disparity map: .exr/.pfm values, .png a colour map with a legend"), RANGE_FLAGS(3), APERTURE_FLAGS,
-    LAYOUT_FLAGS,
-    {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "also write the confidence map"},
-    {"--calibrate-views", NULL, LF_ARG_FLAG, &opt.calibrate_views, NULL,
-     "fit each view's position and pixel offset to the data first (docs/depth.md)"},
-    {"--method", NULL, LF_ARG_CHOICE, &opt.method, "METHOD",
-     "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
-     .choices = "volume|stack"},
-};
-static const lf_arg view_args[] = {
-    OUTPUT_FLAG("the synthesized view"), FOCUS_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
-    {"--u", NULL, LF_ARG_DOUBLE, &opt.u, "U", "viewpoint, in view steps right of the centre", .given = &opt.have_u,
-     .flags = LF_ARG_REQUIRED},
-    {"--v", NULL, LF_ARG_DOUBLE, &opt.v, "V", "viewpoint, in view steps below the centre", .given = &opt.have_v,
-     .flags = LF_ARG_REQUIRED},
-    {"--geometry", NULL, LF_ARG_CHOICE, &opt.geometry, "GEOM",
-     "depth: per-pixel disparity (default); plane: blend on one plane", .choices = "depth|plane"},
-    {"--disparity-map", NULL, LF_ARG_STRING, &opt.dispmap, "D.exr", "use this disparity map instead of estimating"},
-    {"--confidence", NULL, LF_ARG_STRING, &opt.confidence, "C.exr", "its confidence (with --disparity-map)"},
-    {"--calibrate-views", NULL, LF_ARG_FLAG, &opt.calibrate_views, NULL,
-     "fit each view's position and pixel offset to the data first (docs/depth.md)"},
-};
-static const lf_arg synth_args[] = {
-    LAYOUT_FLAGS, PICTURE_FLAGS,
-    {"--samplesperpixel", NULL, LF_ARG_INT, &fl.spp, "N", "samples per pixel", R_IN(1, 1 << 20), .given = &fl.g_spp},
-    {"--focaldistance", NULL, LF_ARG_DOUBLE, &fl.focal, "D", "virtual focal plane distance", R_POS,
-     .given = &opt.have_focal},
-    {"--camerapos", NULL, LF_ARG_DOUBLE, fl.pos, "X Y Z", "virtual camera position", .count = 3,
-     .given = &opt.have_pos},
-    {"--camerarot", NULL, LF_ARG_DOUBLE, fl.rot, "X Y Z", "virtual camera rotation (degrees)", .count = 3},
-    {"--outputfov", NULL, LF_ARG_DOUBLE, &fl.outfov, "DEG", "virtual camera field of view", .min = 0, .max = 180,
-     .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &opt.have_outfov},
-    {"--lensradius", NULL, LF_ARG_DOUBLE, &fl.lensradius, "R", "virtual lens radius (0: pinhole)", R_MIN(0)},
-    {"--outputdim", NULL, LF_ARG_INT, fl.outdim, "W H", "output size in pixels", R_IN(1, 65536), .count = 2,
-     .given = &opt.have_outdim},
-    {"--coverage", NULL, LF_ARG_STRING, &opt.coverage, "COV.exr", "also write where rays left the captured aperture"},
-    {"--seed", NULL, LF_ARG_LONG, &fl.seed, "S", "sampler seed", R_IN(0, 4294967295.0), .given = &fl.g_seed},
-    {"--geometry", NULL, LF_ARG_CHOICE, &opt.geometry, "GEOM", "depth: look data up on the estimated surface",
-     .choices = "depth|plane"},
-    {"--disparity-map", NULL, LF_ARG_STRING, &opt.dispmap, "D.exr", "with --geometry depth: this disparity map"},
-};
-static const lf_arg web_args[] = {
-    OUTPUT_FLAG("folder for index.html, lf.js and data.js"), LAYOUT_FLAGS,
-    {"--format", NULL, LF_ARG_CHOICE, &opt.format, "FMT", "atlases as jpg (default) or png", .choices = "jpg|png"},
-    {"--from", NULL, LF_ARG_DOUBLE, &opt.from, "D0", "lowest disparity (px per view)", .given = &opt.have_from},
-    {"--to", NULL, LF_ARG_DOUBLE, &opt.to, "D1", "highest disparity (px per view)", .given = &opt.have_to},
-    {"--steps", NULL, LF_ARG_INT, &opt.steps, "N", "focal-stack slices (default 9)", R_IN(2, 64),
-     .given = &opt.have_steps},
-};
-static const lf_arg serve_args[] = {
-    {"--port", NULL, LF_ARG_INT, &opt.port, "P", "port on 127.0.0.1 (default 8000; 0: any free)", R_IN(0, 65535)},
-};
-
-/* Turns the gathered layout and synth flags into opt.flags and opt.synth. */
-static void apply_flags(void)
+/* Turns the gathered layout and synth flags (o->fl) into o->flags and o->synth. */
+static void apply_flags(opts *o)
 {
-    lf_lightfield_layout *f = &opt.flags;
+    const struct gathered_flags *fl = &o->fl;
+    lf_lightfield_layout *f = &o->flags;
     lf_lightfield_layout_init(f);
     const struct {
         int given;
         unsigned have;
-    } given[] = {{fl.g_kind, LF_LIGHTFIELD_HAVE_KIND},   {fl.g_cams, LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_KIND},
-                 {fl.g_griddim, LF_LIGHTFIELD_HAVE_BOUNDS}, {fl.g_fov, LF_LIGHTFIELD_HAVE_FOV},
-                 {fl.g_tile, LF_LIGHTFIELD_HAVE_TILE},    {fl.g_grid, LF_LIGHTFIELD_HAVE_GRID},
-                 {fl.g_pitch, LF_LIGHTFIELD_HAVE_PITCH},  {fl.g_rot, LF_LIGHTFIELD_HAVE_ROTATION},
-                 {fl.g_offset, LF_LIGHTFIELD_HAVE_OFFSET}, {fl.g_lenses, LF_LIGHTFIELD_HAVE_LENS_COUNT},
-                 {fl.g_main, LF_LIGHTFIELD_HAVE_MAIN_LENS}};
+    } given[] = {{fl->g_kind, LF_LIGHTFIELD_HAVE_KIND},   {fl->g_cams, LF_LIGHTFIELD_HAVE_CAMS | LF_LIGHTFIELD_HAVE_KIND},
+                 {fl->g_griddim, LF_LIGHTFIELD_HAVE_BOUNDS}, {fl->g_fov, LF_LIGHTFIELD_HAVE_FOV},
+                 {fl->g_tile, LF_LIGHTFIELD_HAVE_TILE},    {fl->g_grid, LF_LIGHTFIELD_HAVE_GRID},
+                 {fl->g_pitch, LF_LIGHTFIELD_HAVE_PITCH},  {fl->g_rot, LF_LIGHTFIELD_HAVE_ROTATION},
+                 {fl->g_offset, LF_LIGHTFIELD_HAVE_OFFSET}, {fl->g_lenses, LF_LIGHTFIELD_HAVE_LENS_COUNT},
+                 {fl->g_main, LF_LIGHTFIELD_HAVE_MAIN_LENS}};
     for (size_t i = 0; i < LF_ARRAY_LEN(given); i++)
         if (given[i].given)
             f->have |= given[i].have;
-    f->kind = fl.g_cams || (fl.g_kind && strcmp(fl.kind, "plenoptic")) ? LF_LIGHTFIELD_CAMERA_ARRAY : LF_LIGHTFIELD_PLENOPTIC;
-    f->grid = fl.g_grid && !strcmp(fl.grid, "hex") ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
-    f->cams_x = fl.cams[0], f->cams_y = fl.cams[1];
-    memcpy(f->grid_bounds, fl.griddim, sizeof f->grid_bounds);
-    f->fov_deg = fl.fov, f->pitch_px = fl.pitch, f->rotation_rad = fl.rotation;
-    f->tile_w = fl.tile[0], f->tile_h = fl.tile[1];
-    f->offset_px[0] = fl.offset[0], f->offset_px[1] = fl.offset[1];
-    f->lens_x = fl.lenses[0], f->lens_y = fl.lenses[1];
-    f->main_focal_mm = fl.mainlens[0], f->main_fstop = fl.mainlens[1];
-    f->mla_distance_mm = fl.mainlens[2], f->pitch_um = fl.mainlens[3];
-    lf_lightfield_synth_opts *s = &opt.synth;
+    f->kind = fl->g_cams || (fl->g_kind && strcmp(fl->kind, "plenoptic")) ? LF_LIGHTFIELD_CAMERA_ARRAY : LF_LIGHTFIELD_PLENOPTIC;
+    f->grid = fl->g_grid && !strcmp(fl->grid, "hex") ? LF_LIGHTFIELD_GRID_HEX : LF_LIGHTFIELD_GRID_SQUARE;
+    f->cams_x = fl->cams[0], f->cams_y = fl->cams[1];
+    memcpy(f->grid_bounds, fl->griddim, sizeof f->grid_bounds);
+    f->fov_deg = fl->fov, f->pitch_px = fl->pitch, f->rotation_rad = fl->rotation;
+    f->tile_w = fl->tile[0], f->tile_h = fl->tile[1];
+    f->offset_px[0] = fl->offset[0], f->offset_px[1] = fl->offset[1];
+    f->lens_x = fl->lenses[0], f->lens_y = fl->lenses[1];
+    f->main_focal_mm = fl->mainlens[0], f->main_fstop = fl->mainlens[1];
+    f->mla_distance_mm = fl->mainlens[2], f->pitch_um = fl->mainlens[3];
+    lf_lightfield_synth_opts *s = &o->synth;
     *s = lf_lightfield_synth_defaults();
-    s->threads = opt.threads;
-    if (fl.g_spp)
-        s->spp = fl.spp;
-    if (fl.g_seed)
-        s->seed = (uint32_t)fl.seed;
-    s->focal_distance = fl.focal, s->lens_radius = fl.lensradius, s->fov_deg = fl.outfov;
-    memcpy(s->pos, fl.pos, sizeof s->pos);
-    memcpy(s->rot_deg, fl.rot, sizeof s->rot_deg);
-    s->width = fl.outdim[0], s->height = fl.outdim[1];
+    s->threads = o->threads;
+    if (fl->g_spp)
+        s->spp = fl->spp;
+    if (fl->g_seed)
+        s->seed = (uint32_t)fl->seed;
+    s->focal_distance = fl->focal, s->lens_radius = fl->lensradius, s->fov_deg = fl->outfov;
+    memcpy(s->pos, fl->pos, sizeof s->pos);
+    memcpy(s->rot_deg, fl->rot, sizeof s->rot_deg);
+    s->width = fl->outdim[0], s->height = fl->outdim[1];
 }
 
 /* ---------- helpers ---------- */
 
 /* Every command starts here: its name, IN (and OUT) and the flags' values. */
-static const opts *begin(const char *cmd, int n, char **pos)
+static const opts *begin(void *ctx, const char *cmd, int n, char **pos)
 {
-    opt.cmd = cmd;
-    opt.input = pos[0];
+    opts *o = ctx;
+    o->cmd = cmd, o->input = pos[0];
     if (n > 1)
-        opt.output = pos[1];
-    apply_flags();
-    return &opt;
+        o->output = pos[1];
+    apply_flags(o);
+    return o;
 }
 
 /* Prints a library error (after the input's name when given): exit 1. */
 static int fail(const lf_error *err, const char *name)
 {
-    if (name)
-        fprintf(stderr, "lftool: %s: %s\n", name, err->msg);
-    else
-        fprintf(stderr, "lftool: %s\n", err->msg);
-    return EXIT_INPUT;
+    fprintf(stderr, "lftool: %s%s%s\n", name ? name : "", name ? ": " : "", err->msg);
+    return LF_EXIT_FAIL;
 }
 
 /* Reads the raw (or folder of views) and resolves its layout (attributes +
@@ -275,21 +179,21 @@ static int load(const opts *o, lf_lightfield_source *s, int layout_only)
     if (!s->folder.dir && s->lf.nonfinite)
         fprintf(stderr, "lftool: %s: warning: %zu non-finite pixel values excluded as missing samples\n", o->input,
                 s->lf.nonfinite);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
-static int write_image(const char *path, const lf_image *img, const lf_attrs *a)
+static int write_image(const opts *o, const char *path, const lf_image *img, const lf_attrs *a)
 {
     lf_error err = {0};
-    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-    return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+    lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
+    return lf_image_write(path, img, a, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
 }
 
 /* ---------- commands ---------- */
 
-static int cmd_info(int n, char **pos)
+static int cmd_info(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("info", n, pos);
+    const opts *o = begin(ctx, "info", n, pos);
     lf_lightfield_source s;
     int rc = load(o, &s, 1);
     if (rc)
@@ -298,7 +202,7 @@ static int cmd_info(int n, char **pos)
     lf_lightfield_source_describe(&s, buf, sizeof buf);
     fputs(buf, stdout);
     lf_lightfield_close(&s);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 /* The HCI benchmark layout, with the centre view's ground truth when known. */
@@ -313,7 +217,7 @@ static int decode_hci(const opts *o, const lf_lightfield_source *s)
     if (no_centre)
         fprintf(stderr, "lftool: %s: note: %d x %d views have no centre view; gt_disp_lowres.pfm not written\n",
                 o->input, lf->nu, lf->nv);
-    int rc = lf_lightfield_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : EXIT_OK;
+    int rc = lf_lightfield_write_hci(o->output, lf, gt.data ? &gt : NULL, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc)
         printf("%s: %d x %d views of %d x %d -> %s (HCI layout%s; %zu missing samples)\n", o->input, lf->nu, lf->nv,
                lf->ns, lf->nt, o->output, gt.data ? ", gt_disp_lowres.pfm" : "", lf->missing);
@@ -321,16 +225,16 @@ static int decode_hci(const opts *o, const lf_lightfield_source *s)
     return rc;
 }
 
-static int cmd_decode(int n, char **pos)
+static int cmd_decode(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("decode", n, pos);
+    const opts *o = begin(ctx, "decode", n, pos);
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
         return rc;
     const lf_lightfield *lf = &s.lf;
     lf_error err = {0};
-    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
     if (o->hci)
         rc = decode_hci(o, &s);
     else if (lf_lightfield_write_views(lf, o->output, o->format ? o->format : "exr", &wo, &err))
@@ -346,13 +250,13 @@ static int cmd_decode(int n, char **pos)
 static int focus_disparity(const opts *o, const lf_lightfield *lf, double *d)
 {
     if (o->have_alpha + o->have_depth + o->have_disp > 1)
-        return usage("%s", "give one of --alpha, --depth, --disparity");
+        return usage(o, "give one of --alpha, --depth, --disparity");
     lf_error err = {0};
     *d = o->have_disp ? o->disp : 0;
     if ((o->have_alpha && lf_lightfield_alpha_to_disparity(lf, o->alpha, d, &err)) ||
         (o->have_depth && lf_lightfield_depth_to_disparity(lf, o->depth, d, &err)))
         return fail(&err, o->input);
-    return 0;
+    return LF_EXIT_OK;
 }
 
 static lf_lightfield_refocus_opts aperture_opts(const opts *o)
@@ -366,11 +270,11 @@ static lf_lightfield_refocus_opts aperture_opts(const opts *o)
     return r;
 }
 
-static int cmd_refocus(int n, char **pos)
+static int cmd_refocus(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("refocus", n, pos);
+    const opts *o = begin(ctx, "refocus", n, pos);
     if (o->have_alpha + o->have_depth + o->have_disp != 1)
-        return usage("%s", "refocus needs exactly one of --alpha A, --depth METRES, --disparity PX");
+        return usage(o, "refocus needs exactly one of --alpha A, --depth METRES, --disparity PX");
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -406,7 +310,7 @@ static int cmd_refocus(int n, char **pos)
         rc = fail(&err, o->input);
         goto done;
     }
-    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
+    lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
     if (lf_lightfield_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
         rc = fail(&err, NULL);
     else
@@ -424,9 +328,9 @@ static void stack_range(const opts *o, double *d0, double *d1)
     *d0 = o->have_from ? o->from : -1, *d1 = o->have_to ? o->to : 1;
 }
 
-static int cmd_stack(int n, char **pos)
+static int cmd_stack(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("stack", n, pos);
+    const opts *o = begin(ctx, "stack", n, pos);
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -446,8 +350,8 @@ static int cmd_stack(int n, char **pos)
         }
         char path[4096];
         snprintf(path, sizeof path, "%s/stack_%03d.%s", o->output, k, o->format ? o->format : "exr");
-        lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-        rc = lf_lightfield_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+        lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
+        rc = lf_lightfield_write_refocused(path, &out, ro.disparity_px, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
         lf_image_free(&out);
     }
     if (!rc)
@@ -471,7 +375,7 @@ static int allfocus_depth(const opts *o, int want_depth)
         lf_lightfield_close(&s);
         return fail(&err, o->input);
     }
-    rc = write_image(o->output, want_depth ? &dm : &af, NULL);
+    rc = write_image(o, o->output, want_depth ? &dm : &af, NULL);
     if (!rc)
         printf("%s: %s from %d slices (disparity %g .. %g) -> %s\n", o->input,
                want_depth ? "disparity map" : "all-in-focus", o->steps, d0, d1, o->output);
@@ -480,20 +384,20 @@ static int allfocus_depth(const opts *o, int want_depth)
     return rc;
 }
 
-static int cmd_allfocus(int n, char **pos)
+static int cmd_allfocus(void *ctx, int n, char **pos)
 {
-    return allfocus_depth(begin("allfocus", n, pos), 0);
+    return allfocus_depth(begin(ctx, "allfocus", n, pos), 0);
 }
 
-static int cmd_depth(int n, char **pos)
+static int cmd_depth(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("depth", n, pos);
+    const opts *o = begin(ctx, "depth", n, pos);
     if (o->method && !strcmp(o->method, "stack"))
         return allfocus_depth(o, 1);
     if (o->have_from != o->have_to)
-        return usage("%s", "depth: give both --from and --to, or neither (range from the file or the data)");
+        return usage(o, "depth: give both --from and --to, or neither (range from the file or the data)");
     if (o->have_from && !(o->from < o->to))
-        return usage("%s", "depth: --from must be below --to");
+        return usage(o, "depth: --from must be below --to");
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -519,10 +423,10 @@ static int cmd_depth(int n, char **pos)
     }
     if (lf_lightfield_depth(&s.lf, &d, &disp, o->confidence ? &conf : NULL, &err))
         goto failed;
-    lf_write_opts wo = lf_write_opts_picture(opt.exposure, opt.tonemap);
-    rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : EXIT_OK;
+    lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
+    rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc && o->confidence)
-        rc = write_image(o->confidence, &conf, NULL);
+        rc = write_image(o, o->confidence, &conf, NULL);
     if (!rc)
         printf("%s: disparity map (range %.4g .. %.4g px/view, %s) -> %s%s%s\n", o->input, d.d0, d.d1, src, o->output,
                o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
@@ -551,14 +455,14 @@ static int calibrate_for_view(const opts *o, lf_lightfield *lf, const lf_image *
     return rc;
 }
 
-static int cmd_view(int n, char **pos)
+static int cmd_view(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("view", n, pos);
+    const opts *o = begin(ctx, "view", n, pos);
     /* per-pixel geometry by default; the plane blend with --geometry plane
      * (or, as before, when a focus plane is given without --geometry) */
     int plane = o->geometry ? !strcmp(o->geometry, "plane") : (o->have_alpha + o->have_depth + o->have_disp) > 0;
     if (plane && o->dispmap)
-        return usage("%s", "--disparity-map needs --geometry depth");
+        return usage(o, "--disparity-map needs --geometry depth");
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -575,7 +479,7 @@ static int cmd_view(int n, char **pos)
         goto done;
     }
     if (!plane && o->calibrate_views && calibrate_for_view(o, &s.lf, &dm, &cm, &err))
-        rc = EXIT_INPUT;
+        rc = LF_EXIT_FAIL;
     else if (plane)
         rc = lf_lightfield_view_at(&s.lf, o->u, o->v, d, &out, &err);
     else {
@@ -586,18 +490,18 @@ static int cmd_view(int n, char **pos)
         vo.confidence = o->dispmap && o->confidence ? &cm : NULL;
         rc = lf_lightfield_view_depth(&s.lf, o->u, o->v, &vo, &out, &err);
     }
-    rc = rc ? fail(&err, o->input) : write_image(o->output, &out, NULL);
+    rc = rc ? fail(&err, o->input) : write_image(o, o->output, &out, NULL);
 done:
     lf_image_free(&out), lf_image_free(&dm), lf_image_free(&cm);
     lf_lightfield_close(&s);
     return rc;
 }
 
-static int cmd_synth(int n, char **pos)
+static int cmd_synth(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("synth", n, pos);
+    const opts *o = begin(ctx, "synth", n, pos);
     if (o->dispmap && !(o->geometry && !strcmp(o->geometry, "depth")))
-        return usage("%s", "--disparity-map needs --geometry depth");
+        return usage(o, "--disparity-map needs --geometry depth");
     lf_lightfield_source s;
     int rc = load(o, &s, 0);
     if (rc)
@@ -623,9 +527,9 @@ static int cmd_synth(int n, char **pos)
     }
     if (lf_lightfield_synth(&s.lf, &so, &out, &cov, &uncovered, &err))
         goto failed;
-    rc = write_image(o->output, &out, NULL);
+    rc = write_image(o, o->output, &out, NULL);
     if (!rc && o->coverage)
-        rc = write_image(o->coverage, &cov, NULL);
+        rc = write_image(o, o->coverage, &cov, NULL);
     if (!rc)
         printf("%s: %dx%d, %d spp -> %s\n", o->input, so.width, so.height, so.spp, o->output);
     if (!rc && uncovered)
@@ -640,9 +544,9 @@ done:
     return rc;
 }
 
-static int cmd_calibrate(int n, char **pos)
+static int cmd_calibrate(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("calibrate", n, pos);
+    const opts *o = begin(ctx, "calibrate", n, pos);
     lf_image white;
     lf_attrs a = {0}; /* only the estimated layout: the input's own header is not carried over */
     lf_error err = {0};
@@ -652,12 +556,12 @@ static int cmd_calibrate(int n, char **pos)
     lf_lightfield_layout_init(&lay);
     if (o->flags.have & LF_LIGHTFIELD_HAVE_GRID)
         lay.grid = o->flags.grid, lay.have |= LF_LIGHTFIELD_HAVE_GRID;
-    int rc = EXIT_INPUT;
+    int rc = LF_EXIT_FAIL;
     if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
     else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1, &err))
         fail(&err, NULL);
-    else if (!(rc = write_image(o->output, &white, &a))) {
+    else if (!(rc = write_image(o, o->output, &white, &a))) {
         char buf[1024];
         lf_lightfield_layout_describe(&lay, buf, sizeof buf);
         printf("%s: estimated layout -> %s\n%s", o->input, o->output, buf);
@@ -671,11 +575,11 @@ static int cmd_calibrate(int n, char **pos)
 
 /* ---------- export-web and serve (web/lf_web.h, docs/web.md) ---------- */
 
-static int cmd_export_web(int n, char **pos)
+static int cmd_export_web(void *ctx, int n, char **pos)
 {
-    const opts *o = begin("export-web", n, pos);
+    const opts *o = begin(ctx, "export-web", n, pos);
     if (o->have_from != o->have_to)
-        return usage("%s", "export-web: give both --from and --to, or neither");
+        return usage(o, "export-web: give both --from and --to, or neither");
     lf_web_export_opts wo = lf_web_export_defaults();
     wo.format = o->format ? o->format : "jpg";
     wo.stack_slices = o->have_steps ? o->steps : 9;
@@ -692,84 +596,157 @@ static int cmd_export_web(int n, char **pos)
     if (lf_web_export(&s.lf, o->output, &wo, &info, &err)) {
         fprintf(stderr, "lftool: export-web: %s: %s\n", o->input, err.msg);
         lf_lightfield_close(&s);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
     printf("%s: %d x %d views of %d x %d, focus %.4g .. %.4g px/view, %d-slice stack -> %s/index.html "
            "(%.1f KiB, %.2f s CPU)\n",
            o->input, s.lf.nu, s.lf.nv, s.lf.ns, s.lf.nt, info.focus_min, info.focus_max, wo.stack_slices, o->output,
            info.page_bytes / 1024.0, (double)(clock() - c0) / CLOCKS_PER_SEC);
     lf_lightfield_close(&s);
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
-static volatile sig_atomic_t serve_stop;
-static void serve_on_signal(int sig)
+static int cmd_serve(void *ctx, int n, char **pos)
 {
-    (void)sig;
-    serve_stop = 1;
-}
-
-static int cmd_serve(int n, char **pos)
-{
-    const opts *o = begin("serve", n, pos);
+    const opts *o = begin(ctx, "serve", n, pos);
     lf_web_server *srv;
     lf_error err = {0};
     if (lf_web_server_open(o->input, o->port, &srv, &err)) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
-    struct sigaction sa = {0};
-    sa.sa_handler = serve_on_signal; /* no SA_RESTART: accept() returns EINTR */
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    volatile sig_atomic_t *stop = lf_cli_stop_on_signals();
     printf("serving %s at http://127.0.0.1:%d/ (Ctrl-C stops)\n", lf_web_server_root(srv), lf_web_server_port(srv));
     fflush(stdout);
-    int rc = lf_web_server_run(srv, &serve_stop, &err);
+    int rc = lf_web_server_run(srv, stop, &err);
     lf_web_server_close(srv);
     if (rc) {
         fprintf(stderr, "lftool: serve: %s\n", err.msg);
-        return EXIT_INPUT;
+        return LF_EXIT_FAIL;
     }
     printf("stopped\n");
-    return EXIT_OK;
+    return LF_EXIT_OK;
 }
 
 #define CMD(name, syn, sum, args, fn, desc) {name, syn, sum, args, LF_ARRAY_LEN(args), 1, 1, fn, desc}
-static const lf_command commands[] = {
-    CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
-    CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
-        "sub-aperture views and a mosaic, or the HCI benchmark layout", decode_args, cmd_decode, NULL),
-    CMD("calibrate", "WHITE.exr -o OUT.exr [--grid square|hex]", "estimate the microlens grid from a white image",
-        calibrate_args, cmd_calibrate, NULL),
-    CMD("refocus", "IN (--alpha A | --depth M | --disparity PX) -o OUT [options]",
-        "refocus after capture (shift-and-add or Fourier slice)", refocus_args, cmd_refocus,
-        "Refocusing outside the refocusable range (Ng 2005) is done, with a warning: the sub-aperture views are "
-        "themselves blurred there."),
-    CMD("stack", "IN --from D0 --to D1 [--steps N] -o DIR", "a focal stack over a disparity range", stack_args,
-        cmd_stack, NULL),
-    CMD("allfocus", "IN --from D0 --to D1 [--steps N] -o OUT", "an all-in-focus image from a focal stack",
-        allfocus_args, cmd_allfocus, NULL),
-    CMD("depth", "IN -o OUT.exr|.pfm|.png [--from D0 --to D1] [--confidence C.exr]",
-        "disparity map of the centre view (docs/depth.md)", depth_args, cmd_depth,
-        "Without --from/--to the range comes from the input's metadata or is estimated from the data. Output in "
-        "the HCI benchmark's convention: a point moves by -d pixels when the viewpoint moves one view right."),
-    CMD("view", "IN --u U --v V -o OUT [--geometry depth|plane] [--disparity-map D.exr]",
-        "synthesize a view from another viewpoint", view_args, cmd_view, NULL),
-    {"synth", "LF OUT.exr [CS348B flags]", "the CS348B virtual camera between the data cameras", synth_args,
-     LF_ARRAY_LEN(synth_args), 2, 2, cmd_synth, NULL},
-    CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
-        "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
-    CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),
-};
 
-static const lf_tool tool = {
-    "lftool", "decode, refocus and re-view light fields", LF_VERSION, commands, LF_ARRAY_LEN(commands),
-    "IN is a light-field raw (EXR with lensfield:* attributes, or any image plus layout flags) or a folder of "
-    "views: the HCI layout (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC.png|exr (docs/lightfield-format.md). "
-    "Exit status: 0 success; 1 bad input (the message names the file); 2 bad command line."};
-
+/* The flag tables (and the *_FLAGS macros) point into o, the options every command gets. */
 int main(int argc, char **argv)
 {
-    return lf_cli_main(&tool, argc, argv);
+    opts o = {.steps = 9, .oversample = 2, .port = 8000};
+    const lf_arg info_args[] = {LAYOUT_FLAGS};
+    const lf_arg decode_args[] = {
+        OUTPUT_FLAG("folder of views (view_ROW_COL) and mosaic"), LAYOUT_FLAGS, PICTURE_FLAGS,
+        {"--format", NULL, LF_ARG_CHOICE, &o.format, "FMT", "views as exr (default) or png", .choices = "exr|png"},
+        {"--white", NULL, LF_ARG_STRING, &o.white, "WHITE.exr", "divide by a white image (devignetting)"},
+        {"--layout", NULL, LF_ARG_CHOICE, &o.hci, "hci",
+         "write the HCI benchmark layout (input_CamNNN.png, parameters.cfg, gt_disp_lowres.pfm)", .choices = "hci"},
+    };
+    const lf_arg calibrate_args[] = {
+        OUTPUT_FLAG("the white image with the estimated layout attributes"),
+        {"--grid", NULL, LF_ARG_CHOICE, &o.fl.grid, "GRID", "microlens grid square or hex (default: estimated)",
+         .choices = "square|hex", .given = &o.fl.g_grid},
+    };
+    const lf_arg refocus_args[] = {
+        OUTPUT_FLAG("the refocused image"), FOCUS_FLAGS, APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+        {"--white", NULL, LF_ARG_STRING, &o.white, "WHITE.exr", "divide by a white image (devignetting)"},
+        {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD", "shift-and-add (default) or Fourier slice",
+         .choices = "shift|fourier"},
+        {"--oversample", NULL, LF_ARG_DOUBLE, &o.oversample, "S", "Fourier slice: spectrum oversampling (default 2)",
+         R_IN(1, 8)},
+    };
+    const lf_arg stack_args[] = {
+        OUTPUT_FLAG("folder of slices stack_NNN"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+        {"--format", NULL, LF_ARG_CHOICE, &o.format, "FMT", "slices as exr (default) or png", .choices = "exr|png"},
+    };
+    const lf_arg allfocus_args[] = {
+        OUTPUT_FLAG("the all-in-focus image"), RANGE_FLAGS(2), APERTURE_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+    };
+    const lf_arg depth_args[] = {
+        OUTPUT_FLAG("disparity map: .exr/.pfm values, .png a colour map with a legend"), RANGE_FLAGS(3), APERTURE_FLAGS,
+        LAYOUT_FLAGS,
+        {"--confidence", NULL, LF_ARG_STRING, &o.confidence, "C.exr", "also write the confidence map"},
+        {"--calibrate-views", NULL, LF_ARG_FLAG, &o.calibrate_views, NULL,
+         "fit each view's position and pixel offset to the data first (docs/depth.md)"},
+        {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD",
+         "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
+         .choices = "volume|stack"},
+    };
+    const lf_arg view_args[] = {
+        OUTPUT_FLAG("the synthesized view"), FOCUS_FLAGS, LAYOUT_FLAGS, PICTURE_FLAGS,
+        {"--u", NULL, LF_ARG_DOUBLE, &o.u, "U", "viewpoint, in view steps right of the centre", .given = &o.have_u,
+         .flags = LF_ARG_REQUIRED},
+        {"--v", NULL, LF_ARG_DOUBLE, &o.v, "V", "viewpoint, in view steps below the centre", .given = &o.have_v,
+         .flags = LF_ARG_REQUIRED},
+        {"--geometry", NULL, LF_ARG_CHOICE, &o.geometry, "GEOM",
+         "depth: per-pixel disparity (default); plane: blend on one plane", .choices = "depth|plane"},
+        {"--disparity-map", NULL, LF_ARG_STRING, &o.dispmap, "D.exr", "use this disparity map instead of estimating"},
+        {"--confidence", NULL, LF_ARG_STRING, &o.confidence, "C.exr", "its confidence (with --disparity-map)"},
+        {"--calibrate-views", NULL, LF_ARG_FLAG, &o.calibrate_views, NULL,
+         "fit each view's position and pixel offset to the data first (docs/depth.md)"},
+    };
+    const lf_arg synth_args[] = {
+        LAYOUT_FLAGS, PICTURE_FLAGS,
+        {"--samplesperpixel", NULL, LF_ARG_INT, &o.fl.spp, "N", "samples per pixel", R_IN(1, 1 << 20),
+         .given = &o.fl.g_spp},
+        {"--focaldistance", NULL, LF_ARG_DOUBLE, &o.fl.focal, "D", "virtual focal plane distance", R_POS,
+         .given = &o.have_focal},
+        {"--camerapos", NULL, LF_ARG_DOUBLE, o.fl.pos, "X Y Z", "virtual camera position", .count = 3,
+         .given = &o.have_pos},
+        {"--camerarot", NULL, LF_ARG_DOUBLE, o.fl.rot, "X Y Z", "virtual camera rotation (degrees)", .count = 3},
+        {"--outputfov", NULL, LF_ARG_DOUBLE, &o.fl.outfov, "DEG", "virtual camera field of view", .min = 0, .max = 180,
+         .flags = LF_ARG_MIN_OPEN | LF_ARG_MAX_OPEN, .given = &o.have_outfov},
+        {"--lensradius", NULL, LF_ARG_DOUBLE, &o.fl.lensradius, "R", "virtual lens radius (0: pinhole)", R_MIN(0)},
+        {"--outputdim", NULL, LF_ARG_INT, o.fl.outdim, "W H", "output size in pixels", R_IN(1, 65536), .count = 2,
+         .given = &o.have_outdim},
+        {"--coverage", NULL, LF_ARG_STRING, &o.coverage, "COV.exr", "also write where rays left the captured aperture"},
+        {"--seed", NULL, LF_ARG_LONG, &o.fl.seed, "S", "sampler seed", R_IN(0, 4294967295.0), .given = &o.fl.g_seed},
+        {"--geometry", NULL, LF_ARG_CHOICE, &o.geometry, "GEOM", "depth: look data up on the estimated surface",
+         .choices = "depth|plane"},
+        {"--disparity-map", NULL, LF_ARG_STRING, &o.dispmap, "D.exr", "with --geometry depth: this disparity map"},
+    };
+    const lf_arg web_args[] = {
+        OUTPUT_FLAG("folder for index.html, lf.js and data.js"), LAYOUT_FLAGS,
+        {"--format", NULL, LF_ARG_CHOICE, &o.format, "FMT", "atlases as jpg (default) or png", .choices = "jpg|png"},
+        {"--from", NULL, LF_ARG_DOUBLE, &o.from, "D0", "lowest disparity (px per view)", .given = &o.have_from},
+        {"--to", NULL, LF_ARG_DOUBLE, &o.to, "D1", "highest disparity (px per view)", .given = &o.have_to},
+        {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "focal-stack slices (default 9)", R_IN(2, 64),
+         .given = &o.have_steps},
+    };
+    const lf_arg serve_args[] = {
+        {"--port", NULL, LF_ARG_INT, &o.port, "P", "port on 127.0.0.1 (default 8000; 0: any free)", R_IN(0, 65535)},
+    };
+    const lf_command commands[] = {
+        CMD("info", "IN", "describe a light-field raw or folder of views", info_args, cmd_info, NULL),
+        CMD("decode", "IN -o DIR [--format exr|png] [--white W.exr] [--layout hci]",
+            "sub-aperture views and a mosaic, or the HCI benchmark layout", decode_args, cmd_decode, NULL),
+        CMD("calibrate", "WHITE.exr -o OUT.exr [--grid square|hex]", "estimate the microlens grid from a white image",
+            calibrate_args, cmd_calibrate, NULL),
+        CMD("refocus", "IN (--alpha A | --depth M | --disparity PX) -o OUT [options]",
+            "refocus after capture (shift-and-add or Fourier slice)", refocus_args, cmd_refocus,
+            "Refocusing outside the refocusable range (Ng 2005) is done, with a warning: the sub-aperture views are "
+            "themselves blurred there."),
+        CMD("stack", "IN --from D0 --to D1 [--steps N] -o DIR", "a focal stack over a disparity range", stack_args,
+            cmd_stack, NULL),
+        CMD("allfocus", "IN --from D0 --to D1 [--steps N] -o OUT", "an all-in-focus image from a focal stack",
+            allfocus_args, cmd_allfocus, NULL),
+        CMD("depth", "IN -o OUT.exr|.pfm|.png [--from D0 --to D1] [--confidence C.exr]",
+            "disparity map of the centre view (docs/depth.md)", depth_args, cmd_depth,
+            "Without --from/--to the range comes from the input's metadata or is estimated from the data. Output in "
+            "the HCI benchmark's convention: a point moves by -d pixels when the viewpoint moves one view right."),
+        CMD("view", "IN --u U --v V -o OUT [--geometry depth|plane] [--disparity-map D.exr]",
+            "synthesize a view from another viewpoint", view_args, cmd_view, NULL),
+        {"synth", "LF OUT.exr [CS348B flags]", "the CS348B virtual camera between the data cameras", synth_args,
+         LF_ARRAY_LEN(synth_args), 2, 2, cmd_synth, NULL},
+        CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
+            "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
+        CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),
+    };
+    const lf_tool tool = {
+        "lftool", "decode, refocus and re-view light fields", LF_VERSION, commands, LF_ARRAY_LEN(commands),
+        "IN is a light-field raw (EXR with lensfield:* attributes, or any image plus layout flags) or a folder of "
+        "views: the HCI layout (input_CamNNN.png + parameters.cfg) or PREFIX_RR_CC.png|exr "
+        "(docs/lightfield-format.md). "
+        "Exit status: 0 success; 1 bad input (the message names the file); 2 bad command line."};
+    return lf_cli_main(&tool, &o, argc, argv);
 }

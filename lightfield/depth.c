@@ -1424,8 +1424,24 @@ int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, doubl
          * would land a parabola offset or more inside).  Double that end,
          * up to the view's limit; the label count stays that of the first
          * sweep (coarser steps: the range needs no precision) */
-        int grow_lo = lo <= a + 0.5 * step * f && a > -view_lim, grow_hi = hi >= b - 0.5 * step * f && b < view_lim;
-        if (!grow_lo && !grow_hi) {
+        double na = lo <= a + 0.5 * step * f && a > -view_lim ? fmax(2 * a, -view_lim) : a;
+        double nb = hi >= b - 0.5 * step * f && b < view_lim ? fmin(2 * b, view_lim) : b;
+        /* a disparity far beyond the first sweep matches nowhere in it, so
+         * its cost need not fall toward the end: one sweep over the whole
+         * range the views allow, at the first sweep's label count, says
+         * whether more than 1% of the confident pixels lie beyond */
+        if (round == 0 && view_lim > lim0) {
+            double ws = fmax(step, 2 * view_lim / f / first_labels), wlo, whi;
+            if ((rc = range_pass(&small, threads, -view_lim / f, view_lim / f, ws, &wlo, &whi, err)))
+                break;
+            wlo *= f, whi *= f;
+            double wpad = 0.05 * (whi - wlo) + ws * f;
+            if (whi > b + ws * f)
+                nb = fmax(nb, fmin(whi + wpad, view_lim));
+            if (wlo < a - ws * f)
+                na = fmin(na, fmax(wlo - wpad, -view_lim));
+        }
+        if (na == a && nb == b) {
             *d0 = lo - pad, *d1 = hi + pad;
             if (*d0 < a)
                 *d0 = a;
@@ -1435,10 +1451,7 @@ int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, doubl
                 *d0 = a, *d1 = b;
             break;
         }
-        if (grow_lo)
-            a = fmax(2 * a, -view_lim);
-        if (grow_hi)
-            b = fmin(2 * b, view_lim);
+        a = na, b = nb;
         step = fmax(step, (b - a) / f / first_labels);
         if (info)
             info->widened = 1;

@@ -64,10 +64,13 @@ int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts 
 /* The disparity range the scene occupies, estimated by a coarse sweep at
  * quarter resolution (first over -8 .. 8 px per view, or less where the
  * views are small), kept to the confident pixels' 1st..99th percentile and
- * padded by 5% and one coarse step.  An end the data reaches (the 1st or
- * 99th percentile on the end label: more than 1% of the pixels' costs still
- * falling toward it) is doubled and the sweep re-run, up to shifts of a
- * quarter of the view size at the outermost view.  *d0 < *d1 on success. */
+ * padded by 5% and one coarse step.  Widened where the data goes beyond:
+ * when the views allow more than 8 px per view (shifts up to a quarter of
+ * the view at the outermost view), a sweep over that whole range at the
+ * same label count finds the percentiles beyond the first sweep's ends; an
+ * end the data reaches (the 1st or 99th percentile on the end label) is
+ * doubled; the sweep is re-run over the widened range.  *d0 < *d1 on
+ * success. */
 int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
 
 /* What the range estimate did, for the tool to say. */

@@ -271,7 +271,7 @@ const char *lf_lightfield_source_disparity_range(const lf_lightfield_source *src
     *d0 = *d1 = 0;
     if ((lay->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
         *d0 = lay->disp_min, *d1 = lay->disp_max; /* a raw's: lfrender --aov disparity's ground-truth range */
-        return src->folder.dir ? "the folder's disp_min/disp_max" : "lensfield:disparity_range";
+        return src->folder.dir ? "the folder's disp_min/disp_max" : LF_KEY_DISPARITY_RANGE;
     }
     const lf_attr *a = lf_attrs_get(&src->attrs, LF_KEY_DISP_MIN), *b = lf_attrs_get(&src->attrs, LF_KEY_DISP_MAX);
     if (a && b) {

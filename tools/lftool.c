@@ -511,7 +511,7 @@ static int cmd_depth(int n, char **pos)
         src = "estimated";
     lf_error err = {0};
     lf_image disp = {0}, conf = {0};
-    lf_lightfield_depth_range_info ri;
+    lf_lightfield_depth_range_info ri = {0};
     char srcbuf[160];
     if (d.d0 >= d.d1 && lf_lightfield_depth_range_report(&s.lf, o->threads, &d.d0, &d.d1, &ri, &err))
         goto failed;

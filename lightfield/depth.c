@@ -1292,13 +1292,11 @@ int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts 
     return depth_core(lf, o, d0, d1, step, disparity, confidence, err);
 }
 
-int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err)
+/* The views box-averaged f x f (calibrated offsets and missing samples
+ * carried over). */
+static int shrink_lightfield(const lf_lightfield *lf, int f, lf_lightfield *out, lf_error *err)
 {
-    int rc = check_lf(lf, err);
-    if (rc)
-        return rc;
-    /* quarter resolution by 4x4 box averaging: disparities shrink by 4 */
-    int f = (lf->ns >= 64 && lf->nt >= 64) ? 4 : 1;
+    int rc;
     lf_lightfield small = {0};
     if ((rc = lf_lightfield_alloc(&small, lf->nu, lf->nv, lf->ns / f, lf->nt / f, err)))
         return rc;
@@ -1344,12 +1342,16 @@ int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, 
                         dst[((size_t)y * small.ns + x) * 3 + c] = s / (float)(f * f);
                     }
         }
-    double m = widest_view(lf);
-    /* widest search: shifts up to a quarter of the view at the outermost view, at most 8 px/view */
-    double lim = (lf->ns < lf->nt ? lf->ns : lf->nt) / 4.0 / (m > 0 ? m : 1);
-    if (lim > 8)
-        lim = 8;
-    double step = 0.25 / m; /* 0.25 px at the outermost view, at quarter resolution */
+    *out = small;
+    return LF_OK;
+}
+
+/* One coarse sweep over [s0, s1] (px/view at the small views' scale): the
+ * 1st..99th percentile of the confident pixels' disparities into *lo, *hi
+ * (same scale). */
+static int range_pass(const lf_lightfield *small, int threads, double s0, double s1, double step, double *lo, double *hi,
+                      lf_error *err)
+{
     lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
     o.threads = threads;
     o.occlusion = 0;
@@ -1357,15 +1359,13 @@ int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, 
     o.refine = -1, o.interp = 1, o.thin = -1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
-    double s0 = -lim / f, s1 = lim / f;
-    if ((rc = depth_core(&small, &o, s0, s1, step, &disp, &conf, err))) {
-        lf_lightfield_free(&small);
+    int rc = depth_core(small, &o, s0, s1, step, &disp, &conf, err);
+    if (rc)
         return rc;
-    }
-    size_t np = (size_t)small.ns * small.nt, n = 0;
+    size_t np = (size_t)small->ns * small->nt, n = 0;
     float *vals = malloc(sizeof(float) * np);
     if (!vals) {
-        lf_image_free(&disp), lf_image_free(&conf), lf_lightfield_free(&small);
+        lf_image_free(&disp), lf_image_free(&conf);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
     for (int pass = 0; pass < 2 && n < np / 20; pass++) {
@@ -1376,17 +1376,89 @@ int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, 
                 vals[n++] = disp.data[i];
     }
     qsort(vals, n, sizeof(float), cmpf);
-    double lo = vals[(size_t)(0.01 * (n - 1))] * f, hi = vals[(size_t)(0.99 * (n - 1))] * f;
+    *lo = vals[(size_t)(0.01 * (n - 1))], *hi = vals[(size_t)(0.99 * (n - 1))];
     free(vals);
-    lf_image_free(&disp), lf_image_free(&conf), lf_lightfield_free(&small);
-    double pad = 0.05 * (hi - lo) + step * f;
-    *d0 = lo - pad, *d1 = hi + pad;
-    if (*d0 < -lim)
-        *d0 = -lim;
-    if (*d1 > lim)
-        *d1 = lim;
-    if (!(*d0 < *d1))
-        *d0 = -lim, *d1 = lim;
+    lf_image_free(&disp), lf_image_free(&conf);
     return LF_OK;
+}
+
+int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err)
+{
+    return lf_lightfield_depth_range_report(lf, threads, d0, d1, NULL, err);
+}
+
+int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, double *d0, double *d1,
+                                     lf_lightfield_depth_range_info *info, lf_error *err)
+{
+    int rc = check_lf(lf, err);
+    if (rc)
+        return rc;
+    /* quarter resolution by 4x4 box averaging: disparities shrink by 4 */
+    int f = (lf->ns >= 64 && lf->nt >= 64) ? 4 : 1;
+    lf_lightfield small;
+    if ((rc = shrink_lightfield(lf, f, &small, err)))
+        return rc;
+    double m = widest_view(lf);
+    /* the widest search the views allow: shifts up to a quarter of the view
+     * at the outermost view.  The first sweep stops at 8 px/view (the common
+     * case, at its cost); an end the data reaches is widened below. */
+    double view_lim = (lf->ns < lf->nt ? lf->ns : lf->nt) / 4.0 / (m > 0 ? m : 1);
+    double lim0 = view_lim > 8 ? 8 : view_lim, a = -lim0, b = lim0;
+    double step = 0.25 / m; /* 0.25 px at the outermost view, at quarter resolution */
+    double first_labels = (b - a) / f / step;
+    double lo = 0, hi = 0;
+    if (info)
+        memset(info, 0, sizeof *info);
+    for (int round = 0;; round++) {
+        if ((rc = range_pass(&small, threads, a / f, b / f, step, &lo, &hi, err)))
+            break;
+        lo *= f, hi *= f;
+        double pad = 0.05 * (hi - lo) + step * f;
+        if (info && round == 0) {
+            info->first_d0 = lo - pad < a ? a : lo - pad;
+            info->first_d1 = hi + pad > b ? b : hi + pad;
+        }
+        /* an end the data reaches: the 1st or 99th percentile sits on the
+         * end label, so more than the 1% the percentile drops have their
+         * cost still falling toward that end (a minimum inside the range
+         * would land a parabola offset or more inside).  Double that end,
+         * up to the view's limit; the label count stays that of the first
+         * sweep (coarser steps: the range needs no precision) */
+        double na = lo <= a + 0.5 * step * f && a > -view_lim ? fmax(2 * a, -view_lim) : a;
+        double nb = hi >= b - 0.5 * step * f && b < view_lim ? fmin(2 * b, view_lim) : b;
+        /* a disparity far beyond the first sweep matches nowhere in it, so
+         * its cost need not fall toward the end: one sweep over the whole
+         * range the views allow, at the first sweep's label count, says
+         * whether more than 1% of the confident pixels lie beyond */
+        if (round == 0 && view_lim > lim0) {
+            double ws = fmax(step, 2 * view_lim / f / first_labels), wlo, whi;
+            if ((rc = range_pass(&small, threads, -view_lim / f, view_lim / f, ws, &wlo, &whi, err)))
+                break;
+            wlo *= f, whi *= f;
+            double wpad = 0.05 * (whi - wlo) + ws * f;
+            if (whi > b + ws * f)
+                nb = fmax(nb, fmin(whi + wpad, view_lim));
+            if (wlo < a - ws * f)
+                na = fmin(na, fmax(wlo - wpad, -view_lim));
+        }
+        if (na == a && nb == b) {
+            *d0 = lo - pad, *d1 = hi + pad;
+            if (*d0 < a)
+                *d0 = a;
+            if (*d1 > b)
+                *d1 = b;
+            if (!(*d0 < *d1))
+                *d0 = a, *d1 = b;
+            break;
+        }
+        a = na, b = nb;
+        step = fmax(step, (b - a) / f / first_labels);
+        if (info)
+            info->widened = 1;
+    }
+    if (info)
+        info->search_d0 = a, info->search_d1 = b;
+    lf_lightfield_free(&small);
+    return rc;
 }
 

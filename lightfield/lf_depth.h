@@ -62,11 +62,27 @@ int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts 
                 lf_error *err);
 
 /* The disparity range the scene occupies, estimated by a coarse sweep at
- * quarter resolution over the widest range the views allow (shifts up to a
- * quarter of the view size at the outermost view, at most 8 px per view),
- * kept to the confident pixels' 1st..99th percentile and padded by 5% and
- * one coarse step.  *d0 < *d1 on success. */
+ * quarter resolution (first over -8 .. 8 px per view, or less where the
+ * views are small), kept to the confident pixels' 1st..99th percentile and
+ * padded by 5% and one coarse step.  Widened where the data goes beyond:
+ * when the views allow more than 8 px per view (shifts up to a quarter of
+ * the view at the outermost view), a sweep over that whole range at the
+ * same label count finds the percentiles beyond the first sweep's ends; an
+ * end the data reaches (the 1st or 99th percentile on the end label) is
+ * doubled; the sweep is re-run over the widened range.  *d0 < *d1 on
+ * success. */
 int lf_lightfield_depth_range(const lf_lightfield *lf, int threads, double *d0, double *d1, lf_error *err);
+
+/* What the range estimate did, for the tool to say. */
+typedef struct lf_lightfield_depth_range_info {
+    double first_d0, first_d1;   /* the first sweep's estimate (px per view) */
+    double search_d0, search_d1; /* the last sweep's search range */
+    int widened;                 /* 1: the data reached an end of the first sweep, which was widened */
+} lf_lightfield_depth_range_info;
+
+/* lf_lightfield_depth_range, reporting into *info (NULL: as above). */
+int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, double *d0, double *d1,
+                                     lf_lightfield_depth_range_info *info, lf_error *err);
 
 /* A view at centred view coordinates (u, v) inside the captured aperture
  * with per-pixel geometry: a disparity map of the reference view (given, or

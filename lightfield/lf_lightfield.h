@@ -269,6 +269,30 @@ void lf_lightfield_folder_free(lf_lightfield_folder *f);
  * layout knows. */
 int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err);
 
+/* The parallax between the centre view and one neighbour
+ * (lf_lightfield_grid_parallax). */
+typedef struct lf_lightfield_pair_parallax {
+    int axis;           /* the axis the parallax runs along: 0 x, 1 y, -1 cannot tell (too little texture or parallax) */
+    double disparity;   /* median over the voting blocks, px per view step (the centre's point is at x - d there) */
+    double positive;    /* share of the voting blocks with d > 0 */
+    int blocks, textured, votes_x, votes_y;
+} lf_lightfield_pair_parallax;
+typedef struct lf_lightfield_parallax {
+    lf_lightfield_pair_parallax row; /* centre view against its right neighbour (iu + 1) */
+    lf_lightfield_pair_parallax col; /* against its lower neighbour (iv + 1) */
+    int both, same_sign;             /* blocks where both pairs voted; of them, with one sign of d */
+} lf_lightfield_parallax;
+
+/* Measures the direction of parallax between the centre view and its right
+ * and lower neighbours (lightfield/gridcheck.c: 16 x 16 blocks, a 1-D shift
+ * search along x and along y on the gradient of log luminance, so exposure
+ * does not matter).  In a grid read as it was captured, row neighbours move
+ * along x and column neighbours along y, with one sign of d per block. */
+int lf_lightfield_grid_parallax(const lf_lightfield *lf, lf_lightfield_parallax *p, lf_error *err);
+/* Reorders the views: transposed (view (iu, iv) becomes (iv, iu)), then
+ * mirrored along the rows (flip_x) and the columns (flip_y). */
+int lf_lightfield_grid_reorder(lf_lightfield *lf, int transpose, int flip_x, int flip_y, lf_error *err);
+
 /* Fills the geometry fields of lf (disp_per_inv_m, ...) from lf->layout's
  * values: lf_lightfield_decode and lf_lightfield_folder_load call it. */
 void lf_lightfield_set_geometry(lf_lightfield *lf, const lf_lightfield_layout *lay);

@@ -27,6 +27,9 @@ typedef struct lf_lightfield_source {
     lf_lightfield lf;     /* the decoded light field (empty when layout_only) */
     lf_lightfield_folder folder;  /* a folder of views when folder.dir != NULL */
     size_t raw_nonfinite; /* the raw's NaN/Inf values */
+    int parallax_measured;         /* folders: the grid was checked against its parallax */
+    lf_lightfield_parallax parallax; /* what the check measured (after any correction) */
+    lf_warnings warnings;          /* notes for the tool to print: a corrected grid */
 } lf_lightfield_source;
 
 typedef struct lf_lightfield_open_opts {
@@ -35,6 +38,9 @@ typedef struct lf_lightfield_open_opts {
     int allow_nonfinite;       /* NaN/Inf samples become missing instead of failing */
     int layout_only;           /* raws: resolve the layout, do not decode (nor check values) */
     int no_equalize;           /* folders: keep the views' brightness as read (no lf_lightfield_equalize) */
+    const char *grid;          /* folders: NULL or "check" (the grid checked against its parallax, swapped or
+                                * mirrored rows/columns corrected with a note), "off" (as named), "transpose",
+                                * "flip-x", "flip-y" (that correction, unchecked) */
 } lf_lightfield_open_opts;
 
 /* Reads a raw or a folder of views (every view is read, even with
@@ -54,9 +60,11 @@ void lf_lightfield_source_describe(const lf_lightfield_source *src, char *buf, s
  * when the view grid has no centre view (even count). */
 int lf_lightfield_source_gt_disparity(const lf_lightfield_source *src, lf_image *gt, int *no_centre, lf_error *err);
 
-/* A disparity range the source states: a folder's disp_min/disp_max, else
- * the raw's lensfield:disp_min/max.  Returns a name for the source of the
- * range ("the folder's disp_min/disp_max", "lensfield:disp_min/max"), or
+/* A disparity range the source states: a folder's disp_min/disp_max or a
+ * raw's lensfield:disparity_range (lfrender --aov disparity), else the raw's
+ * lensfield:disp_min/max.  Returns a name for the source of the range ("the
+ * folder's disp_min/disp_max", "lensfield:disparity_range",
+ * "lensfield:disp_min/max"), or
  * NULL (and 0 0) when it states none. */
 const char *lf_lightfield_source_disparity_range(const lf_lightfield_source *src, double *d0, double *d1);
 

@@ -5,6 +5,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "base/lf_file.h"
@@ -17,6 +18,7 @@ void lf_lightfield_close(lf_lightfield_source *src)
     lf_image_free(&src->raw);
     lf_attrs_free(&src->attrs);
     lf_lightfield_folder_free(&src->folder);
+    lf_warnings_free(&src->warnings);
 }
 
 /* Fails (and empties src) with the message of e, prefixed by the path. */
@@ -35,6 +37,79 @@ static int nonfinite_error(lf_lightfield_source *src, size_t count, lf_error *er
                         src->path, count);
 }
 
+static int reorder(lf_lightfield_source *src, int transpose, int flip_x, int flip_y, lf_error *err)
+{
+    int rc = lf_lightfield_grid_reorder(&src->lf, transpose, flip_x, flip_y, err);
+    if (!rc && transpose) { /* the layout's grid turns with the views */
+        lf_lightfield_layout *l[2] = {&src->lf.layout, &src->layout};
+        for (int i = 0; i < 2; i++) {
+            int c = l[i]->cams_x;
+            l[i]->cams_x = l[i]->cams_y, l[i]->cams_y = c;
+            double b0 = l[i]->grid_bounds[0], b1 = l[i]->grid_bounds[1];
+            l[i]->grid_bounds[0] = l[i]->grid_bounds[2], l[i]->grid_bounds[1] = l[i]->grid_bounds[3];
+            l[i]->grid_bounds[2] = b0, l[i]->grid_bounds[3] = b1;
+        }
+    }
+    return rc;
+}
+
+/* The grid checked against its parallax (lf_lightfield_grid_parallax):
+ * rows and columns swapped when both neighbour pairs say so, one axis
+ * mirrored when the pairs' disparities disagree in sign and the stated range
+ * (else the one-signed disparities of parallel cameras) says which; refused
+ * with the flag that fixes it when one pair alone disagrees. */
+static int check_grid(const lf_lightfield_open_opts *o, lf_lightfield_source *src, lf_error *err)
+{
+    const char *g = o->grid ? o->grid : "check";
+    if (!strcmp(g, "off"))
+        return LF_OK;
+    if (strcmp(g, "check"))
+        return reorder(src, !strcmp(g, "transpose"), !strcmp(g, "flip-x"), !strcmp(g, "flip-y"), err);
+    lf_lightfield_parallax *p = &src->parallax;
+    int rc = lf_lightfield_grid_parallax(&src->lf, p, err);
+    if (rc)
+        return rc;
+    src->parallax_measured = 1;
+    if (p->row.axis == 1 && p->col.axis == 0) {
+        if ((rc = reorder(src, 1, 0, 0, err)) || (rc = lf_lightfield_grid_parallax(&src->lf, p, err)))
+            return rc;
+        lf_warn_at(&src->warnings, NULL,
+                   "%s: rows and columns swapped (the parallax between row neighbours runs along y, between column "
+                   "neighbours along x): views transposed (--grid-order off reads them as named)",
+                   src->path);
+    } else if (p->row.axis == 1 || p->col.axis == 0) {
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: the parallax between %s neighbours runs along %s, but the other pair's does not: give "
+                            "--grid-order transpose if rows and columns are swapped, --grid-order off to read the views as named",
+                            src->path, p->row.axis == 1 ? "row" : "column", p->row.axis == 1 ? "y" : "x");
+    }
+    if (p->row.axis != 0 || p->col.axis != 1 || p->both < 8 || p->same_sign > 0.2 * p->both)
+        return LF_OK;
+    /* one axis runs backwards: flip the one whose sign disagrees with the
+     * stated range, else with the other's one-signed disparities */
+    const lf_lightfield_layout *l = &src->lf.layout;
+    int want = (l->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && l->disp_min >= 0   ? 1
+               : (l->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && l->disp_max <= 0 ? -1
+               : p->row.positive >= 0.8 || p->col.positive >= 0.8            ? 1
+               : p->row.positive <= 0.2 || p->col.positive <= 0.2            ? -1
+                                                                              : 0;
+    int row_ok = want > 0 ? p->row.positive >= 0.5 : p->row.positive < 0.5;
+    int col_ok = want > 0 ? p->col.positive >= 0.5 : p->col.positive < 0.5;
+    if (!want || row_ok == col_ok)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: the parallax between row neighbours and between column neighbours have opposite signs: "
+                            "one axis runs backwards; give --grid-order flip-x (a row's views run right to left) or --grid-order "
+                            "flip-y (a column's run bottom to top), or --grid-order off to read the views as named",
+                            src->path);
+    if ((rc = reorder(src, 0, !row_ok, !col_ok, err)) || (rc = lf_lightfield_grid_parallax(&src->lf, p, err)))
+        return rc;
+    lf_warn_at(&src->warnings, NULL,
+               "%s: %s (its parallax has the sign opposite to the %s): views mirrored (--grid-order off reads them as named)",
+               src->path, !row_ok ? "a row's views run right to left" : "a column's views run bottom to top",
+               (l->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) ? "folder's disp_min/disp_max" : "other axis's");
+    return LF_OK;
+}
+
 static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_layout *flags, lf_lightfield_source *src, lf_error *err)
 {
     if (o->white)
@@ -47,6 +122,8 @@ static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_lay
     if (src->lf.nonfinite && !o->allow_nonfinite)
         return nonfinite_error(src, src->lf.nonfinite, err);
     lf_error e = {0};
+    if (check_grid(o, src, &e))
+        return fail_named(src, &e, err);
     if (!o->no_equalize && lf_lightfield_equalize(&src->lf, &e))
         return fail_named(src, &e, err);
     return LF_OK;
@@ -83,6 +160,33 @@ int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_li
     return rc ? fail_named(src, &e, err) : LF_OK;
 }
 
+static size_t describe_pair(const char *name, const char *expect, const lf_lightfield_pair_parallax *q, char *buf, size_t n)
+{
+    if (q->axis < 0)
+        return (size_t)snprintf(buf, n, "%s neighbours: cannot tell (%d of %d blocks textured, %d voted)", name,
+                                q->textured, q->blocks, q->votes_x + q->votes_y);
+    return (size_t)snprintf(buf, n, "%s neighbours along %s%s (%+.3g px/view, %d of %d votes)", name,
+                            q->axis ? "y" : "x", strcmp(expect, q->axis ? "y" : "x") ? " (!)" : "", q->disparity,
+                            q->axis ? q->votes_y : q->votes_x, q->votes_x + q->votes_y);
+}
+
+/* "parallax: row neighbours along x (+1.02 px/view, ...), column neighbours along y (...)" */
+static size_t describe_parallax(const lf_lightfield_parallax *p, char *buf, size_t n)
+{
+    size_t k = (size_t)snprintf(buf, n, "parallax: ");
+    if (k < n)
+        k += describe_pair("row", "x", &p->row, buf + k, n - k);
+    if (k < n)
+        k += (size_t)snprintf(buf + k, n - k, ", ");
+    if (k < n)
+        k += describe_pair("column", "y", &p->col, buf + k, n - k);
+    if (k < n && p->both)
+        k += (size_t)snprintf(buf + k, n - k, ", one sign on %d of %d blocks", p->same_sign, p->both);
+    if (k < n)
+        k += (size_t)snprintf(buf + k, n - k, "\n");
+    return k < n ? k : n - 1;
+}
+
 void lf_lightfield_source_describe(const lf_lightfield_source *src, char *buf, size_t n)
 {
     char lay[2048];
@@ -96,6 +200,8 @@ void lf_lightfield_source_describe(const lf_lightfield_source *src, char *buf, s
         if (k < n && lf->disp_per_inv_m > 0)
             k += (size_t)snprintf(buf + k, n - k, "disparity %.6g + %.6g / depth px per view step\n", lf->disp_at_inf,
                                   lf->disp_per_inv_m);
+        if (k < n && src->parallax_measured)
+            k += describe_parallax(&src->parallax, buf + k, n - k);
         if (k < n && f->gt_disparity)
             k += (size_t)snprintf(buf + k, n - k, "ground-truth disparity: %s\n", f->gt_disparity);
         if (k < n && lf->views_rescaled)
@@ -164,8 +270,8 @@ const char *lf_lightfield_source_disparity_range(const lf_lightfield_source *src
     const lf_lightfield_layout *lay = &src->lf.layout;
     *d0 = *d1 = 0;
     if ((lay->have & LF_LIGHTFIELD_HAVE_DISP_RANGE) && lay->disp_min < lay->disp_max) { /* a folder's parameters.cfg */
-        *d0 = lay->disp_min, *d1 = lay->disp_max;
-        return "the folder's disp_min/disp_max";
+        *d0 = lay->disp_min, *d1 = lay->disp_max; /* a raw's: lfrender --aov disparity's ground-truth range */
+        return src->folder.dir ? "the folder's disp_min/disp_max" : LF_KEY_DISPARITY_RANGE;
     }
     const lf_attr *a = lf_attrs_get(&src->attrs, LF_KEY_DISP_MIN), *b = lf_attrs_get(&src->attrs, LF_KEY_DISP_MAX);
     if (a && b) {

@@ -24,7 +24,7 @@
 
 typedef struct opts {
     const char *cmd, *input, *output, *white, *format, *hci, *method, *coverage;
-    const char *confidence, *dispmap, *geometry; /* depth, view, synth */
+    const char *confidence, *dispmap, *geometry, *grid; /* depth, view, synth; folders */
     lf_lightfield_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
@@ -81,7 +81,9 @@ static int usage(const opts *o, const char *msg)
          "layout: the plenoptic camera's main lens and microlens array", R_POS, .count = 4, .given = &o.fl.g_main}, \
         {"--threads", NULL, LF_ARG_INT, &o.threads, "N", "threads (default 0: all cores)", R_IN(0, 1024)},         \
         {"--allow-nonfinite", NULL, LF_ARG_FLAG, &o.allow_nonfinite, NULL,                                         \
-         "treat NaN/Inf raw pixels as missing samples instead of failing"}
+         "treat NaN/Inf raw pixels as missing samples instead of failing"},                                        \
+        {"--grid-order", NULL, LF_ARG_CHOICE, &o.grid, "HOW", "folders: check the views' order against their parallax " \
+         "(default), read it as named, or reorder it", .choices = "check|off|transpose|flip-x|flip-y"}
 
 #define OUTPUT_FLAG(what) {"--output", "-o", LF_ARG_STRING, &o.output, "OUT", what, .flags = LF_ARG_REQUIRED}
 #define PICTURE_FLAGS                                                                                              \
@@ -173,9 +175,11 @@ static int fail(const lf_error *err, const char *name)
 static int load(const opts *o, lf_lightfield_source *s, int layout_only)
 {
     lf_error err = {0};
-    lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only};
+    lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only, .grid = o->grid};
     if (lf_lightfield_open(o->input, &oo, s, &err))
         return fail(&err, NULL);
+    if (lf_warnings_text(&s->warnings))
+        fprintf(stderr, "lftool: %s", lf_warnings_text(&s->warnings));
     if (!s->folder.dir && s->lf.nonfinite)
         fprintf(stderr, "lftool: %s: warning: %zu non-finite pixel values excluded as missing samples\n", o->input,
                 s->lf.nonfinite);
@@ -411,8 +415,12 @@ static int cmd_depth(void *ctx, int n, char **pos)
         src = "estimated";
     lf_error err = {0};
     lf_image disp = {0}, conf = {0};
-    if (d.d0 >= d.d1 && lf_lightfield_depth_range(&s.lf, o->threads, &d.d0, &d.d1, &err))
+    lf_lightfield_depth_range_info ri = {0};
+    char srcbuf[160];
+    if (d.d0 >= d.d1 && lf_lightfield_depth_range_report(&s.lf, o->threads, &d.d0, &d.d1, &ri, &err))
         goto failed;
+    if (!strcmp(src, "estimated") && ri.widened) /* the data reached the first sweep's end */
+        snprintf(srcbuf, sizeof srcbuf, "estimated, widened from %.4g .. %.4g", ri.first_d0, ri.first_d1), src = srcbuf;
     if (o->have_steps)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
     if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */

@@ -11,9 +11,10 @@
 #  1. render (cached): lfrender bench/depth/scenes/NAME.pbrt --aov disparity,
 #     then lftool decode --layout hci (8-bit sRGB views, parameters.cfg,
 #     gt_disp_lowres.pfm), then the scene's "# post:" lines (below).  The
-#     cache is OUT/cache/NAME-HASH, HASH the sha1 of the scene file, the
-#     files it includes and the textures they read, and this script's post
-#     version, so a second run only estimates depth.
+#     cache is OUT/cache/NAME-HASH, HASH the sha1 of the scene file and
+#     the files it includes (comments left out, "# post:" lines kept), the
+#     textures they read and this script's post version, so a second run
+#     only estimates depth.
 #  2. `lftool depth DIR -o d.pfm` with no flags (2 threads), timed (wall).
 #     The decoded parameters.cfg's disp_min/disp_max (the ground truth's
 #     range) are left out, so lftool estimates the range from the views as
@@ -130,7 +131,10 @@ for item in "${list[@]}"; do
     IFS=: read -r name half mode <<< "$item"
     f=$here/scenes/$name.pbrt
     [ -f "$f" ] || { echo "run.sh: $f missing" >&2; exit 1; }
-    hash=$( (scene_files "$f" | sort -u | xargs cat; echo "post $post_version") | sha1sum | cut -c1-12)
+    # comments do not change a render; "# post:" lines do
+    hash=$( (scene_files "$f" | sort -u | while read -r g; do
+        case $g in *.pbrt) grep -v '^ *#' "$g" || true; grep '^# post:' "$g" || true ;; *) cat "$g" ;; esac
+    done; echo "post $post_version") | sha1sum | cut -c1-12)
     cache=$out/cache/$name-$hash
     [ -f "$cache/hci/gt_disp_lowres.pfm" ] || render "$name" "$f" "$cache"
     [ $render_only = 1 ] && continue

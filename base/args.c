@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "lf_buf.h"
+#include "lf_suggest.h"
 
 static lf_args_status fail(lf_error *err, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -185,7 +186,28 @@ static lf_args_status unknown(const lf_tool *tool, const lf_command *cmd, const 
             return fail(err, "%.*s is a flag of `%s %s`, not of `%s%s%s`", (int)len, flag, tool->name,
                         o->name, tool->name, cmd->name ? " " : "", cmd->name ? cmd->name : "");
     }
+    char typed[64];
+    snprintf(typed, sizeof typed, "%.*s", (int)len, flag);
+    lf_suggest s = lf_suggest_begin(typed);
+    for (int i = 0; i < cmd->n_args; i++)
+        if (!(cmd->args[i].flags & LF_ARG_HIDDEN))
+            lf_suggest_consider(&s, cmd->args[i].name);
+    lf_suggest_consider(&s, "--help");
+    if (lf_suggest_best(&s))
+        return fail(err, "unknown flag %.*s (did you mean %s?)", (int)len, flag, lf_suggest_best(&s));
     return fail(err, "unknown flag %.*s", (int)len, flag);
+}
+
+const char *lf_args_unknown_command(const lf_tool *tool, const char *word, lf_error *err)
+{
+    lf_suggest s = lf_suggest_begin(word);
+    for (int i = 0; i < tool->n_commands; i++)
+        lf_suggest_consider(&s, tool->commands[i].name);
+    if (lf_suggest_best(&s))
+        lf_error_set(err, LF_ERR_PARAM, "unknown command \"%s\" (did you mean %s?)", word, lf_suggest_best(&s));
+    else
+        lf_error_set(err, LF_ERR_PARAM, "unknown command \"%s\"", word);
+    return err->msg;
 }
 
 lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int argc, char **argv, int first,
@@ -217,6 +239,8 @@ lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int arg
             return LF_ARGS_HELP;
         if (!strcmp(w, "--version"))
             return LF_ARGS_VERSION;
+        if (!strcmp(w, "--man"))
+            return LF_ARGS_MAN;
         const char *eq = strncmp(w, "--", 2) == 0 ? strchr(w, '=') : NULL;
         size_t len = eq ? (size_t)(eq - w) : strlen(w);
         const lf_arg *a = find_arg(cmd, w, len);
@@ -258,7 +282,9 @@ lf_args_status lf_args_parse(const lf_tool *tool, const lf_command *cmd, int arg
             return fail(err, "%s is required", a->name);
     }
     if (*n_positional < cmd->min_positional)
-        return fail(err, "missing argument%s (see the usage below)", cmd->min_positional > 1 ? "s" : "");
+        return fail(err, "missing argument%s (usage: %s%s%s %s)", cmd->min_positional > 1 ? "s" : "",
+                    tool ? tool->name : "",
+                    cmd->name ? " " : "", cmd->name ? cmd->name : "", cmd->synopsis ? cmd->synopsis : "");
     if (cmd->max_positional >= 0 && *n_positional > cmd->max_positional)
         return fail(err, "unexpected argument \"%s\"", positional[cmd->max_positional]);
     return LF_ARGS_OK;
@@ -360,7 +386,8 @@ static void command_usage(const lf_tool *tool, const lf_command *c, lf_strbuf *b
         lf_strbuf_free(&help);
         lf_strbuf_puts(b, "\n");
     }
-    lf_strbuf_puts(b, "  -h, --help                this help\n  --version                 print the version\n");
+    lf_strbuf_puts(b, "  -h, --help                this help\n  --man                     the manual page (through "
+                      "man(1) on a terminal)\n  --version                 print the version\n");
 }
 
 char *lf_args_usage(const lf_tool *tool, const lf_command *cmd)
@@ -384,8 +411,12 @@ char *lf_args_usage(const lf_tool *tool, const lf_command *cmd)
             if (c->name)
                 lf_strbuf_printf(&b, "  %-14s %s\n", c->name, c->summary ? c->summary : "");
         }
-        lf_strbuf_printf(&b, "\nRun `%s COMMAND --help` for a command's flags; `%s --version` prints the version.\n",
-                         tool->name, tool->name);
+        char run[256];
+        snprintf(run, sizeof run, "Run `%s COMMAND --help` for a command's flags, `%s --man` for the manual page; "
+                 "`%s --version` prints the version.", tool->name, tool->name, tool->name);
+        lf_strbuf_puts(&b, "\n");
+        wrap(&b, run, 0, 0, 79);
+        lf_strbuf_puts(&b, "\n");
     }
     if (tool->description && !cmd) {
         lf_strbuf_puts(&b, "\n");

@@ -19,7 +19,8 @@
  *   static const lf_tool tool = {"lftool", "light-field tool", LF_VERSION, cmds, LF_ARRAY_LEN(cmds)};
  *
  * lf_args_parse() fills the values and returns a status; it never prints.
- * What is an error (exit status 2 in every tool): an unknown flag, a flag
+ * What is an error (exit status 2 in every tool): an unknown flag (the
+ * message suggests the nearest known one, base/lf_suggest.h), a flag
  * that belongs to another subcommand (the message says which), a missing or
  * malformed value, a number out of its range or not an integer where one is
  * wanted, a choice not in the list, a required flag missing, too few or too
@@ -97,12 +98,17 @@ typedef enum lf_args_status {
     LF_ARGS_OK = 0,
     LF_ARGS_HELP,    /* --help / -h: print lf_args_usage() to stdout, exit 0 */
     LF_ARGS_VERSION, /* --version: print "tool version", exit 0 */
-    LF_ARGS_ERROR    /* message in err: print it and the usage to stderr, exit 2 */
+    LF_ARGS_ERROR,   /* message in err: print it and where help is to stderr, exit 2 */
+    LF_ARGS_MAN      /* --man: print the tool's man page (lf_args_man), exit 0 */
 } lf_args_status;
 
 /* Finds a command by name (NULL name: the single command of a tool without
  * subcommands).  Returns NULL if there is none. */
 const lf_command *lf_args_find(const lf_tool *tool, const char *name);
+
+/* Sets err to "unknown command "WORD"", with the nearest command name
+ * suggested (lf_suggest.h) when one is near; returns err->msg. */
+const char *lf_args_unknown_command(const lf_tool *tool, const char *word, lf_error *err);
 
 /* Parses argv[first..argc) against cmd's flags.  Positional arguments are
  * collected in order into positional[] (room for argc entries is enough);

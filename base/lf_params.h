@@ -64,6 +64,13 @@ typedef struct lf_paramset {
      * error is deferred, not lost: lf_params_finish reports it.  Read it
      * with lf_params_error. */
     lf_error error;
+    /* The names looked up but absent, each as one type byte (lf_param_type
+     * + 1, 0 when the lookup took any type) then the name and a NUL, so
+     * lf_params_finish can suggest the nearest for an unused one ("float
+     * fvo": did you mean "float fov"?).  Only a hint: if memory runs out a
+     * name is not recorded. */
+    char *absent;
+    size_t absent_len, absent_cap;
 } lf_paramset;
 
 /* The error parked by the lookups so far (code LF_OK when none), for a
@@ -120,7 +127,9 @@ typedef enum lf_spectrum_kind {
 int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_vec3 def, lf_vec3 *out);
 
 /* Reports the parked lookup error, else the first unused parameter:
- * "file:line:col: unused parameter "float fvo" in Camera "perspective"".
+ * "file:line:col: unused parameter "float fvo" in Camera "perspective" (did
+ * you mean "float fov"?)", the suggestion among the names the directive
+ * looked up and did not find (base/lf_suggest.h).
  * `context` names the directive, e.g. "Camera \"perspective\"". */
 int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err);
 

@@ -1,4 +1,5 @@
 #include "lf_params.h"
+#include "lf_suggest.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -162,6 +163,7 @@ void lf_params_free(lf_paramset *ps)
     for (size_t i = 0; i < ps->count; i++)
         param_free(&ps->items[i]);
     free(ps->items);
+    free(ps->absent);
     memset(ps, 0, sizeof *ps);
 }
 
@@ -173,13 +175,36 @@ const lf_param *lf_params_peek(const lf_paramset *ps, const char *name)
     return NULL;
 }
 
-lf_param *lf_params_find(lf_paramset *ps, const char *name)
+/* Remembers a name looked up and not found (lf_paramset.absent). */
+static void note_absent(lf_paramset *ps, const char *name, int type)
+{
+    for (size_t i = 0; i < ps->absent_len; i += strlen(ps->absent + i + 1) + 2)
+        if (!strcmp(ps->absent + i + 1, name))
+            return;
+    size_t n = strlen(name) + 2;
+    if (ps->absent_len + n > ps->absent_cap) {
+        size_t cap = 2 * (ps->absent_len + n) + 64;
+        char *a = realloc(ps->absent, cap);
+        if (!a)
+            return;
+        ps->absent = a, ps->absent_cap = cap;
+    }
+    ps->absent[ps->absent_len] = (char)(type + 1);
+    memcpy(ps->absent + ps->absent_len + 1, name, n - 1);
+    ps->absent_len += n;
+}
+
+static lf_param *find_marked(lf_paramset *ps, const char *name, int type)
 {
     lf_param *p = (lf_param *)lf_params_peek(ps, name);
     if (p)
         p->used = 1;
+    else
+        note_absent(ps, name, type);
     return p;
 }
+
+lf_param *lf_params_find(lf_paramset *ps, const char *name) { return find_marked(ps, name, -1); }
 
 static void type_error(lf_paramset *ps, const lf_param *p, const char *expected)
 {
@@ -197,7 +222,7 @@ static void count_error(lf_paramset *ps, const lf_param *p, size_t expected, siz
  * absent or wrong (the error is recorded in ps). */
 static lf_param *lookup(lf_paramset *ps, const char *name, lf_param_type type, size_t count)
 {
-    lf_param *p = lf_params_find(ps, name);
+    lf_param *p = find_marked(ps, name, (int)type);
     if (!p)
         return NULL;
     if (p->type != type) {
@@ -386,9 +411,17 @@ int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err)
         return lf_error_set(err, parked->code, "%s", parked->msg);
     for (size_t i = 0; i < ps->count; i++) {
         const lf_param *p = &ps->items[i];
-        if (!p->used)
-            return lf_error_at(err, LF_ERR_PARAM, &p->loc, "unused parameter \"%s %s\" in %s",
-                               lf_param_type_name(p->type), p->name, context ? context : "directive");
+        if (p->used)
+            continue;
+        lf_suggest s = lf_suggest_begin(p->name);
+        for (size_t k = 0; k < ps->absent_len; k += strlen(ps->absent + k + 1) + 2)
+            lf_suggest_consider(&s, ps->absent + k + 1);
+        const char *best = lf_suggest_best(&s);
+        int type = best && best[-1] ? best[-1] - 1 : (int)p->type; /* the type byte before the name; 0: as written */
+        return lf_error_at(err, LF_ERR_PARAM, &p->loc, "unused parameter \"%s %s\" in %s%s%s%s%s%s",
+                           lf_param_type_name(p->type), p->name, context ? context : "directive",
+                           best ? " (did you mean \"" : "", best ? lf_param_type_name((lf_param_type)type) : "",
+                           best ? " " : "", best ? best : "", best ? "\"?)" : "");
     }
     return LF_OK;
 }

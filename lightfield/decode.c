@@ -1,5 +1,6 @@
 /* Decoding raw images into L(u, v, s, t): camera-array tiles and plenoptic
  * microlens images (square or hex grids, any pitch and rotation). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -366,6 +367,11 @@ int lf_lightfield_depth_to_disparity(const lf_lightfield *lf, double z, double *
                             "fov_deg (--griddim, --inputfov), or plenoptic main-lens metadata; use --disparity");
     if (!(z > 0) || !isfinite(z))
         return lf_error_set(err, LF_ERR_PARAM, "depth must be > 0 (got %g)", z);
-    *disp = lf->disp_at_inf + lf->disp_per_inv_m / z;
+    double near = lf->disp_per_inv_m / z;
+    *disp = lf->disp_at_inf + near;
+    /* The two terms cancel at the depth the capture focused on: what is left
+     * there is rounding (a few ulps of the terms), and that depth is disparity 0. */
+    if (fabs(*disp) <= 8 * DBL_EPSILON * fmax(fabs(lf->disp_at_inf), fabs(near)))
+        *disp = 0;
     return LF_OK;
 }

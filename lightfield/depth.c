@@ -13,6 +13,7 @@
  * pixel), then a Gauss-Newton refinement (views outer, rows in parallel). */
 #include <float.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -95,6 +96,25 @@ typedef struct dview {
     int group;     /* 2k: on the ray at k*45 degrees; 2k+1: strictly inside octant k */
 } dview;
 
+/* Progress through the two long stages, the cost volume (a row: nlabels
+ * units) and its aggregation (a slice: nt units), taken as equally long.
+ * Only the calling thread (tid 0 of lf_parallel_for) calls the options'
+ * callback, so it needs no lock. */
+typedef struct depth_progress {
+    const lf_lightfield_depth_opts *o;
+    atomic_long done;
+    long total;
+} depth_progress;
+
+static void progress_add(depth_progress *p, long units, int tid)
+{
+    if (!p || !p->o->progress)
+        return;
+    long done = atomic_fetch_add(&p->done, units) + units;
+    if (tid == 0 && done < p->total) /* depth_core reports the end */
+        p->o->progress(p->o->progress_ctx, done, p->total);
+}
+
 typedef struct cost_ctx {
     const lf_lightfield *lf;
     const dview *views;
@@ -112,6 +132,7 @@ typedef struct cost_ctx {
     float *rawd;         /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     float *scratch;      /* per thread: (NGROUPS * NFIELDS + 13) * ns + 12 floats */
     size_t scratch_per_thread;
+    depth_progress *progress; /* or NULL */
 } cost_ctx;
 
 /* Group of offset (du, dv): rays at multiples of 45 degrees and the open
@@ -390,6 +411,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                 }
                 c->rawd[(size_t)y * ns + x] = (float)(c->d0 + c->step * (rt[ns + x] + off));
             }
+        progress_add(c->progress, c->nlabels, tid);
     }
 }
 
@@ -463,6 +485,7 @@ typedef struct gf_ctx {
     float *cost;       /* slices filtered in place */
     float *scratch;    /* per thread: 10 * w * h */
     size_t per_thread;
+    depth_progress *progress; /* or NULL */
 } gf_ctx;
 
 LF_HOT_LOOP static void mul_arr(const float *restrict x, const float *restrict y, float *restrict o, size_t n)
@@ -515,6 +538,7 @@ static void gf_slices(void *vctx, int l0, int l1, int tid)
         box_mean(m2, o2, tmp, g->w, g->h, g->r);
         box_mean(b, mp, tmp, g->w, g->h, g->r);
         gf_out(o0, o1, o2, mp, g->I, p, np);
+        progress_add(g->progress, g->h, tid);
     }
 }
 
@@ -923,6 +947,7 @@ typedef struct depth_work {
     float *refs;        /* square-root encoded reference in the working scale (median, refinement) */
     float *rawd;        /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     cost_ctx cc;
+    depth_progress progress;
 } depth_work;
 
 static void depth_work_free(depth_work *w)
@@ -1023,6 +1048,7 @@ static int build_cost_volume(depth_work *w, lf_error *err)
         .rawd = w->rawd,
         .scratch = w->scratch,
         .scratch_per_thread = w->per_thread,
+        .progress = &w->progress,
     };
     const lf_lightfield *lf = w->lf;
     if (lf->valid)
@@ -1087,7 +1113,7 @@ static void aggregate_cost_volume(depth_work *w)
     guide_inverse_covariance(I, mI, Sinv, tmp, t2, ns, nt, r, eps);
     gf_ctx gc = {
         .w = ns, .h = nt, .r = r, .I = I, .mI = mI, .Sinv = Sinv,
-        .cost = w->cost, .scratch = w->scratch, .per_thread = w->per_thread,
+        .cost = w->cost, .scratch = w->scratch, .per_thread = w->per_thread, .progress = &w->progress,
     };
     lf_parallel_for(w->nlabels, w->threads, 1, gf_slices, &gc);
 }
@@ -1224,6 +1250,8 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     int rc = depth_work_alloc(&w, lf, o, nl, d0, step, err);
     if (rc)
         goto done;
+    w.progress.o = o, w.progress.total = 2L * w.nt * nl;
+    atomic_init(&w.progress.done, 0);
     collect_views(&w);
     w.scale = reference_colour_scale(w.ref, w.np);
     if ((rc = build_cost_volume(&w, err)))
@@ -1249,6 +1277,8 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
         }
         memcpy(confidence->data, w.conf, sizeof(float) * w.np);
     }
+    if (o->progress)
+        o->progress(o->progress_ctx, w.progress.total, w.progress.total);
 done:
     depth_work_free(&w);
     return rc;

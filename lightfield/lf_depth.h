@@ -53,6 +53,11 @@ typedef struct lf_lightfield_depth_opts {
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
     int threads;         /* <= 0: 2 */
+    /* Called now and then from the calling thread with the work done of
+     * `total` (done == total once, at the end); NULL: none.  The library
+     * never prints: a tool draws the bar (base/lf_progress.h). */
+    void (*progress)(void *ctx, long done, long total);
+    void *progress_ctx;
 } lf_lightfield_depth_opts;
 lf_lightfield_depth_opts lf_lightfield_depth_defaults(void);
 

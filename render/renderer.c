@@ -19,6 +19,7 @@
 #include "base/lf_buf.h"
 #include "base/lf_keys.h"
 #include "base/lf_parallel.h"
+#include "base/lf_suggest.h"
 #include "base/lf_progress.h"
 #include "base/lf_color.h"
 #include "render/film.h"
@@ -568,10 +569,15 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     r->camera_type = lf_camera_find(type);
     if (!r->camera_type) {
         char names[512] = "";
+        lf_suggest s = lf_suggest_begin(type);
         for (int i = 0; i < lf_camera_count(); i++) {
             strncat(names, i ? ", " : "", sizeof names - strlen(names) - 1);
             strncat(names, lf_camera_at(i)->name, sizeof names - strlen(names) - 1);
+            lf_suggest_consider(&s, lf_camera_at(i)->name);
         }
+        if (lf_suggest_best(&s))
+            return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown camera \"%s\" (did you mean \"%s\"?)", where,
+                                type, lf_suggest_best(&s));
         return lf_error_set(err, LF_ERR_UNSUPPORTED, "%s: unknown camera \"%s\" (registered: %s)", where, type, names);
     }
     int rc = read_shutter(r, &oe, err);

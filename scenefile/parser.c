@@ -25,6 +25,7 @@
 #include "lf_scene_desc.h"
 #include "base/lf_color.h"
 #include "base/lf_file.h"
+#include "base/lf_suggest.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -1598,6 +1599,10 @@ static int check_supported(parser *P, const token *dir, const char *type, const 
                        : known == pbrt_textures  ? "texture"
                                                  : "material";
     int is_known = in_list(known, type);
+    const char *guess = is_known ? NULL : lf_suggest_among(type, known);
+    if (guess) /* a misspelt type: unknown, whatever --allow-unsupported says */
+        return perr(P, LF_ERR_PARSE, &dir->loc, "%.*s: unknown %s \"%s\" (did you mean \"%s\"?)", (int)dir->n,
+                    dir->s, what, type, guess);
     if (P->allow_unsupported) {
         if (is_known)
             pwarn(P, &dir->loc, "%.*s \"%s\" is not supported; %s (--allow-unsupported)", (int)dir->n, dir->s,
@@ -2079,6 +2084,26 @@ static directive_fn find_directive(const token *t)
     return NULL;
 }
 
+/* Reports an unknown directive with the nearest known one.  Returns 1 when
+ * that is a block keyword (WorldBegin, AttributeBegin/End, ObjectBegin/End,
+ * TransformBegin/End): the parse stops there, since every later line would
+ * be judged inside the wrong block (a misspelt WorldBegin would otherwise
+ * make each following world directive an error of its own). */
+static int unknown_directive(parser *P, const token *t)
+{
+    char b[200], word[64];
+    snprintf(word, sizeof word, "%.*s", (int)(t->n < 63 ? t->n : 63), t->s);
+    lf_suggest s = lf_suggest_begin(word);
+    for (size_t i = 0; i < sizeof directives / sizeof directives[0]; i++)
+        lf_suggest_consider(&s, directives[i].name);
+    const char *best = lf_suggest_best(&s);
+    int block = best && (strstr(best, "Begin") || strstr(best, "End"));
+    perr(P, LF_ERR_PARSE, &t->loc, "unknown directive %s%s%s%s%s", describe(t, b, sizeof b),
+         best ? " (did you mean " : "", best ? best : "", best ? "?)" : "",
+         block ? "; stopped reading: what follows depends on that block" : "");
+    return block;
+}
+
 /* A bare word that is not a value: a directive, or a misspelt one (which
  * then gets its own "unknown directive" error). */
 static int is_directive_like(const token *t)
@@ -2140,8 +2165,8 @@ static int parse_run(parser *P, lexer *L, lf_loc *eof)
         if (!fn) {
             if (t.kind != TK_WORD)
                 perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
-            else
-                perr(P, LF_ERR_PARSE, &t.loc, "unknown directive %s", describe(&t, b, sizeof b));
+            else if (unknown_directive(P, &t)) /* a misspelt block keyword: stop here */
+                return P->first_code;
             recover(P, L);
             continue;
         }

@@ -5,6 +5,7 @@
 
 #include "base/lf_args.h"
 #include "base/lf_buf.h"
+#include "base/lf_suggest.h"
 #include "lf_test.h"
 
 static struct {
@@ -119,7 +120,29 @@ int main(void)
     CHECK(parse("refocus", ARGS("in", "-o", "x", "--lensradius", "0.01")) == LF_ARGS_ERROR);
     CHECK_MSG(strstr(err, "unknown flag --lensradius") != NULL, "%s", err);
 
-    /* help and version win wherever they stand */
+    /* did you mean: the nearest flag of the command (base/lf_suggest.h) */
+    CHECK(parse("refocus", ARGS("in", "-o", "x", "--dpth", "1")) == LF_ARGS_ERROR);
+    CHECK_MSG(strstr(err, "unknown flag --dpth (did you mean --depth?)") != NULL, "%s", err);
+    CHECK(parse("refocus", ARGS("in", "-o", "x", "--stpes=3")) == LF_ARGS_ERROR); /* swapped neighbours */
+    CHECK_MSG(strstr(err, "unknown flag --stpes (did you mean --steps?)") != NULL, "%s", err);
+    CHECK(parse("refocus", ARGS("-o", "x")) == LF_ARGS_ERROR);
+    CHECK_MSG(strstr(err, "missing argument (usage: lftool refocus IN -o OUT [options])") != NULL, "%s", err);
+    /* the distance: optimal string alignment, case-insensitive (textbook values) */
+    CHECK(lf_suggest_distance("kitten", "sitting") == 3);
+    CHECK(lf_suggest_distance("ca", "abc") == 3); /* OSA, not unrestricted Damerau (2) */
+    CHECK(lf_suggest_distance("fvo", "fov") == 1 && lf_suggest_distance("WORLDbegin", "WorldBegin") == 0);
+    CHECK(lf_suggest_distance("", "abc") == 3);
+    /* the limit: one edit per three characters typed, at least one */
+    const char *const names[] = {"fov", "lensradius", "focaldistance", "screenwindow", NULL};
+    CHECK(lf_suggest_among("fvo", names) && !strcmp(lf_suggest_among("fvo", names), "fov"));
+    CHECK(lf_suggest_among("lnsradus", names) && !strcmp(lf_suggest_among("lnsradus", names), "lensradius"));
+    CHECK(lf_suggest_among("xyz", names) == NULL);      /* 3 edits from fov: limit 1 */
+    CHECK(lf_suggest_among("fo", names) != NULL);        /* 1 edit, limit 1 */
+    CHECK(lf_suggest_among("fov", names) == NULL);       /* the word itself is not a suggestion */
+    CHECK(lf_suggest_among("focal", names) == NULL);     /* 8 edits from focaldistance */
+
+    /* help, version and man win wherever they stand */
+    CHECK(parse("refocus", ARGS("in", "--man")) == LF_ARGS_MAN);
     CHECK(parse("refocus", ARGS("--help")) == LF_ARGS_HELP);
     CHECK(parse("refocus", ARGS("in", "-h")) == LF_ARGS_HELP);
     CHECK(parse("synth", ARGS("--version")) == LF_ARGS_VERSION);
@@ -129,10 +152,11 @@ int main(void)
     CHECK(u && strstr(u, "usage: lftool refocus IN -o OUT [options]"));
     CHECK(u && strstr(u, "-o, --output OUT") && strstr(u, "--views N N N N"));
     CHECK(u && strstr(u, "an integer from 1 to 4096"));
-    CHECK(u && strstr(u, "--help") && !strstr(u, "--camerapos"));
+    CHECK(u && strstr(u, "--help") && strstr(u, "--man") && !strstr(u, "--camerapos"));
     free(u);
     u = lf_args_usage(&tool, NULL);
-    CHECK(u && strstr(u, "refocus") && strstr(u, "synth") && strstr(u, "lftool COMMAND --help"));
+    CHECK(u && strstr(u, "refocus") && strstr(u, "synth") && strstr(u, "lftool COMMAND --help") &&
+          strstr(u, "lftool --man"));
     free(u);
     char *m = lf_args_man(&tool, "2026-01-01");
     CHECK(m && !strncmp(m, ".TH lftool 1 \"2026-01-01\" \"lensfield 9.8\"", 41));

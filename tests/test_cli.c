@@ -28,6 +28,22 @@ static void write_file(const char *path, const char *text)
     fclose(f);
 }
 
+static int count_lines(const char *s)
+{
+    int n = 0;
+    for (; *s; s++)
+        n += *s == '\n';
+    return n;
+}
+
+/* A usage error is the message and one line saying where help is (issue 33):
+ * exit 2, two lines, the second naming --help. */
+static int usage_error_shape(void)
+{
+    const char *nl = strchr(out_text, '\n');
+    return count_lines(out_text) == 2 && nl && strstr(nl, "--help` for usage.") != NULL;
+}
+
 static const char *scene_ok =
     "LookAt 0 0 -3 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" [40]\n"
     "Film \"rgb\" \"integer xresolution\" [32] \"integer yresolution\" [24] \"bool savefp16\" false\n"
@@ -53,6 +69,21 @@ int main(void)
     CHECK(run("%s %s --spp abc", LF_LFRENDER, scene) == 2);
     CHECK(strstr(out_text, "--spp") != NULL);
     CHECK(run("%s %s --bogus", LF_LFRENDER, scene) == 2);
+    CHECK_MSG(usage_error_shape(), "message: %s", out_text);
+    CHECK(run("%s %s --spp 0", LF_LFRENDER, scene) == 2);
+    CHECK_MSG(usage_error_shape() && strstr(out_text, "--spp"), "message: %s", out_text);
+    CHECK(run("%s merge a.exr", LF_LFRENDER) == 2); /* -o missing: the subcommand's help is named */
+    CHECK_MSG(usage_error_shape() && strstr(out_text, "lfrender merge --help"), "message: %s", out_text);
+    CHECK(run("%s %s --sped 4", LF_LFRENDER, scene) == 2); /* one edit from --seed */
+    CHECK_MSG(usage_error_shape() && strstr(out_text, "did you mean --seed?"), "message: %s", out_text);
+    CHECK(run("%s %s --zzzzzz 4", LF_LFRENDER, scene) == 2); /* nothing near: no guess */
+    CHECK_MSG(!strstr(out_text, "did you mean"), "message: %s", out_text);
+    /* --man: raw roff when stdout is not a terminal; every help names it */
+    CHECK(run("%s --man", LF_LFRENDER) == 0 && strncmp(out_text, ".TH lfrender 1", 14) == 0);
+    CHECK(run("%s merge --man", LF_LFRENDER) == 0 && strncmp(out_text, ".TH lfrender 1", 14) == 0);
+    CHECK(run("%s merge --help", LF_LFRENDER) == 0 && strstr(out_text, "--man"));
+    /* --threads 0 means all cores, as in lftool and lfgrade */
+    CHECK(run("%s %s --threads 0 --explain", LF_LFRENDER, scene) == 0);
 
     /* a good render: EXR with metadata, PNG */
     CHECK(run("%s %s -o %s --seed 7 --threads 2 --quiet", LF_LFRENDER, scene, out) == 0);
@@ -113,6 +144,21 @@ int main(void)
     write_file(bad, "WorldBegin\nShape \"sphere\" \"float radius\" [1] \"float radus\" [2]\n");
     CHECK(run("%s %s -o %s/never.exr", LF_LFRENDER, bad, dir) == 1);
     CHECK_MSG(strstr(out_text, "bad.pbrt:2:") && strstr(out_text, "radus"), "message: %s", out_text);
+    /* did you mean: a parameter among those the type looked up */
+    write_file(bad, "WorldBegin\nShape \"sphere\" \"float radus\" [2]\n");
+    CHECK(run("%s %s -o %s/never.exr", LF_LFRENDER, bad, dir) == 1);
+    CHECK_MSG(strstr(out_text, "(did you mean \"float radius\"?)"), "message: %s", out_text);
+    /* a misspelt type is unknown, with the nearest, even with --allow-unsupported */
+    write_file(bad, "WorldBegin\nMaterial \"difuse\"\nShape \"sphere\"\n");
+    CHECK(run("%s %s -o %s/never.exr --allow-unsupported", LF_LFRENDER, bad, dir) == 1);
+    CHECK_MSG(strstr(out_text, "bad.pbrt:2:1: Material: unknown material \"difuse\" (did you mean \"diffuse\"?)") &&
+                  !strstr(out_text, "allow-unsupported"), "message: %s", out_text);
+    /* a misspelt WorldBegin: one error, no cascade (scenefile/parser.c's rule) */
+    write_file(bad, "Camera \"perspective\"\nWorldBgin\nLightSource \"point\"\nMaterial \"diffuse\"\n"
+                    "Shape \"sphere\"\nAttributeBegin\nShape \"sphere\"\nAttributeEnd\n");
+    CHECK(run("%s %s -o %s/never.exr", LF_LFRENDER, bad, dir) == 1);
+    CHECK_MSG(count_lines(out_text) == 1 && strstr(out_text, "bad.pbrt:2:1: unknown directive \"WorldBgin\" (did you "
+                                                              "mean WorldBegin?)"), "message: %s", out_text);
     char never[512];
     snprintf(never, sizeof never, "%s/never.exr", dir);
     CHECK(!exists(never));

@@ -47,7 +47,7 @@ int main(void)
     CHECK(run("%s %s/badrubric %s", LFGRADE, dir, dir) == 1);
     CHECK(strstr(out_text, "rubric.txt:1: unknown check kind") != NULL);
 
-    /* batch: an empty folder, a missing folder and a half-done submission;
+    /* batch: an empty folder and a half-done submission;
      * grading runs (exit 0) and reports each */
     snprintf(cmd, sizeof cmd,
              "mkdir -p %s/subs/empty %s/subs/half && printf '## Answers\\nx\\n## Commands\\nlfrender\\n' > "
@@ -55,12 +55,15 @@ int main(void)
              "%s/subs/half/flatfield.png --quiet --seed 5",
              dir, dir, dir, LF_BINARY_DIR "/bin/lfrender", dir);
     CHECK(system(cmd) == 0);
-    CHECK(run("%s 1-thinlens %s/subs/empty %s/subs/missing %s/subs/half --report %s/rep --cache %s/cache --json "
-              "--threads 2",
-              LFGRADE, dir, dir, dir, dir, dir) == 0);
-    CHECK(strstr(out_text, "[1/3] empty: 0/25") != NULL);
-    CHECK(strstr(out_text, "[2/3] missing: 0/25") != NULL);
-    CHECK(strstr(out_text, "[3/3] half: 12/25") != NULL);
+    /* a submission path that does not exist is a mistyped command line: exit 2, one line naming it, nothing
+     * graded (issue 33: it was a silent 0/25) */
+    CHECK(run("%s 1-thinlens %s/subs/empty %s/subs/missing --cache %s/cache", LFGRADE, dir, dir, dir) == 2);
+    CHECK_MSG(strstr(out_text, "lfgrade: no such submission: ") && strstr(out_text, "/subs/missing\n") &&
+                  !strstr(out_text, "0/25"), "%s", out_text);
+    CHECK(run("%s 1-thinlens %s/subs/empty %s/subs/half --report %s/rep --cache %s/cache --json --threads 2", LFGRADE,
+              dir, dir, dir, dir) == 0);
+    CHECK(strstr(out_text, "[1/2] empty: 0/25") != NULL);
+    CHECK(strstr(out_text, "[2/2] half: 12/25") != NULL);
     CHECK(strstr(out_text, "\"student\": \"half\"") != NULL);
     CHECK(strstr(out_text, "missing: neither bokeh.png nor bokeh.exr") != NULL);
     CHECK(exists("%s/rep/gradebook.csv", dir));

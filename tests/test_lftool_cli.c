@@ -78,6 +78,16 @@ int main(void)
     CHECK(run("%s refocus %s -o %s/r.exr", LFTOOL, raw_path, dir) == 2); /* no focus given */
     CHECK(run("%s refocus %s --alpha 1 --disparity 1 -o %s/r.exr", LFTOOL, raw_path, dir) == 2);
     CHECK(run("%s refocus %s --disparity abc -o %s/r.exr", LFTOOL, raw_path, dir) == 2);
+    /* a usage error is two lines: the message and where help is; a typo gets the nearest name */
+    CHECK(run("%s refocus %s --dpth 1 -o %s/r.exr", LFTOOL, raw_path, dir) == 2);
+    CHECK_MSG(!strcmp(out_text, "lftool refocus: unknown flag --dpth (did you mean --depth?)\n"
+                                "Run `lftool refocus --help` for usage.\n"), "%s", out_text);
+    CHECK(run("%s refocus %s -o %s/r.exr", LFTOOL, raw_path, dir) == 2);
+    CHECK_MSG(strstr(out_text, "Run `lftool refocus --help` for usage.\n") && !strstr(out_text, "options:"), "%s",
+              out_text);
+    CHECK(run("%s refocsu %s", LFTOOL, raw_path) == 2);
+    CHECK_MSG(!strcmp(out_text, "lftool: unknown command \"refocsu\" (did you mean refocus?)\n"
+                                "Run `lftool --help` for usage.\n"), "%s", out_text);
 
     /* info */
     CHECK(run("%s info %s", LFTOOL, raw_path) == 0);
@@ -137,6 +147,8 @@ int main(void)
     CHECK(run("%s allfocus %s --from 0 --to 1 --steps 3 -o %s/af.exr", LFTOOL, raw_path, dir) == 0);
     CHECK(run("%s depth %s --from 0 --to 1 --steps 3 -o %s/dm.exr", LFTOOL, raw_path, dir) == 0);
     CHECK(run("%s view %s --u 0.5 --v -0.5 -o %s/view.exr", LFTOOL, raw_path, dir) == 0);
+    CHECK_MSG(strstr(out_text, "view at u 0.5, v -0.5 (depth) -> ") && strstr(out_text, "/view.exr\n"), "%s",
+              out_text); /* says what it wrote, as the other commands do */
     /* depth with no range (estimated), confidence beside it */
     CHECK(run("%s depth %s -o %s/dm2.exr --confidence %s/conf.exr", LFTOOL, raw_path, dir, dir) == 0);
     CHECK(strstr(out_text, "estimated") != NULL);

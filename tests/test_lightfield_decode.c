@@ -227,7 +227,9 @@ static void test_white_and_nonfinite(void)
     /* depth: the plane conjugate to the microlens array (1/z + 1/F = 1/f) has d = 0 */
     double zf = 1.0 / (1.0 / 0.050 - 1.0 / 0.052);
     CHECK(lf_lightfield_depth_to_disparity(&lf, zf, &d, &err) == 0);
-    CHECK_NEAR(d, 0, 1e-9);
+    CHECK_MSG(d == 0, "disparity %g at the focused depth: exactly 0, not rounding", d); /* issue 33 */
+    CHECK(lf_lightfield_depth_to_disparity(&lf, zf * (1 + 1e-9), &d, &err) == 0);
+    CHECK(d < 0 && d > -1e-6); /* a plane just beyond it is not snapped */
     CHECK(lf_lightfield_depth_to_disparity(&lf, zf / 2, &d, &err) == 0);
     CHECK(d > 0); /* nearer than focus: positive disparity */
     /* alpha for a depth: 1/z + 1/(alpha F) = 1/f, same disparity both ways */

@@ -743,8 +743,47 @@ static void test_data_scene(void)
     lf_scene_desc_free(&d);
 }
 
+/* Did you mean (issue 33): directives and types get the nearest known name;
+ * a misspelt block keyword ends the parse with that one error. */
+static void test_suggestions(void)
+{
+    parse_fails("WorldBegin\nShpae \"sphere\"\n", LF_ERR_PARSE,
+                "test.pbrt:2:1: unknown directive \"Shpae\" (did you mean Shape?)");
+    parse_fails("WorldBegin\nShape \"spere\"\n", LF_ERR_PARSE,
+                "test.pbrt:2:1: Shape: unknown shape \"spere\" (did you mean \"sphere\"?)");
+    parse_fails("WorldBegin\nLightSource \"spot_\"\n", LF_ERR_PARSE, "(did you mean \"spot\"?)");
+    parse_fails("WorldBegin\nTexture \"t\" \"float\" \"imagemp\"\n", LF_ERR_PARSE,
+                "(did you mean \"imagemap\"?)");
+    const char *cascade[] = {"WorldBgin", "AttributeBgin", "AtributeEnd", "ObjectBegn"};
+    for (int i = 0; i < 4; i++) {
+        char text[512], *errors = NULL;
+        /* with WorldBegin itself misspelt every world directive after it would be an error */
+        snprintf(text, sizeof text,
+                 "Camera \"perspective\"\n%s%s\nLightSource \"point\"\nShape \"sphere\"\n"
+                 "Material \"diffuse\"\nAttributeEnd\nObjectEnd\nShape \"sphere\"\n", i ? "WorldBegin\n" : "",
+                 cascade[i]);
+        lf_scene_desc d;
+        lf_error err = {0};
+        int rc = lf_scene_parse_string_ex(text, "t.pbrt", NULL, &d, &err, &errors);
+        int lines = 0;
+        for (const char *c = errors; c && *c; c++)
+            lines += *c == '\n';
+        CHECK_MSG(rc == LF_ERR_PARSE && lines == 1 && strstr(errors, "stopped reading"), "%s: %s", cascade[i],
+                  errors ? errors : err.msg);
+        free(errors);
+    }
+    /* a misspelt word near no block keyword does not stop the parse */
+    char *errors = NULL;
+    lf_scene_desc d;
+    lf_error err = {0};
+    CHECK(lf_scene_parse_string_ex("WorldBegin\nShpae \"sphere\"\nFoo\n", "t.pbrt", NULL, &d, &err, &errors));
+    CHECK_MSG(errors && strstr(errors, "t.pbrt:3:1: unknown directive \"Foo\"\n"), "%s", errors ? errors : "");
+    free(errors);
+}
+
 int main(void)
 {
+    test_suggestions();
     test_transforms();
     test_camera_coordsys();
     test_attributes();

@@ -7,6 +7,10 @@ bash tools/install-deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 mkdir -p out
-build/bin/lfrender scenes/demo.pbrt -o out/demo.exr "$@"
-build/bin/lfrender scenes/demo.pbrt -o out/demo.png --quiet "$@"
+# Rendered once, as a mergeable part (exact sums); `lfrender merge` writes
+# both formats from it, bit for bit what a render to each would give.
+build/bin/lfrender scenes/demo.pbrt --part -o out/demo.part.exr "$@"
+build/bin/lfrender merge out/demo.part.exr -o out/demo.exr
+build/bin/lfrender merge out/demo.part.exr -o out/demo.png
+rm -f out/demo.part.exr
 echo "demo: wrote out/demo.exr and out/demo.png"

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "grade/lf_grade.h"
@@ -31,17 +32,18 @@ static int run_grade(void *ctx, int n, char **pos)
     o.threads = f->threads;
     char adir[PATH_MAX];
     lf_error err = {0};
-    if (lf_grade_find_assignment(assignment, adir, sizeof adir, &err)) {
-        fprintf(stderr, "lfgrade: %s\n", err.msg);
-        return LF_EXIT_USAGE;
-    }
+    if (lf_grade_find_assignment(assignment, adir, sizeof adir, &err))
+        return lf_cli_usage_error("lfgrade", NULL, "%s", err.msg);
+    for (int i = 0; i < nsubs; i++) /* a mistyped path is a usage error, not a score of 0 */
+        if (access(subs[i], F_OK))
+            return lf_cli_usage_error("lfgrade", NULL, "no such submission: %s", subs[i]);
     o.report_dir = f->report;
     lf_grade_ctx *g;
     if (lf_grade_ctx_new(adir, &o, &g, &err)) {
         fprintf(stderr, "lfgrade: %s\n", err.msg);
         return LF_EXIT_FAIL;
     }
-    lf_grade_result *res = calloc((size_t)nsubs, sizeof *res);
+    lf_grade_result *res = calloc((size_t)n, sizeof *res); /* n - 1 submissions */
     int rc = res ? LF_EXIT_OK : LF_EXIT_FAIL, graded = 0;
     for (int i = 0; i < nsubs && res; i++) {
         lf_error e = {0};

@@ -35,14 +35,11 @@ static int analyse(const flags *f, const char *path, lf_lens *L, lf_lens_report 
 {
     lf_error err = {0};
     double w, h;
-    if (f->sensor && f->diagonal_mm > 0) {
-        fprintf(stderr, "lflens: give --sensor or --diagonal, not both\n");
-        return LF_EXIT_USAGE;
-    }
-    if (f->sensor && lf_lens_sensor_size(f->sensor, &w, &h)) {
-        fprintf(stderr, "lflens: unknown sensor \"%s\" (known: %s)\n", f->sensor, lf_lens_sensor_names());
-        return LF_EXIT_USAGE;
-    }
+    if (f->sensor && f->diagonal_mm > 0)
+        return lf_cli_usage_error("lflens", NULL, "give --sensor or --diagonal, not both");
+    if (f->sensor && lf_lens_sensor_size(f->sensor, &w, &h))
+        return lf_cli_usage_error("lflens", NULL, "unknown sensor \"%s\" (known: %s)", f->sensor,
+                                  lf_lens_sensor_names());
     if (!f->sensor && f->diagonal_mm > 0)
         w = f->diagonal_mm * 3.0 / sqrt(13.0), h = f->diagonal_mm * 2.0 / sqrt(13.0);
     else if (!f->sensor)
@@ -165,10 +162,8 @@ static int run_plot(void *ctx, int n, char **pos)
     (void)n;
     const flags *f = ctx;
     const char *dot = strrchr(f->out, '.');
-    if (!dot || (strcmp(dot, ".svg") && strcmp(dot, ".png"))) {
-        fprintf(stderr, "lflens plot: -o wants OUT.svg or OUT.png, got \"%s\"\n", f->out);
-        return LF_EXIT_USAGE;
-    }
+    if (!dot || (strcmp(dot, ".svg") && strcmp(dot, ".png")))
+        return lf_cli_usage_error("lflens", "plot", "-o wants OUT.svg or OUT.png, got \"%s\"", f->out);
     lf_lens L;
     lf_lens_report r;
     int rc = analyse(f, pos[0], &L, &r);

@@ -35,15 +35,6 @@ typedef struct flags {
     double checkpoint_every, exposure;
 } flags;
 
-static void on_progress(void *ctx, long done, long total)
-{
-    char line[160];
-    if (lf_progress_line(ctx, done, total, line, sizeof line)) {
-        fputs(line, stderr);
-        fflush(stderr);
-    }
-}
-
 static int run_merge(void *ctx, int n, char **parts)
 {
     const flags *f = ctx;
@@ -72,26 +63,20 @@ static int render_opts_from_flags(const flags *f, lf_render_opts *o)
     o->white = f->white, o->part = f->part, o->resume = f->resume;
     o->checkpoint_every = f->checkpoint_every;
     if (f->have_crop) {
-        if (f->crop[1] <= f->crop[0] || f->crop[3] <= f->crop[2]) {
-            fprintf(stderr, "lfrender: --crop x0 x1 y0 y1 needs x0 < x1 and y0 < y1\n");
-            return LF_EXIT_USAGE;
-        }
+        if (f->crop[1] <= f->crop[0] || f->crop[3] <= f->crop[2])
+            return lf_cli_usage_error("lfrender", NULL, "--crop x0 x1 y0 y1 needs x0 < x1 and y0 < y1");
         memcpy(o->crop, f->crop, sizeof f->crop);
     }
     if (f->have_spp_range) {
-        if (f->spp_range[1] <= f->spp_range[0]) {
-            fprintf(stderr, "lfrender: --spp-range A B needs A < B\n");
-            return LF_EXIT_USAGE;
-        }
+        if (f->spp_range[1] <= f->spp_range[0])
+            return lf_cli_usage_error("lfrender", NULL, "--spp-range A B needs A < B");
         o->spp_begin = f->spp_range[0], o->spp_end = f->spp_range[1], o->part = 1;
     }
     if (f->tile) {
         int ti, tn;
         char extra;
-        if (sscanf(f->tile, "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn) {
-            fprintf(stderr, "lfrender: --tile wants I/N with 0 <= I < N, got \"%s\"\n", f->tile);
-            return LF_EXIT_USAGE;
-        }
+        if (sscanf(f->tile, "%d/%d%c", &ti, &tn, &extra) != 2 || tn < 1 || ti < 0 || ti >= tn)
+            return lf_cli_usage_error("lfrender", NULL, "--tile wants I/N with 0 <= I < N, got \"%s\"", f->tile);
         o->tile_index = ti, o->tile_count = tn, o->part = 1;
     }
     return LF_EXIT_OK;
@@ -137,15 +122,12 @@ static int check_output(const flags *f, lf_renderer *r, const lf_render_opts *o,
     }
     if (!*out)
         *out = lf_renderer_film_filename(r);
-    if (o->part && !lf_path_has_ext(*out, ".exr")) {
-        fprintf(stderr, "lfrender: parts (--spp-range, --tile, --part) must be written as .exr, not %s\n", *out);
-        return LF_EXIT_USAGE;
-    }
-    if (f->aov && (o->part || !lf_path_has_ext(*out, ".exr"))) {
-        fprintf(stderr, "lfrender: --aov disparity needs an .exr output and an unsplit render (no --part, --tile, "
-                        "--spp-range)\n");
-        return LF_EXIT_USAGE;
-    }
+    if (o->part && !lf_path_has_ext(*out, ".exr"))
+        return lf_cli_usage_error("lfrender", NULL, "parts (--spp-range, --tile, --part) must be written as .exr, "
+                                  "not %s", *out);
+    if (f->aov && (o->part || !lf_path_has_ext(*out, ".exr")))
+        return lf_cli_usage_error("lfrender", NULL, "--aov disparity needs an .exr output and an unsplit render (no "
+                                  "--part, --tile, --spp-range)");
     lf_error err = {0};
     if (lf_file_check_writable(*out, &err)) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
@@ -218,7 +200,7 @@ static int run_render(void *ctx, int n, char **pos)
         return rc;
     o.scene_path = scene;
     lf_progress pr;
-    o.progress = !f->quiet && isatty(2) ? on_progress : NULL;
+    o.progress = !f->quiet && isatty(2) ? lf_cli_progress : NULL;
     o.progress_ctx = &pr;
     lf_renderer *r;
     lf_error err = {0};
@@ -255,7 +237,7 @@ int main(int argc, char **argv)
         {"--spp", NULL, LF_ARG_INT, &f.spp, "N", "samples per pixel (default: the Sampler's \"pixelsamples\")",
          .min = 1, .max = 1 << 24, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
         {"--threads", NULL, LF_ARG_INT, &f.threads, "N",
-         "render threads (default: all cores); never changes the result", .min = 1, .max = 1024,
+         "render threads (default 0: all cores); never changes the result", .min = 0, .max = 1024,
          .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX},
         {"--seed", NULL, LF_ARG_LONG, &f.seed, "S", "sampler seed (default: the Sampler's \"seed\", 0)", .min = 0,
          .max = 4294967295.0, .flags = LF_ARG_HAS_MIN | LF_ARG_HAS_MAX, .given = &f.have_seed},

@@ -10,9 +10,11 @@
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "base/lf_file_write.h"
 #include "base/lf_keys.h"
+#include "base/lf_progress.h"
 #include "cli.h"
 #include "image/lf_image.h"
 #include "lightfield/lf_depth.h"
@@ -44,11 +46,7 @@ typedef struct opts {
     } fl;
 } opts;
 
-static int usage(const opts *o, const char *msg)
-{
-    fprintf(stderr, "lftool: %s\n(lftool %s --help for its flags)\n", msg, o->cmd ? o->cmd : "COMMAND");
-    return LF_EXIT_USAGE;
-}
+static int usage(const opts *o, const char *msg) { return lf_cli_usage_error("lftool", o->cmd, "%s", msg); }
 
 #define R_MIN(lo) .min = (lo), .flags = LF_ARG_HAS_MIN
 #define R_POS .min = 0, .flags = LF_ARG_MIN_OPEN
@@ -310,12 +308,10 @@ static int cmd_refocus(void *ctx, int n, char **pos)
     } else {
         rc = lf_lightfield_refocus(&s.lf, &ro, &out, &err);
     }
-    if (rc) {
-        rc = fail(&err, o->input);
-        goto done;
-    }
     lf_write_opts wo = lf_write_opts_picture(o->exposure, o->tonemap);
-    if (lf_lightfield_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
+    if (rc)
+        rc = fail(&err, o->input);
+    else if (lf_lightfield_write_refocused(o->output, &out, ro.disparity_px, &wo, &err))
         rc = fail(&err, NULL);
     else
         printf("%s: refocused at disparity %.6g px/view -> %s\n", o->input, ro.disparity_px, o->output);
@@ -373,14 +369,11 @@ static int allfocus_depth(const opts *o, int want_depth)
     double d0, d1;
     stack_range(o, &d0, &d1);
     lf_lightfield_refocus_opts ro = aperture_opts(o);
-    lf_image af, dm;
+    lf_image af = {0}, dm = {0};
     lf_error err = {0};
-    if (lf_lightfield_allfocus(&s.lf, &ro, d0, d1, o->steps, &af, &dm, &err)) {
-        lf_lightfield_close(&s);
-        return fail(&err, o->input);
-    }
-    rc = write_image(o, o->output, want_depth ? &dm : &af, NULL);
-    if (!rc)
+    if (lf_lightfield_allfocus(&s.lf, &ro, d0, d1, o->steps, &af, &dm, &err))
+        rc = fail(&err, o->input);
+    else if (!(rc = write_image(o, o->output, want_depth ? &dm : &af, NULL)))
         printf("%s: %s from %d slices (disparity %g .. %g) -> %s\n", o->input,
                want_depth ? "disparity map" : "all-in-focus", o->steps, d0, d1, o->output);
     lf_image_free(&af), lf_image_free(&dm);
@@ -407,7 +400,9 @@ static int cmd_depth(void *ctx, int n, char **pos)
     if (rc)
         return rc;
     lf_lightfield_depth_opts d = lf_lightfield_depth_defaults();
-    d.threads = o->threads;
+    lf_progress pr;
+    lf_progress_start(&pr);
+    d.threads = o->threads, d.progress = isatty(2) ? lf_cli_progress : NULL, d.progress_ctx = &pr;
     const char *src = "--from/--to";
     if (o->have_from)
         d.d0 = o->from, d.d1 = o->to;
@@ -499,6 +494,8 @@ static int cmd_view(void *ctx, int n, char **pos)
         rc = lf_lightfield_view_depth(&s.lf, o->u, o->v, &vo, &out, &err);
     }
     rc = rc ? fail(&err, o->input) : write_image(o, o->output, &out, NULL);
+    if (!rc)
+        printf("%s: view at u %g, v %g (%s) -> %s\n", o->input, o->u, o->v, plane ? "plane" : "depth", o->output);
 done:
     lf_image_free(&out), lf_image_free(&dm), lf_image_free(&cm);
     lf_lightfield_close(&s);

@@ -187,3 +187,23 @@ int lf_file_check_writable(const char *path, lf_error *err)
     remove(probe);
     return LF_OK;
 }
+
+int lf_output_is_input(const char *output, const char *const *inputs, int n, lf_error *err)
+{
+    if (!output)
+        return LF_OK;
+    struct stat so;
+    int out_exists = stat(output, &so) == 0;
+    for (int i = 0; i < n; i++) {
+        const char *in = inputs[i];
+        if (!in)
+            continue;
+        struct stat si;
+        int same = strcmp(in, output) == 0 ||
+                   (out_exists && stat(in, &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino);
+        if (same)
+            return lf_error_set(err, LF_ERR_PARAM, "the output '%s' is the input '%s': writing it would destroy the "
+                                "input (choose another output name)", output, in);
+    }
+    return LF_OK;
+}

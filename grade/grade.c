@@ -595,9 +595,10 @@ static void parse_declared(const char *md, const char *word, declared *d)
         const char *name = a + 2;
         remember(d, name, x[0]);
         if (!strcmp(name, "samplesperpixel")) {
-            if (x[0] < 1 || x[0] > 1024)
+            if (x[0] < 1 || x[0] > 1024) /* checked before the conversion: 1e308 has no int */
                 d->ok = 0, snprintf(d->why, sizeof d->why, "--samplesperpixel %g outside 1..1024", x[0]);
-            d->synth.spp = (int)x[0];
+            else
+                d->synth.spp = (int)x[0];
         } else if (!strcmp(name, "focaldistance"))
             d->synth.focal_distance = x[0], d->have_focal = 1;
         else if (!strcmp(name, "camerapos"))
@@ -611,9 +612,14 @@ static void parse_declared(const char *md, const char *word, declared *d)
         else if (!strcmp(name, "outputdim")) {
             if (x[0] < 1 || x[1] < 1 || x[0] > 2048 || x[1] > 2048)
                 d->ok = 0, snprintf(d->why, sizeof d->why, "--outputdim %g %g outside 1..2048", x[0], x[1]);
-            d->synth.width = (int)x[0], d->synth.height = (int)x[1], d->have_outdim = 1;
-        } else if (!strcmp(name, "seed"))
-            d->synth.seed = (uint32_t)fabs(x[0]);
+            else
+                d->synth.width = (int)x[0], d->synth.height = (int)x[1], d->have_outdim = 1;
+        } else if (!strcmp(name, "seed")) {
+            if (!(fabs(x[0]) <= 4294967295.0))
+                d->ok = 0, snprintf(d->why, sizeof d->why, "--seed %g outside 0..4294967295", x[0]);
+            else
+                d->synth.seed = (uint32_t)fabs(x[0]);
+        }
         else if (!strcmp(name, "depth"))
             d->focus_kind = 1, d->focus = x[0];
         else if (!strcmp(name, "disparity"))

@@ -622,7 +622,7 @@ int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_i
     int bad = ferror(f);
     if (fclose(f) || bad || rename(tmp, path)) {
         remove(tmp);
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s'", path);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
     }
     return LF_OK;
 }

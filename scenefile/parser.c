@@ -28,6 +28,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -189,11 +190,13 @@ static int lx_getc(lx_frame *L)
     if (L->pos >= L->len)
         return EOF;
     int c = (unsigned char)L->text[L->pos++];
+    /* saturating: a line over 2 GiB (or a file of 2^31 lines) must not
+     * overflow the int; its locations then say INT_MAX */
     if (c == '\n') {
-        L->line++;
+        L->line += L->line < INT_MAX;
         L->col = 1;
     } else {
-        L->col++;
+        L->col += L->col < INT_MAX;
     }
     return c;
 }
@@ -1087,9 +1090,20 @@ static int d_lookat(parser *P, lexer *L, const token *dir)
     if (rc)
         return rc;
     lf_transform t;
-    if (lf_transform_look_at(v, v + 3, v + 6, &t))
+    if (lf_transform_look_at(v, v + 3, v + 6, &t)) {
+        /* Distinct but huge numbers cancel (1e19 + 1 == 1e19) or overflow
+         * when squared: say so rather than that eye equals look. */
+        double big = 0;
+        for (int i = 0; i < 9; i++)
+            big = fmax(big, fabs(v[i]));
+        if (big > 1e15 && (v[0] != v[3] || v[1] != v[4] || v[2] != v[5]))
+            return perr(P, LF_ERR_PARSE, &dir->loc,
+                        "LookAt: the numbers are too large (up to %g): at that magnitude eye, look and up cannot be "
+                        "told apart in double precision; keep |coordinate| <= 1e15 scene units",
+                        big);
         return perr(P, LF_ERR_PARSE, &dir->loc,
                     "LookAt: eye equals look, or the up vector is parallel to the viewing direction");
+    }
     apply_transform(P, &t);
     return LF_OK;
 }

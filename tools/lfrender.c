@@ -50,6 +50,10 @@ static int run_merge(void *ctx, int n, char **parts)
     lf_error err = {0};
     lf_image img;
     lf_attrs meta = {0};
+    if (lf_output_is_input(f->out, (const char *const *)parts, n, &err)) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
+        return LF_EXIT_FAIL;
+    }
     int rc = lf_render_merge((const char **)parts, n, &img, &meta, &err);
     if (!rc) { /* write as the unsplit render would: Film "savefp16" travels in the parts */
         const lf_attr *h = lf_attrs_get(&meta, LF_KEY_SAVEFP16);
@@ -147,7 +151,7 @@ static int check_output(const flags *f, lf_renderer *r, const lf_render_opts *o,
         return LF_EXIT_USAGE;
     }
     lf_error err = {0};
-    if (lf_file_check_writable(*out, &err)) {
+    if (lf_output_is_input(*out, &o->scene_path, 1, &err) || lf_file_check_writable(*out, &err)) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
         return LF_EXIT_FAIL;
     }

@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# Hostile and unlucky inputs (issue 32): every tool must answer bad input
+# with a clear error and a failing exit code, never an abort, undefined
+# behaviour, a destroyed input or memory out of proportion to the file.
+# Each section is one point of the issue; every bomb is made here, small on
+# disk.  Limits are listed with their reasons in docs/testing.md.
+set -uo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+bin=$(cd "${1:?usage: test_hostile.sh BUILD_BIN_DIR}" && pwd)
+passed=0 failed=0
+ok() { passed=$((passed + 1)); echo "ok   $*"; }
+bad() { failed=$((failed + 1)); echo "FAIL $*"; }
+finish() { echo "$passed passed, $failed failed"; [ "$failed" -eq 0 ]; exit; }
+tmp=$(mktemp -d /tmp/lf_hostile_XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+
+# run NAME EXPECTED_RC PATTERN CMD...: the command exits with EXPECTED_RC
+# and its stderr matches the extended regular expression PATTERN.
+run() {
+  local name=$1 want=$2 pat=$3
+  shift 3
+  "$@" >out.txt 2>err.txt
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then
+    bad "$name: exit $rc, expected $want: $(head -c 400 err.txt)"
+  elif [ -n "$pat" ] && ! grep -Eq -- "$pat" err.txt; then
+    bad "$name: stderr does not match /$pat/: $(head -c 400 err.txt)"
+  else
+    ok "$name"
+  fi
+}
+
+# scene CAMERA_LINES [WORLD_LINES]: a 16x12 scene with one sphere and light
+scene() {
+  printf '%s\nFilm "rgb" "integer xresolution" [16] "integer yresolution" [12]\n' "$1"
+  printf 'Sampler "zsobol" "integer pixelsamples" [1]\nWorldBegin\n'
+  printf '%s\n' "${2-LightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]
+Shape \"sphere\"}"
+}
+look='LookAt 0 0 -3  0 0 0  0 1 0'
+
+# ---- 1. huge but finite camera values: a clear error, not Embree's abort
+i=0
+for cam in "Translate 1e19 0 0
+$look
+Camera \"perspective\"" \
+  "$look
+Camera \"perspective\" \"float lensradius\" [1e19] \"float focaldistance\" [3]" \
+  "$look
+Camera \"perspective\" \"float lensradius\" [0.1] \"float focaldistance\" [1e308]" \
+  "$look
+Camera \"perspective\" \"float screenwindow\" [-1e308 1e308 -1 1]" \
+  "$look
+Camera \"lightfield\" \"integer camerasperdim\" [2 2] \"float cameragridbounds\" [-1e308 1e308 -1 1]" \
+  "$look
+ActiveTransform EndTime
+Translate 1e19 0 0
+ActiveTransform All
+Camera \"perspective\" \"float shutterclose\" [1]"; do
+  i=$((i + 1))
+  scene "$cam" > cam$i.pbrt
+  run "1. huge camera value $i: refused with the limit" 1 'cam'$i'\.pbrt:[0-9]+:[0-9]+: .*(1e\+15 scene units)' \
+    "$bin/lfrender" cam$i.pbrt -o cam$i.exr --quiet
+done
+
+# ---- 2. float-to-int conversions out of range
+scene "$look
+Camera \"perspective\"" 'LightSource "infinite"
+Shape "sphere"' | sed 's/Film "rgb"/Film "rgb" "float cropwindow" [0 1e308 0 1]/' > crop.pbrt
+run "2. cropwindow 1e308: outside the film, no wrapped int" 1 'outside the 16x12 film' \
+  "$bin/lfrender" crop.pbrt -o crop.exr --quiet
+grep -q -- '-2147483648' err.txt && bad "2. cropwindow message shows a wrapped int: $(cat err.txt)"
+plen='LookAt 0 0 -3  0 0 0  0 1 0
+Camera "plenoptic" "float focallength" [50] "float fstop" [4] "float focusdistance" [3]'
+scene "$plen \"float rotation\" [1e308]" > rot.pbrt
+run "2. plenoptic rotation 1e308: one turn taken first" 0 '' "$bin/lfrender" rot.pbrt -o rot.exr --quiet
+scene "$plen \"float microlensfocallength\" [1e-308]" > mlf.pbrt
+run "2. plenoptic microlensfocallength 1e-308: too small" 1 'microlensfocallength.*too small' \
+  "$bin/lfrender" mlf.pbrt -o mlf.exr --quiet
+
+# ---- 5. an output that is an input is refused, and the input survives
+same() { # NAME FILE CMD...: refused (exit 1, "is the input") and FILE unchanged
+  local name=$1 file=$2
+  shift 2
+  local before
+  before=$(md5sum < "$file")
+  run "$name" 1 'is the input' "$@"
+  [ "$(md5sum < "$file")" = "$before" ] || bad "$name: $file was changed"
+}
+scene "$look
+Camera \"lightfield\" \"integer camerasperdim\" [2 2] \"float cameragridbounds\" [-0.01 0.01 -0.01 0.01]" > lf.pbrt
+"$bin/lfrender" lf.pbrt -o raw.exr --quiet 2>/dev/null || bad "5. the light field did not render"
+ln raw.exr link.exr
+same "5. lftool refocus raw.exr -o raw.exr" raw.exr "$bin/lftool" refocus raw.exr --disparity 0 -o raw.exr
+same "5. lftool refocus raw.exr -o (a hard link to it)" raw.exr "$bin/lftool" refocus raw.exr --disparity 0 -o link.exr
+same "5. lftool depth raw.exr -o raw.exr" raw.exr "$bin/lftool" depth raw.exr -o raw.exr
+run "5. lftool refocus to another name still works" 0 '' "$bin/lftool" refocus raw.exr --disparity 0 -o ref.exr
+scene "$look
+Camera \"perspective\"" > p.pbrt
+"$bin/lfrender" p.pbrt -o p0.exr --spp-range 0 1 --quiet 2>/dev/null
+cp p0.exr p1.exr
+same "5. lfrender merge p0.exr p1.exr -o p0.exr" p0.exr "$bin/lfrender" merge p0.exr p1.exr -o p0.exr
+cp p.pbrt same.exr
+same "5. lfrender same.exr -o same.exr (a scene named .exr)" same.exr "$bin/lfrender" same.exr -o same.exr --quiet
+cp "$root/scenes/lenses/dgauss.50mm.dat" lens.svg
+same "5. lflens plot lens.svg -o lens.svg" lens.svg "$bin/lflens" plot lens.svg -o lens.svg
+
+# ---- 10. nonsense parameters refused (or warned about), not rendered black
+scene "$look
+Camera \"perspective\"" | sed 's/Film "rgb"/Film "rgb" "float maxcomponentvalue" [-1]/' > mcv.pbrt
+run "10. maxcomponentvalue -1 refused" 1 'mcv\.pbrt:[0-9]+:[0-9]+: .*maxcomponentvalue.*must be > 0' \
+  "$bin/lfrender" mcv.pbrt -o mcv.exr --quiet
+scene "$look
+Camera \"perspective\" \"float shutteropen\" [1e308]" > shut.pbrt
+run "10. shutteropen 1e308 refused" 1 'shut\.pbrt:[0-9]+:[0-9]+: .*shutteropen.*seconds' \
+  "$bin/lfrender" shut.pbrt -o shut.exr --quiet
+scene "$plen \"float pitch\" [1e308]" > pitch.pbrt
+run "10. plenoptic pitch 1e308 refused" 1 'microlens pitch' "$bin/lfrender" pitch.pbrt -o pitch.exr --quiet
+scene "$look
+Camera \"perspective\"" '' > empty.pbrt
+run "10. an empty world renders with a warning" 0 'warning: the world is empty' \
+  "$bin/lfrender" empty.pbrt -o empty.exr --quiet
+scene "$look
+Camera \"perspective\"" 'Shape "sphere"' > dark.pbrt
+run "10. a world without lights renders with a warning" 0 'warning: nothing lights the world' \
+  "$bin/lfrender" dark.pbrt -o dark.exr --quiet
+run "10. a lit world has no such warning" 0 '' "$bin/lfrender" p.pbrt -o p.exr --quiet
+grep -q 'image will be black' err.txt && bad "10. a lit world was warned about: $(cat err.txt)"
+
+# ---- 11. messages say what is wrong, and why a write failed
+printf '# radius thickness ior aperture\n1e-308 5 1.5 20\n-50 40 1 20\n' > tiny.dat
+run "11. a denormal lens radius is too small, not 'not a number'" 1 'radius "1e-308" is too small' \
+  "$bin/lflens" info tiny.dat
+scene 'LookAt 1e19 0 0  1e19 0 1  0 1 0
+Camera "perspective"' > far.pbrt
+run "11. LookAt 1e19: the numbers are too large, not 'eye equals look'" 1 'far\.pbrt:1:1: LookAt: the numbers are too large' \
+  "$bin/lfrender" far.pbrt -o far.exr --quiet
+# a file-size limit of 0 makes every write fail (EFBIG; SIGXFSZ ignored)
+# (the messages pass through a pipe to a process without the limit)
+nowrite() { (trap '' XFSZ; ulimit -f 0; exec "$@") 2>&1 | cat >&2; }
+run "11. a PFM write failure says why" 1 'write failed: File too large' nowrite "$bin/lfrender" p.pbrt -o w.pfm --quiet
+run "11. a PNG write failure says why" 1 'File too large' nowrite "$bin/lfrender" p.pbrt -o w.png --quiet
+
+finish

@@ -164,6 +164,8 @@ typedef struct lx_frame {
     int line, col;
     const char *file; /* kept in the description's strings */
     const char *dir;  /* directory of file */
+    int included;     /* read by Include/Import: refused whole if it does not start as a scene */
+    int directives;   /* directives read from it so far */
 } lx_frame;
 
 typedef struct lexer {
@@ -223,7 +225,8 @@ static int lx_push(lexer *X, char *owned, const char *text, size_t len, const ch
         X->done = n;
         X->cap_done = nc;
     }
-    X->fr[X->n_fr++] = (lx_frame){owned, text, len, 0, 1, 1, file, dir};
+    X->fr[X->n_fr] = (lx_frame){owned, text, len, 0, 1, 1, file, dir, X->n_fr > 0, 0};
+    X->n_fr++;
     return 0;
 }
 
@@ -2151,6 +2154,19 @@ static int parse_run(parser *P, lexer *L, lf_loc *eof)
         }
         char b[200];
         directive_fn fn = find_directive(&t);
+        lx_frame *top = &L->fr[L->n_fr - 1];
+        int from_top = t.loc.file == top->file;
+        if (!fn && from_top && top->included && top->directives == 0) {
+            /* An included file that does not begin with a directive is not a
+             * scene (Include "/etc/shadow"): refused whole, its content never
+             * echoed in messages. */
+            perr(P, LF_ERR_PARSE, &t.loc, "\"%s\" is not a scene file (it does not begin with a directive): not "
+                 "read further", top->file);
+            top->pos = top->len; /* its end: the lexer returns to the including file */
+            continue;
+        }
+        if (fn && from_top)
+            top->directives++;
         if (!fn) {
             if (t.kind != TK_WORD)
                 perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
@@ -2253,6 +2269,9 @@ static int parse_begin(parser *P, const lf_parse_opts *o, lf_scene_desc *out, lf
     out->transform_start_time = 0.0;
     out->transform_end_time = 1.0;
     P->gs.ctm[0] = P->gs.ctm[1] = lf_transform_identity();
+    /* a scene without a Camera directive: pbrt-v4's default camera at the
+     * origin (a zero matrix here made NaN rays and Embree aborted) */
+    out->camera.world_to_camera.xf[0] = out->camera.world_to_camera.xf[1] = P->gs.ctm[0];
     P->gs.active[0] = P->gs.active[1] = 1;
     P->gs.material = -1;
     P->gs.area_light = -1;

@@ -63,6 +63,9 @@ Camera \"perspective\" \"float shutterclose\" [1]"; do
   run "1. huge camera value $i: refused with the limit" 1 'cam'$i'\.pbrt:[0-9]+:[0-9]+: .*(1e\+15 scene units)' \
     "$bin/lfrender" cam$i.pbrt -o cam$i.exr --quiet
 done
+printf 'WorldBegin\nLightSource "infinite"\nShape "sphere"\n' > nocam.pbrt
+run "1. a scene without a Camera directive: pbrt's default camera, no abort" 0 '' \
+  "$bin/lfrender" nocam.pbrt -o nocam.exr --quiet
 
 # ---- 2. float-to-int conversions out of range
 scene "$look
@@ -141,5 +144,15 @@ run "11. LookAt 1e19: the numbers are too large, not 'eye equals look'" 1 'far\.
 nowrite() { (trap '' XFSZ; ulimit -f 0; exec "$@") 2>&1 | cat >&2; }
 run "11. a PFM write failure says why" 1 'write failed: File too large' nowrite "$bin/lfrender" p.pbrt -o w.pfm --quiet
 run "11. a PNG write failure says why" 1 'File too large' nowrite "$bin/lfrender" p.pbrt -o w.png --quiet
+
+# ---- 7. an included file that is not a scene: refused, its lines never echoed
+printf 'root:$y$j9T$hidden-hash:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\nbin:secret-word:1:1\n' > shadow
+scene "$look
+Camera \"perspective\"" 'LightSource "infinite"
+Include "shadow"
+Shape "sphere"' > inc.pbrt
+run "7. Include of a non-scene file refused" 1 'shadow.* is not a scene file' "$bin/lfrender" inc.pbrt -o inc.exr --quiet
+grep -Eq 'hidden-hash|daemon|secret-word' err.txt && bad "7. the included file's content was echoed: $(cat err.txt)"
+[ "$(grep -c . err.txt)" -le 2 ] || bad "7. one error expected for the non-scene include: $(cat err.txt)"
 
 finish

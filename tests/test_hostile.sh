@@ -155,4 +155,30 @@ run "7. Include of a non-scene file refused" 1 'shadow.* is not a scene file' "$
 grep -Eq 'hidden-hash|daemon|secret-word' err.txt && bad "7. the included file's content was echoed: $(cat err.txt)"
 [ "$(grep -c . err.txt)" -le 2 ] || bad "7. one error expected for the non-scene include: $(cat err.txt)"
 
+# ---- 3. memory in proportion to what is used (asserted with ulimit -v)
+# a 0.6 MB PNG declaring 25000 x 25000 pixels (2.5 GB as floats): info reads its header only
+python3 - <<'PY'
+import struct, zlib
+def chunk(t, d): return struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+n, k = 25000, 1000  # k rows per block: compressed once, then repeated (a full flush makes blocks independent)
+block = (b'\0' * (n + 1)) * k
+c = zlib.compressobj(9, zlib.DEFLATED, -15)
+once = c.compress(block) + c.flush(zlib.Z_FULL_FLUSH)
+adler = 1
+for _ in range(n // k):
+    adler = zlib.adler32(block, adler)
+idat = b'\x78\xda' + once * (n // k) + c.flush() + struct.pack('>I', adler)
+open('bomb.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', n, n, 8, 0, 0, 0, 0))
+                             + chunk(b'IDAT', idat) + chunk(b'IEND', b''))
+PY
+limited() { (ulimit -v 1000000; exec "$@"); } # 1 GB of address space
+run "3. lftool info on a PNG bomb reads the header only (1 GB limit)" 0 '' limited "$bin/lftool" info bomb.png \
+  --kind camera-array --camsperdim 5 5 --griddim -1 1 -1 1 --inputfov 30 --tilesize 5000 5000
+grep -q '25000 x 25000 raw, 1 channels' out.txt || bad "3. info did not describe the PNG: $(cat out.txt)"
+# 1M nested AttributeBegin in a 15 KB .pbrt.gz: refused at the depth limit, not 6 GB later
+{ scene "$look
+Camera \"perspective\"" ''; yes AttributeBegin | head -n 1000000; } | gzip -9 > deep.pbrt.gz
+run "3. a million nested AttributeBegin refused at the depth limit (1 GB limit)" 1 'nested more than 10000 deep' \
+  limited "$bin/lfrender" deep.pbrt.gz -o deep.exr --quiet
+
 finish

@@ -561,7 +561,9 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
 
     /* Open it ourselves first: "missing" and "not a file" deserve plain
      * messages rather than whatever a codec makes of them. */
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is then
+     * refused as not a regular file); regular files ignore the flag. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
         return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     struct stat st;

@@ -181,4 +181,10 @@ Camera \"perspective\"" ''; yes AttributeBegin | head -n 1000000; } | gzip -9 > 
 run "3. a million nested AttributeBegin refused at the depth limit (1 GB limit)" 1 'nested more than 10000 deep' \
   limited "$bin/lfrender" deep.pbrt.gz -o deep.exr --quiet
 
+# ---- 9. a FIFO named like a view is refused at once, not waited on
+rm -rf views && "$bin/lftool" decode raw.exr -o views >/dev/null 2>&1 && rm -f views/mosaic.exr views/view_01_01.exr &&
+  mkfifo views/view_01_01.exr || bad "9. could not make the folder of views"
+run "9. lftool refocus DIR with a FIFO view: refused, no hang" 1 'view_01_01\.exr.*not a regular file' \
+  timeout 20 "$bin/lftool" refocus views --disparity 0 -o fifo.exr
+
 finish

@@ -187,4 +187,12 @@ rm -rf views && "$bin/lftool" decode raw.exr -o views >/dev/null 2>&1 && rm -f v
 run "9. lftool refocus DIR with a FIFO view: refused, no hang" 1 'view_01_01\.exr.*not a regular file' \
   timeout 20 "$bin/lftool" refocus views --disparity 0 -o fifo.exr
 
+# ---- 8. a killed run's hidden temporaries are removed by the next run
+mkdir -p ck && cp p.pbrt ck/s.pbrt
+: > ck/.out.exr.tmpab12cd.exr; : > ck/.out.exr.checkpoint.exr.tmpzz99yy.exr; : > ck/.out.exr.keep.exr
+run "8. lfrender with checkpoints renders" 0 '' "$bin/lfrender" ck/s.pbrt -o ck/out.exr --checkpoint-every 100 --quiet
+[ ! -e ck/.out.exr.tmpab12cd.exr ] && [ ! -e ck/.out.exr.checkpoint.exr.tmpzz99yy.exr ] && ok "8. stale temporaries removed" ||
+  bad "8. stale temporaries left: $(ls -a ck)"
+[ -e ck/.out.exr.keep.exr ] && ok "8. a file not named like a temporary is kept" || bad "8. an unrelated file was removed"
+
 finish

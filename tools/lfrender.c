@@ -235,9 +235,11 @@ static int run_render(void *ctx, int n, char **pos)
         fputs(lf_renderer_warnings(r), stderr);
     char ckpath[4200];
     if ((rc = check_output(f, r, &o, &out)) < 0) {
+        lf_file_temp_clean(out); /* a killed run's half-written temporaries (issue 32) */
         if (stop) {
             snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
             o.checkpoint_path = f->checkpoint ? f->checkpoint : ckpath;
+            lf_file_temp_clean(o.checkpoint_path);
             o.stop = stop;
             lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
         }

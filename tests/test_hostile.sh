@@ -195,4 +195,13 @@ run "8. lfrender with checkpoints renders" 0 '' "$bin/lfrender" ck/s.pbrt -o ck/
   bad "8. stale temporaries left: $(ls -a ck)"
 [ -e ck/.out.exr.keep.exr ] && ok "8. a file not named like a temporary is kept" || bad "8. an unrelated file was removed"
 
+# ---- 6. lfgrade: folder names cannot take the grade book or each other's report
+mkdir -p g/a/alice g/b/alice g/gradebook.csv
+run "6. lfgrade with students alice, alice and gradebook.csv" 0 'reports in' \
+  "$bin/lfgrade" "$root/assignments/1-thinlens" g/a/alice g/b/alice g/gradebook.csv --report g/R --cache g/cache
+[ -f g/R/gradebook.csv ] && [ -f g/R/gradebook.json ] && ok "6. the grade book survives a student named gradebook.csv" ||
+  bad "6. the grade book is missing: $(ls g/R)"
+[ -f g/R/alice/index.html ] && [ -f g/R/alice-2/index.html ] && ok "6. two students named alice get a report each" ||
+  bad "6. a report was overwritten: $(ls g/R)"
+
 finish

@@ -1,6 +1,7 @@
 /* Atomic file output (lf_file_write.h). */
 #include "lf_file_write.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -186,4 +187,58 @@ int lf_file_check_writable(const char *path, lf_error *err)
     fclose(f);
     remove(probe);
     return LF_OK;
+}
+
+int lf_output_is_input(const char *output, const char *const *inputs, int n, lf_error *err)
+{
+    if (!output)
+        return LF_OK;
+    struct stat so;
+    int out_exists = stat(output, &so) == 0;
+    for (int i = 0; i < n; i++) {
+        const char *in = inputs[i];
+        if (!in)
+            continue;
+        struct stat si;
+        int same = strcmp(in, output) == 0 ||
+                   (out_exists && stat(in, &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino);
+        if (same)
+            return lf_error_set(err, LF_ERR_PARAM, "the output '%s' is the input '%s': writing it would destroy the "
+                                "input (choose another output name)", output, in);
+    }
+    return LF_OK;
+}
+
+int lf_file_temp_clean(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *ext = extension_of(base);
+    char dir[PATH_MAX], prefix[PATH_MAX];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
+    int pl = snprintf(prefix, sizeof prefix, ".%s.tmp", base);
+    if (!*base || pl < 0 || (size_t)pl >= sizeof prefix)
+        return 0;
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    int removed = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        const char *n = e->d_name;
+        if (strncmp(n, prefix, (size_t)pl) != 0)
+            continue;
+        const char *r = n + pl; /* six of [a-z0-9], then ".<ext>" or the end (lf_file_temp_create's names) */
+        int ok = 1;
+        for (int i = 0; i < 6; i++)
+            ok = ok && ((r[i] >= 'a' && r[i] <= 'z') || (r[i] >= '0' && r[i] <= '9'));
+        if (!ok || (*ext ? (r[6] != '.' || strcmp(r + 7, ext) != 0) : r[6] != '\0'))
+            continue;
+        char full[PATH_MAX * 2];
+        snprintf(full, sizeof full, "%s/%s", dir, n);
+        struct stat st;
+        if (lstat(full, &st) == 0 && S_ISREG(st.st_mode) && unlink(full) == 0)
+            removed++;
+    }
+    closedir(d);
+    return removed;
 }

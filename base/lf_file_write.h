@@ -40,6 +40,16 @@ int lf_dir_create_parents(const char *path, lf_error *err);
 /* Before long work: creates path's folder and a probe file beside path
  * (removed again), so an unwritable output fails now, not at the end. */
 int lf_file_check_writable(const char *path, lf_error *err);
+/* Removes the hidden temporaries lf_file_temp_create made for path that a
+ * killed process left behind ("<dir>/.<name>.tmpXXXXXX.<ext>"); returns how
+ * many.  For a program about to write path itself (nothing else may be
+ * writing it then). */
+int lf_file_temp_clean(const char *path);
+/* Before reading: LF_ERR_PARAM when output names one of the n inputs (the
+ * same path, or the same file through another name: device and inode),
+ * since writing it would destroy what is being read.  NULL entries are
+ * skipped. */
+int lf_output_is_input(const char *output, const char *const *inputs, int n, lf_error *err);
 
 #ifdef __cplusplus
 }

@@ -24,13 +24,18 @@
 
 /* ---------------------------------------------------------------- parsing */
 
-static int parse_number(const char *tok, double *out)
+/* 0, or what is wrong with tok as a number (for the message). */
+static const char *parse_number(const char *tok, double *out)
 {
     char *end;
     errno = 0;
     double v = strtod(tok, &end);
-    if (end == tok || *end || errno == ERANGE || !isfinite(v))
-        return -1;
+    if (end == tok || *end)
+        return "is not a number";
+    if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1.0))
+        return "is too large (beyond double precision's range)";
+    if (errno == ERANGE)
+        return "is too small (it underflows double precision: below 2.2e-308, denormal or zero)";
     *out = v;
     return 0;
 }
@@ -85,11 +90,13 @@ int lf_lens_parse(const char *text, const char *filename, lf_lens *lens, lf_erro
         }
         double v[5] = {0, 0, 0, 0, 0};
         static const char *const col[5] = {"radius", "thickness", "ior", "aperture", "abbe"};
-        for (int i = 0; i < nt; i++)
-            if (parse_number(tok[i], &v[i])) {
-                lf_error_at(err, LF_ERR_PARSE, &at, "%s \"%s\" is not a number", col[i], tok[i]);
+        for (int i = 0; i < nt; i++) {
+            const char *why = parse_number(tok[i], &v[i]);
+            if (why) {
+                lf_error_at(err, LF_ERR_PARSE, &at, "%s \"%s\" %s", col[i], tok[i], why);
                 goto fail;
             }
+        }
         if (v[1] < 0.0) {
             lf_error_at(err, LF_ERR_PARSE, &at, "thickness %g must be >= 0", v[1]);
             goto fail;

@@ -71,6 +71,10 @@
  * this many microlenses (plenoptic 2.0 designs see each point several
  * times; beyond this the design is rejected at create). */
 enum { MAX_CANDIDATES = 256 };
+/* 1 nm: below it the microlens's power (1/f) overflows the lattice's
+ * arithmetic (1e-308 mm made NaN pixel indices); real microlenses are
+ * tens of micrometres and more. */
+#define MIN_FOCAL_MM 1e-6
 
 typedef struct plenoptic {
     /* main lens (a compound lens: its equivalent thin lens, see below) */
@@ -315,7 +319,8 @@ static int lattice_shape(plenoptic *c, const char *grid, double rot_deg, lf_erro
         return lf_error_set(err, LF_ERR_PARAM, "unknown \"grid\" \"%s\" (square or hex)", grid);
     if (!isfinite(rot_deg))
         return lf_error_set(err, LF_ERR_PARAM, "\"rotation\" must be finite, got %g", rot_deg);
-    c->rotation_rad = rot_deg * M_PI / 180.0;
+    /* reduced to one turn first: 1e308 degrees times pi overflows to inf */
+    c->rotation_rad = fmod(rot_deg, 360.0) * M_PI / 180.0;
     c->cos_r = cos(c->rotation_rad);
     c->sin_r = sin(c->rotation_rad);
     return LF_OK;
@@ -363,6 +368,9 @@ static int microlens_array(plenoptic *c, mla_params m, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM, "\"pitch\" must be > 0 um, got %g", m.pitch_um);
     if (!(m.fmla_mm >= 0.0) || !isfinite(m.fmla_mm))
         return lf_error_set(err, LF_ERR_PARAM, "\"microlensfocallength\" must be > 0 mm, got %g", m.fmla_mm);
+    if (m.fmla_mm > 0.0 && m.fmla_mm < MIN_FOCAL_MM)
+        return lf_error_set(err, LF_ERR_PARAM, "\"microlensfocallength\" %g mm is too small (at least %g mm)",
+                            m.fmla_mm, MIN_FOCAL_MM);
     if (!isfinite(m.offset_mm))
         return lf_error_set(err, LF_ERR_PARAM, "\"sensoroffset\" must be finite, got %g", m.offset_mm);
     /* the lattice sees the aperture at the (exit) pupil: Z and D below are z_i and f/N for a thin lens */
@@ -396,6 +404,11 @@ static int microlens_array(plenoptic *c, mla_params m, lf_error *err)
     if (!(c->image_pitch_px >= 0.25) || !isfinite(c->image_pitch_px))
         return lf_error_set(err, LF_ERR_PARAM, "the microlens pitch is %g pixels: at least 0.25 pixel is needed",
                             c->image_pitch_px);
+    if (c->image_pitch_px > 2.0 * c->width) /* one lens across the sensor (the most "microlenses" asks for) is ~1x */
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "the microlens pitch is %g pixels, over twice the %d-pixel image width: not one microlens "
+                            "image fits on the sensor, so there is no light field",
+                            c->image_pitch_px, c->width);
     c->cell_area = c->hex ? sqrt(3.0) / 2.0 * c->pitch * c->pitch : c->pitch * c->pitch;
     c->cell_radius = c->hex ? c->pitch / sqrt(3.0) : c->pitch / sqrt(2.0);
     double alpha = 1.0 + zi / d - zi / c->mla_focal;
@@ -403,7 +416,7 @@ static int microlens_array(plenoptic *c, mla_params m, lf_error *err)
     double cell_px = c->hex ? sqrt(3.0) / 2.0 * c->image_pitch_px * c->image_pitch_px
                             : c->image_pitch_px * c->image_pitch_px;
     double max_cand = M_PI * pow(c->search_px + c->image_pitch_px, 2.0) / cell_px;
-    if (max_cand > MAX_CANDIDATES)
+    if (!(max_cand <= MAX_CANDIDATES)) /* also NaN */
         return lf_error_set(err, LF_ERR_PARAM,
                             "each sensor point would see the main lens through up to %.0f microlenses (limit %d): the "
                             "microlens focal length or sensor offset is too far from the matched design",

@@ -36,6 +36,8 @@ struct lf_grade_ctx {
     int threads;
     cached_ref *refs;
     int nrefs;
+    char **students; /* report folder names given so far: each submission gets its own */
+    int nstudents;
 };
 
 lf_grade_opts lf_grade_opts_default(void)
@@ -91,6 +93,9 @@ void lf_grade_ctx_release(lf_grade_ctx *g)
     for (int i = 0; i < g->nrefs; i++)
         lf_image_free(&g->refs[i].img), lf_attrs_free(&g->refs[i].meta);
     free(g->refs);
+    for (int i = 0; i < g->nstudents; i++)
+        free(g->students[i]);
+    free(g->students);
     lf_grade_rubric_free(&g->rubric);
     free(g);
 }
@@ -595,9 +600,10 @@ static void parse_declared(const char *md, const char *word, declared *d)
         const char *name = a + 2;
         remember(d, name, x[0]);
         if (!strcmp(name, "samplesperpixel")) {
-            if (x[0] < 1 || x[0] > 1024)
+            if (x[0] < 1 || x[0] > 1024) /* checked before the conversion: 1e308 has no int */
                 d->ok = 0, snprintf(d->why, sizeof d->why, "--samplesperpixel %g outside 1..1024", x[0]);
-            d->synth.spp = (int)x[0];
+            else
+                d->synth.spp = (int)x[0];
         } else if (!strcmp(name, "focaldistance"))
             d->synth.focal_distance = x[0], d->have_focal = 1;
         else if (!strcmp(name, "camerapos"))
@@ -611,9 +617,14 @@ static void parse_declared(const char *md, const char *word, declared *d)
         else if (!strcmp(name, "outputdim")) {
             if (x[0] < 1 || x[1] < 1 || x[0] > 2048 || x[1] > 2048)
                 d->ok = 0, snprintf(d->why, sizeof d->why, "--outputdim %g %g outside 1..2048", x[0], x[1]);
-            d->synth.width = (int)x[0], d->synth.height = (int)x[1], d->have_outdim = 1;
-        } else if (!strcmp(name, "seed"))
-            d->synth.seed = (uint32_t)fabs(x[0]);
+            else
+                d->synth.width = (int)x[0], d->synth.height = (int)x[1], d->have_outdim = 1;
+        } else if (!strcmp(name, "seed")) {
+            if (!(fabs(x[0]) <= 4294967295.0))
+                d->ok = 0, snprintf(d->why, sizeof d->why, "--seed %g outside 0..4294967295", x[0]);
+            else
+                d->synth.seed = (uint32_t)fabs(x[0]);
+        }
         else if (!strcmp(name, "depth"))
             d->focus_kind = 1, d->focus = x[0];
         else if (!strcmp(name, "disparity"))
@@ -1636,12 +1647,40 @@ static void student_name(const char *dir, char *out, size_t n)
         snprintf(out, n, "submission");
 }
 
+/* The student's name made unique within the run (a/alice and b/alice are
+ * alice and alice-2) and never the grade book's own files, so no report
+ * overwrites another nor the grade book.  0, or -1 out of memory. */
+static int unique_student(lf_grade_ctx *g, char *name, size_t n)
+{
+    char base[sizeof ((lf_grade_result *)0)->student];
+    snprintf(base, sizeof base, "%s", name);
+    for (int k = 1;; k++) {
+        if (k > 1)
+            snprintf(name, n, "%.*s-%d", (int)(n - 12), base, k);
+        int taken = !strcasecmp(name, "gradebook.csv") || !strcasecmp(name, "gradebook.json");
+        for (int i = 0; i < g->nstudents && !taken; i++)
+            taken = !strcmp(g->students[i], name);
+        if (!taken)
+            break;
+    }
+    char **grown = realloc(g->students, (size_t)(g->nstudents + 1) * sizeof *grown);
+    if (!grown)
+        return -1;
+    g->students = grown;
+    if (!(g->students[g->nstudents] = strdup(name)))
+        return -1;
+    g->nstudents++;
+    return 0;
+}
+
 int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_result *res, lf_error *err)
 {
     memset(res, 0, sizeof *res);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     student_name(submission_dir, res->student, sizeof res->student);
+    if (unique_student(g, res->student, sizeof res->student))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     snprintf(res->path, sizeof res->path, "%s", submission_dir);
     res->checks = calloc((size_t)g->rubric.nchecks, sizeof *res->checks);
     if (!res->checks)

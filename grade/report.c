@@ -1,4 +1,5 @@
 /* report.c - per-student HTML reports and the grade book (CSV, JSON). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,7 +47,7 @@ int lf_grade_report_student(const char *dir, const char *title, const lf_grade_r
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
     if (!f)
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", tmp);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", tmp, strerror(errno));
     fputs("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>", f);
     html_escape(f, r->student);
     fputs("</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
@@ -111,7 +112,7 @@ int lf_grade_report_student(const char *dir, const char *title, const lf_grade_r
     int bad = ferror(f);
     if (fclose(f) || bad || rename(tmp, path)) {
         remove(tmp);
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     }
     return 0;
 }
@@ -202,7 +203,7 @@ int lf_grade_write_gradebook(const char *dir, const lf_grade_result *res, int n,
     snprintf(path, sizeof path, "%s/gradebook.csv", dir);
     FILE *f = fopen(path, "w");
     if (!f)
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     fputs("student,score,max", f);
     if (n > 0)
         for (int i = 0; i < res[0].nchecks; i++)
@@ -229,11 +230,11 @@ int lf_grade_write_gradebook(const char *dir, const lf_grade_result *res, int n,
         fputc('\n', f);
     }
     if (fclose(f))
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     snprintf(path, sizeof path, "%s/gradebook.json", dir);
     f = fopen(path, "w");
     if (!f)
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     fputs("[\n", f);
     for (int s = 0; s < n; s++) {
         char *j = lf_grade_result_json(&res[s]);
@@ -247,6 +248,6 @@ int lf_grade_write_gradebook(const char *dir, const lf_grade_result *res, int n,
     }
     fputs("]\n", f);
     if (fclose(f))
-        return lf_error_set(err, LF_ERR_IO, "%s: cannot write", path);
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     return 0;
 }

@@ -243,12 +243,15 @@ int lf_grade_image_decode(const unsigned char *data, size_t n, const char *forma
         return -1;
     }
     size_t put = 0;
+    int werr = 0;
     while (put < n) {
         ssize_t r = write(fd, data + put, n - put);
         if (r < 0 && errno == EINTR)
             continue;
-        if (r <= 0)
+        if (r <= 0) {
+            werr = r < 0 ? errno : ENOSPC;
             break;
+        }
         put += (size_t)r;
     }
     close(fd);
@@ -261,9 +264,12 @@ int lf_grade_image_decode(const unsigned char *data, size_t n, const char *forma
         const char *p = strstr(m, path);
         if (p)
             m = p + strlen(path);
-        while (*m == ':' || *m == ' ')
+        while (*m == '\'' || *m == ':' || *m == ' ') /* the quote that closed the path, then ": " */
             m++;
-        snprintf(why, wn, "cannot decode: %s", put == n ? (m[0] ? m : "unreadable image") : "write failed");
+        if (put == n)
+            snprintf(why, wn, "cannot decode: %s", m[0] ? m : "unreadable image");
+        else
+            snprintf(why, wn, "cannot decode: writing the temporary copy failed: %s", strerror(werr));
         memset(img, 0, sizeof *img);
         return -1;
     }

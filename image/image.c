@@ -483,6 +483,27 @@ static uint32_t be32(const unsigned char *p)
     return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | (uint32_t)p[3];
 }
 
+int lf_image_read_size(const char *path, int *width, int *height, int *channels, lf_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    /* signature, IHDR length and type, width, height, bit depth, colour type */
+    unsigned char h[26];
+    size_t got = fread(h, 1, sizeof h, f);
+    fclose(f);
+    if (got < 8 || memcmp(h, png_signature, 8) != 0)
+        return LF_ERR_UNSUPPORTED; /* not a PNG: the caller reads it whole */
+    static const int channels_of[7] = {1, 0, 3, 3, 2, 0, 4}; /* by PNG colour type; palette: RGB */
+    if (got < sizeof h || memcmp(h + 12, "IHDR", 4) != 0 || h[25] > 6 || !channels_of[h[25]])
+        return lf_error_set(err, LF_ERR_PARSE, "cannot read '%s': corrupt PNG header", path);
+    uint32_t w = be32(h + 16), ht = be32(h + 20);
+    if (w == 0 || ht == 0 || w > 0x7fffffffu || ht > 0x7fffffffu)
+        return lf_error_set(err, LF_ERR_PARSE, "cannot read '%s': PNG header claims %u x %u pixels", path, w, ht);
+    *width = (int)w, *height = (int)ht, *channels = channels_of[h[25]];
+    return LF_OK;
+}
+
 static int png_check(const char *path, lf_error *err)
 {
     FILE *f = fopen(path, "rb");
@@ -540,7 +561,9 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
 
     /* Open it ourselves first: "missing" and "not a file" deserve plain
      * messages rather than whatever a codec makes of them. */
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer (it is then
+     * refused as not a regular file); regular files ignore the flag. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0)
         return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     struct stat st;

@@ -122,6 +122,12 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
  * with a clear error rather than trying to allocate. */
 int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *err);
 
+/* The size of an image without its pixels, from the header, where the
+ * format allows it cheaply (PNG: its IHDR chunk); LF_ERR_UNSUPPORTED for
+ * other formats, whose callers read the image.  A 2 MB PNG can declare 25000
+ * x 25000 pixels (7.5 GB as floats): describing it must not decode it. */
+int lf_image_read_size(const char *path, int *width, int *height, int *channels, lf_error *err);
+
 /* Number of NaN or Inf values. */
 size_t lf_image_count_nonfinite(const lf_image *img);
 /* 1 when every value is finite with magnitude <= 65504, the largest half

@@ -114,6 +114,7 @@ int lf_pfm_write(const char *file, const char *name, const lf_image *img, lf_err
     FILE *f = fopen(file, "wb");
     if (!f)
         return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", name, strerror(errno));
+    errno = 0;
     int ok = fprintf(f, "%s\n%d %d\n-1.0\n", img->channels == 3 ? "PF" : "Pf", img->width, img->height) > 0;
     size_t row = (size_t)img->width * img->channels;
     float *buf = malloc(row * sizeof *buf);
@@ -124,8 +125,11 @@ int lf_pfm_write(const char *file, const char *name, const lf_image *img, lf_err
             swap4((unsigned char *)buf, row);
         ok = fwrite(buf, sizeof *buf, row, f) == row;
     }
+    int e = ok ? 0 : (buf ? errno : ENOMEM);
     free(buf);
-    if (fclose(f))
-        ok = 0;
-    return ok ? LF_OK : lf_error_set(err, LF_ERR_IO, "cannot write '%s': write failed", name);
+    if (fclose(f) && ok)
+        ok = 0, e = errno;
+    return ok ? LF_OK
+              : lf_error_set(err, LF_ERR_IO, "cannot write '%s': write failed: %s", name,
+                             e ? strerror(e) : "stream error");
 }

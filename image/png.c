@@ -3,6 +3,7 @@
  * loads those only for other formats).  The pixels arrive tonemapped and
  * sRGB-encoded; the file says so with an sRGB chunk.  libpng reports errors
  * by longjmp: its messages are kept for ours, nothing goes to stderr. */
+#include <errno.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdio.h>
@@ -17,8 +18,12 @@ typedef struct png_err_ctx {
 
 static void on_error(png_structp png, png_const_charp msg)
 {
+    int e = errno; /* libpng's "Write Error" follows a failed fwrite: keep its reason */
     png_err_ctx *ctx = png_get_error_ptr(png);
-    snprintf(ctx->msg, sizeof ctx->msg, "%s", msg);
+    if (e && strstr(msg, "Write Error"))
+        snprintf(ctx->msg, sizeof ctx->msg, "write error: %s", strerror(e));
+    else
+        snprintf(ctx->msg, sizeof ctx->msg, "%s", msg);
     longjmp(ctx->jb, 1);
 }
 
@@ -37,7 +42,7 @@ int lf_png_write(const char *file, const char *name, int width, int height, int 
                             channels);
     FILE *f = fopen(file, "wb");
     if (!f)
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': cannot create %s", name, file);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': cannot create %s: %s", name, file, strerror(errno));
     /* volatile: read after longjmp */
     png_err_ctx ctx;
     ctx.msg[0] = 0;
@@ -70,11 +75,14 @@ int lf_png_write(const char *file, const char *name, int width, int height, int 
     png_infop i = info;
     png_destroy_write_struct(&p, &i);
     /* a failed flush or close is a failed write */
+    errno = 0;
     if (fflush(f) != 0 || ferror(f)) {
+        int e = errno;
         fclose(f);
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': write error", name);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': write error: %s", name,
+                            e ? strerror(e) : "stream error");
     }
     if (fclose(f) != 0)
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': write error", name);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': write error: %s", name, strerror(errno));
     return LF_OK;
 }

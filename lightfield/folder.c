@@ -4,12 +4,14 @@
 #include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "lf_lightfield.h"
 
@@ -123,9 +125,21 @@ typedef struct cfg_key {
 /* The keys lensfield uses; others are kept by the benchmark and ignored here. */
 static int read_cfg(const char *path, lf_lightfield_folder *f, lf_error *err)
 {
-    FILE *in = fopen(path, "r");
-    if (!in)
+    /* non-blocking open, regular files only: a FIFO named parameters.cfg
+     * must not hang the reader */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
         return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return lf_error_set(err, LF_ERR_IO, "cannot read '%s': not a regular file", path);
+    }
+    FILE *in = fdopen(fd, "r");
+    if (!in) {
+        close(fd);
+        return lf_error_set(err, LF_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    }
     double focal = 0, sensor = 0, resx = 0, resy = 0, camsx = 0, camsy = 0, base = 0, focus = 0, dmin = 0, dmax = 0;
     int s_focal = 0, s_sensor = 0, s_resx = 0, s_resy = 0, s_cx = 0, s_cy = 0, s_base = 0, s_focus = 0, s_dmin = 0,
         s_dmax = 0;
@@ -622,7 +636,7 @@ int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_i
     int bad = ferror(f);
     if (fclose(f) || bad || rename(tmp, path)) {
         remove(tmp);
-        return lf_error_set(err, LF_ERR_IO, "cannot write '%s'", path);
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
     }
     return LF_OK;
 }

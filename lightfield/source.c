@@ -138,7 +138,17 @@ int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_li
     const lf_lightfield_layout *flags = o->flags ? o->flags : &none;
     if (lf_lightfield_is_folder(path))
         return open_folder(o, flags, src, err);
-    if (lf_image_read(path, &src->raw, &src->attrs, err))
+    /* The layout alone needs no pixels where the header gives the size (a
+     * PNG: no attributes, no non-finite values); otherwise read it all. */
+    lf_error he = {0};
+    int hrc = o->layout_only ? lf_image_read_size(path, &src->raw.width, &src->raw.height, &src->raw.channels, &he)
+                             : LF_ERR_UNSUPPORTED;
+    if (hrc && hrc != LF_ERR_UNSUPPORTED) {
+        if (err)
+            *err = he;
+        return hrc;
+    }
+    if (hrc && lf_image_read(path, &src->raw, &src->attrs, err))
         return err ? err->code : LF_ERR_IO;
     lf_error e = {0};
     lf_lightfield_layout file;

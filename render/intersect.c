@@ -6,6 +6,17 @@
 
 #include "render/scene.h"
 
+/* Embree asserts (and aborts) on a ray whose origin or direction is beyond
+ * about 1.8e18 or not finite; the renderer refuses cameras that would make
+ * one (renderer.c, check_camera_reach), and any other such ray is a miss
+ * here rather than an abort.  NaN fails every comparison. */
+static inline int ray_in_range(lf_vec3 o, lf_vec3 d)
+{
+    const float lim = 1e18f;
+    return fabsf(o.x) <= lim && fabsf(o.y) <= lim && fabsf(o.z) <= lim && fabsf(d.x) <= lim && fabsf(d.y) <= lim &&
+           fabsf(d.z) <= lim;
+}
+
 static void init_ray(struct RTCRayHit *rh, lf_vec3 o, lf_vec3 d, float tmax, float tau)
 {
     rh->ray.org_x = o.x, rh->ray.org_y = o.y, rh->ray.org_z = o.z;
@@ -203,6 +214,8 @@ static void mesh_hit(const lf_mesh *m, int t, const lf_vec3 p[3], const lf_vec3 
 
 int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau, lf_hit *hit)
 {
+    if (!ray_in_range(o, d))
+        return 0;
     struct RTCRayHit rh;
     init_ray(&rh, o, d, tmax, tau);
     struct RTCIntersectContext ctx;
@@ -325,6 +338,8 @@ void lf_scene_sphere_uv(const lf_scene *s, lf_hit *hit)
 
 int lf_scene_occluded(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, float tau)
 {
+    if (!ray_in_range(o, d))
+        return 0;
     struct RTCRay r;
     r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
     r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;

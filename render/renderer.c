@@ -192,6 +192,16 @@ static int cp_floats(void *ctx, const char *name, double *out, int max)
     return (int)n;
 }
 
+/* A pixel coordinate from a scene's number, held within +-2^30 before the
+ * conversion (a double beyond int's range is undefined behaviour to
+ * convert); the crop check then reports it as outside the film. */
+static int pixel_index(double v)
+{
+    if (!(v > -1073741824.0)) /* also NaN */
+        return -1073741824;
+    return v < 1073741824.0 ? (int)v : 1073741824;
+}
+
 static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_entity *f = &d->film;
@@ -220,6 +230,11 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
                             r->yres);
     if (!(iso > 0))
         return lf_error_set(err, LF_ERR_PARAM, "%s: Film \"iso\" must be positive", where);
+    if (!(r->max_component > 0)) /* a clamp at or below 0 makes every pixel that value */
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: Film \"maxcomponentvalue\" must be > 0 (each sample's largest RGB component is "
+                            "clamped to it), got %g",
+                            where, r->max_component);
     r->imaging_ratio = iso / 100.0; /* times exposure time, applied once the shutter is known */
     /* pbrt-v4: cropwindow in NDC, pixelbounds in pixels (pixelbounds wins). */
     double cw[4] = {0, 1, 0, 1};
@@ -230,15 +245,16 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
             return lf_error_set(err, LF_ERR_PARAM, "%s: \"cropwindow\" needs 4 values", where);
         memcpy(cw, c, sizeof cw);
     }
-    r->px0 = (int)ceil(r->xres * fmin(cw[0], cw[1]));
-    r->px1 = (int)ceil(r->xres * fmax(cw[0], cw[1]));
-    r->py0 = (int)ceil(r->yres * fmin(cw[2], cw[3]));
-    r->py1 = (int)ceil(r->yres * fmax(cw[2], cw[3]));
+    r->px0 = pixel_index(ceil(r->xres * fmin(cw[0], cw[1])));
+    r->px1 = pixel_index(ceil(r->xres * fmax(cw[0], cw[1])));
+    r->py0 = pixel_index(ceil(r->yres * fmin(cw[2], cw[3])));
+    r->py1 = pixel_index(ceil(r->yres * fmax(cw[2], cw[3])));
     const double *pb = lf_params_nums(ps, "pixelbounds", LF_PT_INTEGER, &n);
     if (pb) {
         if (n != 4)
             return lf_error_set(err, LF_ERR_PARAM, "%s: \"pixelbounds\" needs 4 values", where);
-        r->px0 = (int)pb[0], r->px1 = (int)pb[1], r->py0 = (int)pb[2], r->py1 = (int)pb[3];
+        r->px0 = pixel_index(pb[0]), r->px1 = pixel_index(pb[1]), r->py0 = pixel_index(pb[2]),
+        r->py1 = pixel_index(pb[3]);
     }
     if (lf_params_finish(ps, "Film \"rgb\"", err))
         return err->code;
@@ -417,12 +433,20 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 
 /* The shutter every camera shares (read by the host): open and close times,
  * global or rolling, readout time and direction (docs/motion.md). */
+#define LF_SHUTTER_TIME_MAX 1e9
+
 static int read_shutter(lf_renderer *r, const option_entity *oe, lf_error *err)
 {
     lf_paramset *ps = oe->ps;
     const char *where = oe->where;
     r->shutter_open = lf_params_float(ps, "shutteropen", 0.0);
     r->shutter_close = lf_params_float(ps, "shutterclose", 1.0);
+    /* Beyond a billion seconds (32 years) the exposure scale overflows
+     * float radiance: every sample would be dropped as Inf, a black image. */
+    if (!(fabs(r->shutter_open) <= LF_SHUTTER_TIME_MAX && fabs(r->shutter_close) <= LF_SHUTTER_TIME_MAX))
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: \"shutteropen\" %g and \"shutterclose\" %g must lie within +-%g seconds", where,
+                            r->shutter_open, r->shutter_close, LF_SHUTTER_TIME_MAX);
     if (r->shutter_close < r->shutter_open) {
         lf_warn_at(&r->warnings, oe->loc, "shutterclose < shutteropen; swapping them (as pbrt does)");
         double t = r->shutter_open;
@@ -560,6 +584,77 @@ static int read_camera_motion(lf_renderer *r, lf_scene_desc *d, const char *wher
     return 0;
 }
 
+/* Embree asserts that a ray's origin and direction are within about 1.8e18
+ * (its FLT_LARGE) and aborts otherwise; a camera a scene placed that far is
+ * refused here with its parameters named, long before, at a bound (1e15
+ * scene units) that still leaves float rays a thousand-fold margin. */
+#define LF_SCENE_COORD_MAX 1e15
+
+static int coord_ok(lf_dvec3 v)
+{
+    return fabs(v.x) <= LF_SCENE_COORD_MAX && fabs(v.y) <= LF_SCENE_COORD_MAX && fabs(v.z) <= LF_SCENE_COORD_MAX;
+}
+
+static int camera_to_world_ok(const lf_transform *c2w)
+{
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            if (!(fabs(c2w->m[i][j]) <= LF_SCENE_COORD_MAX))
+                return 0;
+    return 1;
+}
+
+/* The camera's placement and a few of its rays (the film's corners, edges
+ * and centre, the lens's rim and centre, the shutter's ends) in world
+ * space: finite and within LF_SCENE_COORD_MAX, or the render is refused. */
+static int check_camera_reach(lf_renderer *r, const char *where, lf_error *err)
+{
+    lf_transform keys[2];
+    int nk = 1;
+    keys[0] = r->camera_to_world;
+    if (r->camera_moving) {
+        lf_motion_pair_matrix(&r->camera_motion, 0, keys[0].m);
+        lf_motion_pair_matrix(&r->camera_motion, 1, keys[1].m);
+        nk = 2;
+    }
+    for (int k = 0; k < nk; k++)
+        if (!camera_to_world_ok(&keys[k]))
+            return lf_error_set(err, LF_ERR_NUMERIC,
+                                "%s: the camera's %splacement (its transform) is out of range: every coordinate must "
+                                "be finite with |coordinate| <= %g scene units",
+                                where, nk == 2 ? (k ? "end " : "start ") : "", LF_SCENE_COORD_MAX);
+    static const double film[3] = {0, 0.5, 1}, lens[3] = {0.001, 0.5, 0.999};
+    enum { N = 9 * 9 };
+    lf_camera_sample cs[N];
+    lf_camera_ray cr[N];
+    double w[N];
+    for (int t = 0; t < nk; t++) {
+        double time = t ? r->shutter_close : r->shutter_open;
+        for (int i = 0; i < N; i++) {
+            int f = i / 9, l = i % 9;
+            cs[i] = (lf_camera_sample){film[f % 3] * r->xres, film[f / 3] * r->yres, lens[l % 3], lens[l / 3], time, 0.5};
+            cr[i].time = time;
+            cr[i].wavelength_nm = 0;
+        }
+        lf_camera_generate_rays(r->camera_type, r->camera, N, cs, cr, w);
+        for (int i = 0; i < N; i++) {
+            if (!(w[i] > 0) || !isfinite(w[i]))
+                continue; /* vignetted: not traced */
+            lf_dvec3 o = lf_xform_point_d(&keys[t], (lf_dvec3){cr[i].origin[0], cr[i].origin[1], cr[i].origin[2]});
+            lf_dvec3 d = lf_xform_vector_d(&keys[t], (lf_dvec3){cr[i].dir[0], cr[i].dir[1], cr[i].dir[2]});
+            double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+            if (!coord_ok(o) || !(dl > 0) || !isfinite(dl))
+                return lf_error_set(err, LF_ERR_NUMERIC,
+                                    "%s: Camera \"%s\": its rays are out of range (origin %g %g %g, direction %g %g "
+                                    "%g in world space): a ray must start within |coordinate| <= %g scene units and "
+                                    "have a finite, non-zero direction; check the camera's size, focus and screen "
+                                    "parameters and its transform",
+                                    where, r->camera_name, o.x, o.y, o.z, d.x, d.y, d.z, LF_SCENE_COORD_MAX);
+        }
+    }
+    return 0;
+}
+
 static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_camera_desc *cd = &d->camera;
@@ -589,6 +684,8 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     rc = create_camera(r, cd, &oe, err);
     if (!rc)
         rc = read_camera_motion(r, d, where, err);
+    if (!rc)
+        rc = check_camera_reach(r, where, err);
     if (rc)
         return rc;
     return option_entity_finish(&oe, "Camera", err);
@@ -670,6 +767,11 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
                    "Integrator \"path\" ignores participating media (as pbrt-v4's); \"volpath\" "
                    "renders them");
     }
+    if (!r->white && r->scene.n_lights == 0) /* a black image is all such a scene can make */
+        lf_warn_at(&r->warnings, NULL, "%s: the image will be black",
+                   r->scene.n_meshes + r->scene.n_spheres + r->scene.n_instances
+                       ? "nothing lights the world (no LightSource and no AreaLightSource)"
+                       : "the world is empty (no shapes and no lights)");
     if (d->accelerator.type)
         for (size_t i = 0; i < d->accelerator.params.count; i++)
             d->accelerator.params.items[i].used = 1; /* Embree builds its own BVH */

@@ -29,6 +29,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -39,6 +40,11 @@
 #include <unistd.h>
 
 #define MAX_INCLUDE_DEPTH 64
+/* AttributeBegin/ObjectBegin/TransformBegin nesting: each level keeps a
+ * copy of the graphics state (about 6 KB), so 1M levels in a 15 KB .pbrt.gz
+ * took 6 GB.  Real scenes nest a few levels (exporters: tens); 10,000 keeps
+ * the stack under 60 MB. */
+#define MAX_BLOCK_DEPTH 10000
 
 /* ------------------------------------------------------------------------ */
 /* Small utilities                                                          */
@@ -164,6 +170,8 @@ typedef struct lx_frame {
     int line, col;
     const char *file; /* kept in the description's strings */
     const char *dir;  /* directory of file */
+    int included;     /* read by Include/Import: refused whole if it does not start as a scene */
+    int directives;   /* directives read from it so far */
 } lx_frame;
 
 typedef struct lexer {
@@ -190,11 +198,13 @@ static int lx_getc(lx_frame *L)
     if (L->pos >= L->len)
         return EOF;
     int c = (unsigned char)L->text[L->pos++];
+    /* saturating: a line over 2 GiB (or a file of 2^31 lines) must not
+     * overflow the int; its locations then say INT_MAX */
     if (c == '\n') {
-        L->line++;
+        L->line += L->line < INT_MAX;
         L->col = 1;
     } else {
-        L->col++;
+        L->col += L->col < INT_MAX;
     }
     return c;
 }
@@ -221,7 +231,8 @@ static int lx_push(lexer *X, char *owned, const char *text, size_t len, const ch
         X->done = n;
         X->cap_done = nc;
     }
-    X->fr[X->n_fr++] = (lx_frame){owned, text, len, 0, 1, 1, file, dir};
+    X->fr[X->n_fr] = (lx_frame){owned, text, len, 0, 1, 1, file, dir, X->n_fr > 0, 0};
+    X->n_fr++;
     return 0;
 }
 
@@ -1088,9 +1099,20 @@ static int d_lookat(parser *P, lexer *L, const token *dir)
     if (rc)
         return rc;
     lf_transform t;
-    if (lf_transform_look_at(v, v + 3, v + 6, &t))
+    if (lf_transform_look_at(v, v + 3, v + 6, &t)) {
+        /* Distinct but huge numbers cancel (1e19 + 1 == 1e19) or overflow
+         * when squared: say so rather than that eye equals look. */
+        double big = 0;
+        for (int i = 0; i < 9; i++)
+            big = fmax(big, fabs(v[i]));
+        if (big > 1e15 && (v[0] != v[3] || v[1] != v[4] || v[2] != v[5]))
+            return perr(P, LF_ERR_PARSE, &dir->loc,
+                        "LookAt: the numbers are too large (up to %g): at that magnitude eye, look and up cannot be "
+                        "told apart in double precision; keep |coordinate| <= 1e15 scene units",
+                        big);
         return perr(P, LF_ERR_PARSE, &dir->loc,
                     "LookAt: eye equals look, or the up vector is parallel to the viewing direction");
+    }
     apply_transform(P, &t);
     return LF_OK;
 }
@@ -1238,6 +1260,11 @@ static int d_reverse_orientation(parser *P, lexer *L, const token *dir)
 
 static int push_state(parser *P, char kind, const lf_loc *loc)
 {
+    if (P->n_stack >= MAX_BLOCK_DEPTH)
+        return perr(P, LF_ERR_PARSE, loc,
+                    "blocks (AttributeBegin, ObjectBegin, TransformBegin) nested more than %d deep: each level keeps "
+                    "a copy of the graphics state, and no scene needs that many (is an End missing?)",
+                    MAX_BLOCK_DEPTH);
     if (grow((void **)&P->stack, &P->cap_stack, P->n_stack, sizeof *P->stack))
         return nomem(P);
     pushed *e = &P->stack[P->n_stack];
@@ -2162,6 +2189,19 @@ static int parse_run(parser *P, lexer *L, lf_loc *eof)
         }
         char b[200];
         directive_fn fn = find_directive(&t);
+        lx_frame *top = &L->fr[L->n_fr - 1];
+        int from_top = t.loc.file == top->file;
+        if (!fn && from_top && top->included && top->directives == 0) {
+            /* An included file that does not begin with a directive is not a
+             * scene (Include "/etc/shadow"): refused whole, its content never
+             * echoed in messages. */
+            perr(P, LF_ERR_PARSE, &t.loc, "\"%s\" is not a scene file (it does not begin with a directive): not "
+                 "read further", top->file);
+            top->pos = top->len; /* its end: the lexer returns to the including file */
+            continue;
+        }
+        if (fn && from_top)
+            top->directives++;
         if (!fn) {
             if (t.kind != TK_WORD)
                 perr(P, LF_ERR_PARSE, &t.loc, "expected a directive, got %s", describe(&t, b, sizeof b));
@@ -2264,6 +2304,9 @@ static int parse_begin(parser *P, const lf_parse_opts *o, lf_scene_desc *out, lf
     out->transform_start_time = 0.0;
     out->transform_end_time = 1.0;
     P->gs.ctm[0] = P->gs.ctm[1] = lf_transform_identity();
+    /* a scene without a Camera directive: pbrt-v4's default camera at the
+     * origin (a zero matrix here made NaN rays and Embree aborted) */
+    out->camera.world_to_camera.xf[0] = out->camera.world_to_camera.xf[1] = P->gs.ctm[0];
     P->gs.active[0] = P->gs.active[1] = 1;
     P->gs.material = -1;
     P->gs.area_light = -1;

@@ -164,13 +164,15 @@ static int run_plot(void *ctx, int n, char **pos)
     const char *dot = strrchr(f->out, '.');
     if (!dot || (strcmp(dot, ".svg") && strcmp(dot, ".png")))
         return lf_cli_usage_error("lflens", "plot", "-o wants OUT.svg or OUT.png, got \"%s\"", f->out);
+    lf_error err = {0};
+    if (lf_output_is_input(f->out, (const char *const *)pos, 1, &err))
+        return fprintf(stderr, "lflens: %s\n", err.msg), LF_EXIT_FAIL;
     lf_lens L;
     lf_lens_report r;
     int rc = analyse(f, pos[0], &L, &r);
     if (rc)
         return rc;
     lf_plot plot;
-    lf_error err = {0};
     rc = lf_lens_plot_build(&L, &r, &plot, &err) || write_plot(&plot, f->out, &err);
     if (rc)
         fprintf(stderr, "lflens: %s\n", err.msg);

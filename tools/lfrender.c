@@ -41,6 +41,10 @@ static int run_merge(void *ctx, int n, char **parts)
     lf_error err = {0};
     lf_image img;
     lf_attrs meta = {0};
+    if (lf_output_is_input(f->out, (const char *const *)parts, n, &err)) {
+        fprintf(stderr, "lfrender: %s\n", err.msg);
+        return LF_EXIT_FAIL;
+    }
     int rc = lf_render_merge((const char **)parts, n, &img, &meta, &err);
     if (!rc) { /* write as the unsplit render would: Film "savefp16" travels in the parts */
         const lf_attr *h = lf_attrs_get(&meta, LF_KEY_SAVEFP16);
@@ -129,7 +133,7 @@ static int check_output(const flags *f, lf_renderer *r, const lf_render_opts *o,
         return lf_cli_usage_error("lfrender", NULL, "--aov disparity needs an .exr output and an unsplit render (no "
                                   "--part, --tile, --spp-range)");
     lf_error err = {0};
-    if (lf_file_check_writable(*out, &err)) {
+    if (lf_output_is_input(*out, &o->scene_path, 1, &err) || lf_file_check_writable(*out, &err)) {
         fprintf(stderr, "lfrender: %s\n", err.msg);
         return LF_EXIT_FAIL;
     }
@@ -213,9 +217,11 @@ static int run_render(void *ctx, int n, char **pos)
         fputs(lf_renderer_warnings(r), stderr);
     char ckpath[4200];
     if ((rc = check_output(f, r, &o, &out)) < 0) {
+        lf_file_temp_clean(out); /* a killed run's half-written temporaries (issue 32) */
         if (stop) {
             snprintf(ckpath, sizeof ckpath, "%s.checkpoint.exr", out);
             o.checkpoint_path = f->checkpoint ? f->checkpoint : ckpath;
+            lf_file_temp_clean(o.checkpoint_path);
             o.stop = stop;
             lf_renderer_set_opts(r, &o); /* the renderer copied the options at create */
         }

@@ -168,11 +168,27 @@ static int fail(const lf_error *err, const char *name)
     return LF_EXIT_FAIL;
 }
 
+/* No output may be one of the inputs (issue 32): refused before reading.
+ * --confidence is written by depth and read by view and synth. */
+static int refuse_overwrite(const opts *o)
+{
+    int conf_out = !strcmp(o->cmd, "depth");
+    const char *in[] = {o->input, o->white, o->dispmap, conf_out ? NULL : o->confidence};
+    const char *out[] = {o->output, o->coverage, conf_out ? o->confidence : NULL};
+    lf_error err = {0};
+    for (int i = 0; i < 3; i++)
+        if (lf_output_is_input(out[i], in, 4, &err))
+            return fail(&err, NULL);
+    return LF_EXIT_OK;
+}
+
 /* Reads the raw (or folder of views) and resolves its layout (attributes +
  * flags); decodes unless layout_only. */
 static int load(const opts *o, lf_lightfield_source *s, int layout_only)
 {
     lf_error err = {0};
+    if (refuse_overwrite(o))
+        return LF_EXIT_FAIL;
     lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only, .grid = o->grid};
     if (lf_lightfield_open(o->input, &oo, s, &err))
         return fail(&err, NULL);
@@ -555,6 +571,8 @@ static int cmd_calibrate(void *ctx, int n, char **pos)
     lf_image white;
     lf_attrs a = {0}; /* only the estimated layout: the input's own header is not carried over */
     lf_error err = {0};
+    if (refuse_overwrite(o))
+        return LF_EXIT_FAIL;
     if (lf_image_read(o->input, &white, NULL, &err))
         return fail(&err, NULL);
     lf_lightfield_layout lay;

@@ -40,11 +40,17 @@ int lf_grade_find_assignment(const char *a, char *out, size_t n, lf_error *err)
     }
     if (slash) {
         *slash = 0;
+        /* the source tree (build/bin/../../assignments), then an install
+         * (PREFIX/bin/../share/lensfield/assignments, CMakeLists.txt) */
         if (snprintf(out, n, "%s/../../assignments/%s", exe, a) < (int)n && is_dir(out))
+            return LF_OK;
+        if (snprintf(out, n, "%s/../share/lensfield/assignments/%s", exe, a) < (int)n && is_dir(out))
             return LF_OK;
     }
     return lf_error_set(err, LF_ERR_PARAM,
-                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/)", a);
+                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/ here, in the "
+                        "source tree or in the installed share/lensfield/assignments/)",
+                        a);
 }
 
 static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, lf_error *err)

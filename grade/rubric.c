@@ -222,6 +222,11 @@ static int parse_variant_field(lf_grade_variant *va, char *kv, const lf_loc *at,
         snprintf(va->measure, sizeof va->measure, "%s", val);
     else if (!strcmp(kv, "base"))
         va->base = atof(val);
+    else if (!strcmp(kv, "brightness")) {
+        va->brightness = atof(val);
+        if (!(va->brightness > 0))
+            return lf_error_at(err, LF_ERR_PARSE, at, "brightness= wants a factor > 0");
+    }
     else if (!strcmp(kv, "range")) {
         if (sscanf(val, "%lf:%lf", &va->lo, &va->hi) != 2 || !(va->lo > 0) || !(va->hi > va->lo))
             return lf_error_at(err, LF_ERR_PARSE, at, "range= wants LO:HI factors, 0 < LO < HI");

@@ -1171,10 +1171,12 @@ static double saturation_bound(const lf_image *x, const lf_image *a)
     return isfinite(amin) && amin > 0 ? 1 / amin : 1;
 }
 
-/* "14.1x too bright" / "2.0x too dark" */
+/* "14.1x too bright" / "2.0x too dark" / "4% too bright" (near 1) */
 static void brightness_words(double k, char *out, size_t n)
 {
-    if (k >= 1)
+    if (k > 0.75 && k < 1.5)
+        snprintf(out, n, "%.0f%% too %s", 100 * fabs(k - 1), k >= 1 ? "bright" : "dark");
+    else if (k >= 1)
         snprintf(out, n, "%.1fx too bright", k);
     else
         snprintf(out, n, "%.1fx too dark", 1 / k);

@@ -9,13 +9,14 @@
  *   lf_lens_spot s;                     // film at lens.film_distance_mm (set by the report)
  *   lf_lens_spot_diagram(&lens, 10 * M_PI / 180, 61, &s, &err); ... s.rms_mm ...; lf_lens_spot_free(&s);
  *   lf_plot plot; lf_lens_plot_build(&lens, &r, &plot, &err);
- *   char *svg = lf_plot_svg(&plot);     // or lf_plot_raster() into an RGB buffer
+ *   char *svg = lf_plot_svg(&plot);     // or lf_image_from_plot() (image/: pixels, with text)
  *   lf_plot_free(&plot);
  */
 #ifndef LF_LENS_ANALYSIS_H
 #define LF_LENS_ANALYSIS_H
 
 #include "base/lf_error.h"
+#include "base/lf_plot.h"
 #include "lens.h"
 
 typedef struct lf_lens_report {
@@ -77,34 +78,10 @@ void lf_lens_spot_free(lf_lens_spot *spot);
 int lf_lens_distortion_curve(const lf_lens *lens, const lf_lens_paraxial *px, double image_circle_mm, int n,
                              double *theta_deg, double *percent);
 
-/* ---- drawings: a list of vector primitives, as SVG or rasterised ---- */
-typedef enum { LF_PLOT_POLYLINE, LF_PLOT_POLYGON, LF_PLOT_DOT, LF_PLOT_TEXT } lf_plot_kind;
-
-typedef struct lf_plot_prim {
-    lf_plot_kind kind;
-    double *pts; /* x0 y0 x1 y1 ... (pixels) */
-    int n;       /* points */
-    unsigned color, fill; /* 0xRRGGBB */
-    double width;
-    int dashed;
-    char *text;
-} lf_plot_prim;
-
-typedef struct lf_plot {
-    lf_plot_prim *p;
-    size_t n, cap;
-    int w, h;
-    int failed; /* memory ran out while drawing */
-} lf_plot;
+/* ---- drawings: a list of vector primitives (base/lf_plot.h) ---- */
 
 /* The cross-section with traced ray fans (on axis, 0.7 and full field),
  * spot diagrams at four field angles and the distortion curve. */
 int lf_lens_plot_build(const lf_lens *lens, const lf_lens_report *r, lf_plot *plot, lf_error *err);
-/* The drawing as an SVG document (malloc'd; NULL when memory runs out). */
-char *lf_plot_svg(const lf_plot *plot);
-/* Rasterises the lines and dots (no text) into a w x h linear RGB float
- * buffer (sRGB colours decoded), white background. */
-void lf_plot_raster(const lf_plot *plot, float *rgb);
-void lf_plot_free(lf_plot *plot);
 
 #endif

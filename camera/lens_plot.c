@@ -1,6 +1,6 @@
 /* The lflens drawing (lens_analysis.h): cross-section with traced ray fans,
- * spot diagrams and distortion, as vector primitives; SVG and raster
- * output. */
+ * spot diagrams and distortion, as vector primitives (base/lf_plot.h: SVG
+ * there, pixels with text in image/). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -272,103 +272,4 @@ int lf_lens_plot_build(const lf_lens *L, const lf_lens_report *r, lf_plot *d, lf
     if (d->failed)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory drawing %s", L->path);
     return LF_OK;
-}
-
-char *lf_plot_svg(const lf_plot *d)
-{
-    lf_strbuf b = {0};
-    lf_strbuf_printf(&b, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">\n",
-                     d->w, d->h, d->w, d->h);
-    lf_strbuf_puts(&b, "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n");
-    for (size_t i = 0; i < d->n; i++) {
-        const lf_plot_prim *q = &d->p[i];
-        if (q->kind == LF_PLOT_DOT) {
-            lf_strbuf_printf(&b, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"0.8\" fill=\"#%06x\"/>\n", q->pts[0], q->pts[1],
-                             q->color);
-        } else if (q->kind == LF_PLOT_TEXT) {
-            lf_strbuf_printf(&b, "<text x=\"%.1f\" y=\"%.1f\" font-family=\"sans-serif\" font-size=\"12\" fill=\"#333\">",
-                             q->pts[0], q->pts[1]);
-            for (const char *c = q->text ? q->text : ""; *c; c++)
-                if (*c == '<')
-                    lf_strbuf_puts(&b, "&lt;");
-                else if (*c == '&')
-                    lf_strbuf_puts(&b, "&amp;");
-                else
-                    lf_strbuf_append(&b, c, 1);
-            lf_strbuf_puts(&b, "</text>\n");
-        } else {
-            lf_strbuf_printf(&b, "<%s points=\"", q->kind == LF_PLOT_POLYGON ? "polygon" : "polyline");
-            for (int j = 0; j < q->n; j++)
-                lf_strbuf_printf(&b, "%.2f,%.2f ", q->pts[2 * j], q->pts[2 * j + 1]);
-            if (q->kind == LF_PLOT_POLYGON)
-                lf_strbuf_printf(&b, "\" fill=\"#%06x", q->fill);
-            else
-                lf_strbuf_puts(&b, "\" fill=\"none");
-            lf_strbuf_printf(&b, "\" stroke=\"#%06x\" stroke-width=\"%.2f\"%s/>\n", q->color, q->width,
-                             q->dashed ? " stroke-dasharray=\"6,4\"" : "");
-        }
-    }
-    lf_strbuf_puts(&b, "</svg>\n");
-    if (b.failed) {
-        lf_strbuf_free(&b);
-        return NULL;
-    }
-    return lf_strbuf_take(&b);
-}
-
-static float srgb_to_linear(unsigned v)
-{
-    double c = v / 255.0;
-    return (float)(c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4));
-}
-
-static void put(float *rgb, int w, int h, int x, int y, unsigned c)
-{
-    if (x < 0 || y < 0 || x >= w || y >= h)
-        return;
-    float *p = rgb + 3 * ((size_t)y * (size_t)w + (size_t)x);
-    p[0] = srgb_to_linear(c >> 16 & 255), p[1] = srgb_to_linear(c >> 8 & 255), p[2] = srgb_to_linear(c & 255);
-}
-
-static void raster_line(float *rgb, int w, int h, const double *a, const double *b, unsigned c, int dashed)
-{
-    for (int k = 0; k < 2; k++)
-        if (!(fabs(a[k]) < 1e6 && fabs(b[k]) < 1e6)) /* off any sane canvas (or NaN) */
-            return;
-    double len = fmax(fabs(b[0] - a[0]), fabs(b[1] - a[1]));
-    int n = (int)ceil(len) + 1;
-    for (int i = 0; i <= n; i++) {
-        double t = (double)i / n;
-        if (dashed && ((int)(t * len) / 5) % 2)
-            continue;
-        put(rgb, w, h, (int)floor(a[0] + t * (b[0] - a[0])), (int)floor(a[1] + t * (b[1] - a[1])), c);
-    }
-}
-
-void lf_plot_raster(const lf_plot *d, float *rgb)
-{
-    for (size_t i = 0; i < (size_t)d->w * (size_t)d->h * 3; i++)
-        rgb[i] = 1.0f;
-    for (size_t i = 0; i < d->n; i++) {
-        const lf_plot_prim *q = &d->p[i];
-        if (q->kind == LF_PLOT_DOT && isfinite(q->pts[0]) && isfinite(q->pts[1]) && fabs(q->pts[0]) < 1e6 &&
-            fabs(q->pts[1]) < 1e6) {
-            put(rgb, d->w, d->h, (int)q->pts[0], (int)q->pts[1], q->color);
-        } else if (q->kind == LF_PLOT_POLYLINE || q->kind == LF_PLOT_POLYGON) {
-            for (int j = 0; j + 1 < q->n; j++)
-                raster_line(rgb, d->w, d->h, &q->pts[2 * j], &q->pts[2 * j + 2], q->color, q->dashed);
-            if (q->kind == LF_PLOT_POLYGON && q->n > 2)
-                raster_line(rgb, d->w, d->h, &q->pts[2 * q->n - 2], &q->pts[0], q->color, 0);
-        }
-    }
-}
-
-void lf_plot_free(lf_plot *d)
-{
-    for (size_t i = 0; i < d->n; i++) {
-        free(d->p[i].pts);
-        free(d->p[i].text);
-    }
-    free(d->p);
-    memset(d, 0, sizeof *d);
 }

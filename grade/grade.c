@@ -866,18 +866,56 @@ static void search_text(const lf_grade_variant *v, const char *text, double fact
     out[k < n ? k : n - 1] = 0;
 }
 
-/* ratio of the submission against variant v (two seeds); < 0 grader error */
+/* The gain k of x ~ k v, least squares over the values x does not clip
+ * (an 8-bit image saturates: its clipped part says only "at least"). */
+static double fit_gain(const lf_image *x, const lf_image *v, int eight_bit)
+{
+    double sxv = 0, svv = 0;
+    size_t n = (size_t)x->width * x->height * (size_t)x->channels;
+    for (size_t i = 0; i < n; i++) {
+        if (eight_bit && x->data[i] >= 0.98f)
+            continue;
+        sxv += (double)x->data[i] * v->data[i], svv += (double)v->data[i] * v->data[i];
+    }
+    return svv > 0 && sxv > 0 ? sxv / svv : NAN;
+}
+
+static void scale_image(lf_image *im, double k)
+{
+    size_t n = (size_t)im->width * im->height * (size_t)im->channels;
+    for (size_t i = 0; i < n; i++)
+        im->data[i] = (float)(im->data[i] * k);
+}
+
+/* ratio of the submission against variant v (two seeds; NULL: the correct
+ * reference); < 0 grader error.  With gain non-NULL, also the ratio once v
+ * is scaled by the gain fitted to x (*gain, *gain_ratio): the same mistake
+ * at another exposure. */
 static double variant_ratio(compare_job *j, const lf_grade_variant *v, const lf_image *x, int eight_bit,
-                            const lf_image *a, char *why, size_t wn, int *grader_err)
+                            const lf_image *a, char *why, size_t wn, int *grader_err, double *gain,
+                            double *gain_ratio)
 {
     lf_image va = {0}, vb = {0};
     int rc = j->make(j, v, 0, &va, why, wn);
     if (!rc)
         rc = j->make(j, v, 1, &vb, why, wn);
     double r = INFINITY;
+    if (gain)
+        *gain = NAN, *gain_ratio = INFINITY;
     if (rc == -2)
         *grader_err = 1;
     else if (!rc && va.width == a->width && va.height == a->height && vb.width == a->width && vb.height == a->height) {
+        double k = gain ? fit_gain(x, &va, eight_bit) : NAN;
+        if (isfinite(k)) {
+            lf_image ga = {0}, gb = {0};
+            if (!copy_image(&va, &ga) && !copy_image(&vb, &gb)) {
+                scale_image(&ga, k), scale_image(&gb, k);
+                if (eight_bit)
+                    lf_grade_quantize8(&ga), lf_grade_quantize8(&gb);
+                *gain = k, *gain_ratio = lf_grade_noise_ratio(x, &ga, &ga, &gb);
+            }
+            lf_image_free(&ga), lf_image_free(&gb);
+        }
         if (eight_bit)
             lf_grade_quantize8(&va), lf_grade_quantize8(&vb);
         r = lf_grade_noise_ratio(x, &va, &va, &vb);
@@ -952,7 +990,7 @@ static int ratio_at(compare_job *j, const lf_grade_variant *v, double l, subject
     lf_grade_variant inst;
     if (instantiate(v, v->base * exp(l), &inst))
         return -1;
-    *r = variant_ratio(j, &inst, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr);
+    *r = variant_ratio(j, &inst, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr, NULL, NULL);
     free_instance(&inst);
     return 0;
 }
@@ -1042,36 +1080,64 @@ static double clipped_fraction(const lf_image *x)
 }
 
 /* The verdict on a failed comparison: the known mistake that matches best,
- * what the searches measured. */
+ * what the searches measured.  The diagnosis comes first in the reason and
+ * only what supports it follows; fits against the correct reference are
+ * listed only when nothing accounts for the image (they would contradict a
+ * right diagnosis: a pinhole's image fits no focus distance). */
 typedef struct diagnosis {
     const lf_grade_variant *best;
-    char best_reason[600], found[700];
+    char best_reason[600], best_measure[420], found[900];
     size_t nfound;
     double clipped;
+    /* the best fixed variant at a fitted exposure: gain_variant x gain
+     * matches at gain_ratio (gain against the variant's own exposure) */
+    const lf_grade_variant *gain_variant;
+    double gain, gain_ratio;
+    /* the correct reference at a fitted exposure: a uniform brightness error */
+    double uniform_gain, uniform_ratio;
+    /* the exposure of the named mistake over the correct one (1: as the reason says) */
+    double exposure;
 } diagnosis;
 
 /* Fixed variants, each with its own two seeds (its noise can differ: a
- * pinhole is noisier).  Returns the lowest ratio among them. */
+ * pinhole is noisier), as given and at the exposure fitted to the image.
+ * Returns the lowest ratio as given. */
 static double match_fixed_variants(compare_job *j, subject *t, diagnosis *d)
 {
     lf_grade_check_result *r = j->res;
     double fixed_ratio = INFINITY;
+    d->gain_ratio = d->uniform_ratio = INFINITY;
+    d->gain = d->uniform_gain = NAN;
+    variant_ratio(j, NULL, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr, &d->uniform_gain,
+                  &d->uniform_ratio);
     for (int k = 0; k < j->c->nvariants && !t->gerr; k++) {
         const lf_grade_variant *v = &j->c->variants[k];
         if (!v->search) {
-            double rv = variant_ratio(j, v, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr);
-            if (rv < r->variant_ratio)
+            double g, rg;
+            double rv = variant_ratio(j, v, t->x, t->eight_bit, t->a, t->why, sizeof t->why, &t->gerr, &g, &rg);
+            if (rv < r->variant_ratio) {
                 r->variant_ratio = rv, d->best = v, snprintf(d->best_reason, sizeof d->best_reason, "%s", v->reason);
+                /* measured: the variant's exposure times the gain fitted against it */
+                d->exposure = (v->brightness > 0 ? v->brightness : 1) * (isfinite(g) ? g : 1);
+            }
+            if (rg < d->gain_ratio)
+                d->gain_ratio = rg, d->gain = g, d->gain_variant = v;
             fixed_ratio = fmin(fixed_ratio, rv);
         }
     }
     return fixed_ratio;
 }
 
+/* What a search's ratio at its best value means. */
+static const char *search_meaning(double ratio, double max_ratio)
+{
+    return ratio <= max_ratio ? "accounts for the image" : "does not account for the image";
+}
+
 /* Searches (a scene value scaled over a range: any focus error, aperture,
  * sensor size or shutter): each located on a grid, refined, and named
  * unless a fixed variant already explains the image or it is clipped. */
-static void search_variants(compare_job *j, subject *t, diagnosis *d, int named_ok)
+static void search_variants(compare_job *j, subject *t, diagnosis *d, int named_ok, double max_ratio)
 {
     lf_grade_check_result *r = j->res;
     for (int k = 0; k < j->c->nvariants && !t->gerr && j->make == make_render; k++) {
@@ -1083,49 +1149,123 @@ static void search_variants(compare_job *j, subject *t, diagnosis *d, int named_
         if (bi < 0 || t->gerr)
             continue;
         double lbest = refine_full_count(j, v, t, grid_vertex(ll, rr, bi, ns), 0.5 * (ll[1] - ll[0]), &rfull);
+        char m[400] = "";
         if (v->measure[0] && d->nfound + 8 < sizeof d->found) {
-            char m[400];
             search_text(v, v->measure, exp(lbest), m, sizeof m);
-            d->nfound += (size_t)snprintf(d->found + d->nfound, sizeof d->found - d->nfound, "; %s (%.1fx)", m, rfull);
+            d->nfound += (size_t)snprintf(d->found + d->nfound, sizeof d->found - d->nfound,
+                                          "; %s (there: %.1fx the Monte Carlo noise level, %s)", m, rfull,
+                                          search_meaning(rfull, max_ratio));
             if (d->nfound >= sizeof d->found)
                 d->nfound = sizeof d->found - 1;
         }
         if (named_ok && rfull < r->variant_ratio) {
-            r->variant_ratio = rfull, d->best = v;
+            r->variant_ratio = rfull, d->best = v, d->exposure = 1;
             search_text(v, v->reason, exp(lbest), d->best_reason, sizeof d->best_reason);
+            snprintf(d->best_measure, sizeof d->best_measure, "%s", m);
         }
     }
 }
 
-/* The failure's reason: the matching mistake, or the measurements of an
- * unrecognised one. */
-static void report_failure(compare_job *j, const sub_image *im, const lf_image *a, const diagnosis *d,
-                           double max_ratio)
+/* The fraction of clipped pixels above which an 8-bit image is only "too bright". */
+#define SATURATED 0.95
+
+/* A lower bound of the exposure factor of an image clipped at white: every
+ * clipped value k a >= 1, so k >= 1 / a (a the reference, values a visible
+ * pixel would hold). */
+static double saturation_bound(const lf_image *x, const lf_image *a)
+{
+    double amin = INFINITY;
+    size_t n = (size_t)x->width * x->height * (size_t)x->channels;
+    for (size_t i = 0; i < n; i++)
+        if (x->data[i] >= 0.999f && a->data[i] > 1.0f / 255)
+            amin = fmin(amin, a->data[i]);
+    return isfinite(amin) && amin > 0 ? 1 / amin : 1;
+}
+
+/* "14.1x too bright" / "2.0x too dark" / "4% too bright" (near 1) */
+static void brightness_words(double k, char *out, size_t n)
+{
+    if (k > 0.75 && k < 1.5)
+        snprintf(out, n, "%.0f%% too %s", 100 * fabs(k - 1), k >= 1 ? "bright" : "dark");
+    else if (k >= 1)
+        snprintf(out, n, "%.1fx too bright", k);
+    else
+        snprintf(out, n, "%.1fx too dark", 1 / k);
+}
+
+/* What the noise ratio of the image against the correct reference means. */
+static void noise_words(double ratio, double max_ratio, int spp, char *out, size_t n)
+{
+    snprintf(out, n, "%.1fx the Monte Carlo noise level of the reference at %d spp: %s; pass <= %.1fx", ratio, spp,
+             ratio <= max_ratio ? "within the noise" : "a real difference, not noise", max_ratio);
+}
+
+/* The failure's reason: the diagnosis first (a known mistake, a uniform
+ * exposure error, a known mistake at another exposure), then what supports
+ * it; or, when nothing accounts for the image, every measurement. */
+static void report_failure(compare_job *j, const sub_image *im, const lf_image *a, diagnosis *d, double max_ratio)
 {
     lf_grade_check_result *r = j->res;
-    measure(j, &im->img, a, r->measurements, sizeof r->measurements);
-    if (d->clipped > 0.2) {
-        size_t l = strlen(r->measurements);
-        snprintf(r->measurements + l, sizeof r->measurements - l,
-                 "; %.0f%% of the pixels clipped at white (over-exposed: brightness and exposure cannot be measured "
-                 "there)",
+    char noise[200], bw[64], clip[200] = "";
+    noise_words(r->noise_ratio, max_ratio, j->spp, noise, sizeof noise);
+    if (d->clipped > 0.2)
+        snprintf(clip, sizeof clip,
+                 "; %.0f%% of the pixels clipped at white (over-exposed: the mean brightness there is only a lower "
+                 "bound)",
                  100 * d->clipped);
+    if (d->clipped >= SATURATED) {
+        double bright = lf_grade_mean(&im->img) / fmax(lf_grade_mean(a), 1e-12);
+        snprintf(r->measurements, sizeof r->measurements, "mean brightness %.2fx the reference%s", bright, clip);
+        snprintf(r->best_variant, sizeof r->best_variant, "over-exposed");
+        brightness_words(saturation_bound(&im->img, a), bw, sizeof bw);
+        fail(r, "%s: over-exposed: %.0f%% of the pixels clipped at white, at least %s: check the ray weight and the "
+                "exposure (a white image shows nothing else; against the correct reference: %s); measured: %s",
+             im->file, 100 * d->clipped, bw, noise, r->measurements);
+        return;
     }
-    if (d->found[0]) {
+    int named = d->best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio;
+    int uniform = !named && d->uniform_ratio <= max_ratio && isfinite(d->uniform_gain);
+    int gained = !named && !uniform && d->gain_variant && d->gain_ratio <= max_ratio;
+    if (named || uniform || gained) {
+        size_t k = 0;
+        double bright = lf_grade_mean(&im->img) / fmax(lf_grade_mean(a), 1e-12);
+        appendf(r->measurements, sizeof r->measurements, &k, "mean brightness %.2fx the reference%s", bright, clip);
+        if (named && d->best_measure[0])
+            appendf(r->measurements, sizeof r->measurements, &k, "; %s", d->best_measure);
+    } else {
+        measure(j, &im->img, a, r->measurements, sizeof r->measurements);
         size_t l = strlen(r->measurements);
-        snprintf(r->measurements + l, sizeof r->measurements - l, "%s", d->found);
+        snprintf(r->measurements + l, sizeof r->measurements - l, "%s%s", clip, d->found);
     }
-    if (d->best)
+    if (named) {
         snprintf(r->best_variant, sizeof r->best_variant, "%s", d->best->name);
-    if (d->best && r->variant_ratio <= max_ratio && r->variant_ratio < r->noise_ratio)
-        fail(r, "%s: %s (matches the reference for that mistake at %.2fx the Monte Carlo noise level; the correct "
-                "reference: %.1fx, pass <= %.1fx); measured: %s",
-             im->file, d->best_reason, r->variant_ratio, r->noise_ratio, max_ratio, r->measurements);
-    else
-        fail(r, "%s differs from the reference: %.1fx the Monte Carlo noise level at %d spp (pass <= %.1fx); "
-                "unrecognised mistake, measured: %s%s",
-             im->file, r->noise_ratio, j->spp, max_ratio, r->measurements,
-             d->best ? " (no known mistake accounts for it)" : "");
+        char extra[160] = "";
+        if (fabs(log(d->exposure)) > log(1.1)) {
+            brightness_words(d->exposure, bw, sizeof bw);
+            snprintf(extra, sizeof extra, "; %s: check the ray weight and the exposure", bw);
+        }
+        fail(r, "%s: %s%s (the image matches the reference for that mistake at %.2fx the Monte Carlo noise level; "
+                "against the correct reference: %s); measured: %s",
+             im->file, d->best_reason, extra, r->variant_ratio, noise, r->measurements);
+    } else if (uniform) {
+        snprintf(r->best_variant, sizeof r->best_variant, "exposure");
+        r->variant_ratio = d->uniform_ratio;
+        brightness_words(d->uniform_gain, bw, sizeof bw);
+        fail(r, "%s: uniformly %s: check the ray weight and the exposure (scaled by %.3g, the image matches the "
+                "reference at %.2fx the Monte Carlo noise level; as it is: %s); measured: %s",
+             im->file, bw, 1 / d->uniform_gain, d->uniform_ratio, noise, r->measurements);
+    } else if (gained) {
+        const lf_grade_variant *v = d->gain_variant;
+        snprintf(r->best_variant, sizeof r->best_variant, "%s", v->name);
+        r->variant_ratio = d->gain_ratio;
+        brightness_words(d->gain * (v->brightness > 0 ? v->brightness : 1), bw, sizeof bw);
+        fail(r, "%s: %s; and %s: check the ray weight and the exposure (at that exposure the image matches the "
+                "reference for that mistake at %.2fx the Monte Carlo noise level; against the correct reference: "
+                "%s); measured: %s",
+             im->file, v->reason, bw, d->gain_ratio, noise, r->measurements);
+    } else
+        fail(r, "%s differs from the reference: %s; unrecognised mistake, measured: %s%s", im->file, noise,
+             r->measurements, d->best ? " (no known mistake accounts for it)" : "");
 }
 
 /* The scores of x against the correct reference a (b: its second seed),
@@ -1180,12 +1320,20 @@ static int compare(compare_job *j, submission *s, lf_error *err)
     if (r->noise_ratio > max_ratio) {
         diagnosis d = {0};
         r->variant_ratio = INFINITY;
-        double fixed_ratio = match_fixed_variants(j, &t, &d);
-        int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
+        d.gain_ratio = d.uniform_ratio = INFINITY;
         /* an 8-bit image clipped at white over much of its area: any larger
-         * exposure explains the clipped part, so no search is named */
+         * exposure explains the clipped part, so no search is named; one
+         * white almost everywhere says nothing but "too bright" */
         d.clipped = t.eight_bit ? clipped_fraction(&im->img) : 0;
-        search_variants(j, &t, &d, !fixed_ok && d.clipped <= 0.2);
+        if (d.clipped < SATURATED) {
+            double fixed_ratio = match_fixed_variants(j, &t, &d);
+            int fixed_ok = fixed_ratio <= max_ratio && fixed_ratio < r->noise_ratio;
+            int gain_ok = d.gain_ratio <= max_ratio && !(d.uniform_ratio <= max_ratio);
+            /* a fixed mistake that accounts for the image (at some exposure)
+             * ends the diagnosis: searches would only add contradicting fits */
+            if (!fixed_ok && !gain_ok)
+                search_variants(j, &t, &d, d.clipped <= 0.2, max_ratio);
+        }
         if (t.gerr)
             rc = lf_error_set(err, LF_ERR_INTERNAL, "check %s: %s", j->c->id, t.why);
         else

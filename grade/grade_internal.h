@@ -25,6 +25,9 @@ typedef struct lf_grade_variant {
     int search;
     double base, lo, hi;
     char measure[256]; /* what the best value means physically ({value}, {base}, {K/value}, {value*K}) */
+    /* the variant's exposure over the correct camera's, by construction
+     * (0: 1), so a brightness fitted against it reads against the correct one */
+    double brightness;
 } lf_grade_variant;
 
 typedef struct lf_grade_check {

@@ -68,7 +68,8 @@ void lf_grade_result_free(lf_grade_result *r);
 typedef struct lf_grade_ctx lf_grade_ctx;
 /* The assignment folder a command line names: NAME itself when it holds
  * rubric.txt, else assignments/NAME under the working directory, else
- * assignments/NAME beside the executable's folder (build/bin/../../).
+ * assignments/NAME beside the executable's folder (build/bin/../../), else
+ * the installed copy (PREFIX/bin/../share/lensfield/assignments/NAME).
  * LF_ERR_PARAM when none exists. */
 int lf_grade_find_assignment(const char *name, char *dir, size_t dir_size, lf_error *err);
 /* Loads ASSIGNMENT_DIR/rubric.txt (LF_ERR_PARSE with file:line on errors). */

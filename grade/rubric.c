@@ -40,11 +40,17 @@ int lf_grade_find_assignment(const char *a, char *out, size_t n, lf_error *err)
     }
     if (slash) {
         *slash = 0;
+        /* the source tree (build/bin/../../assignments), then an install
+         * (PREFIX/bin/../share/lensfield/assignments, CMakeLists.txt) */
         if (snprintf(out, n, "%s/../../assignments/%s", exe, a) < (int)n && is_dir(out))
+            return LF_OK;
+        if (snprintf(out, n, "%s/../share/lensfield/assignments/%s", exe, a) < (int)n && is_dir(out))
             return LF_OK;
     }
     return lf_error_set(err, LF_ERR_PARAM,
-                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/)", a);
+                        "%s: no such assignment (a folder with rubric.txt, or a name under assignments/ here, in the "
+                        "source tree or in the installed share/lensfield/assignments/)",
+                        a);
 }
 
 static int tokenize(const char *line, int strict, char ***argv_out, int *argc_out, lf_error *err)
@@ -216,6 +222,11 @@ static int parse_variant_field(lf_grade_variant *va, char *kv, const lf_loc *at,
         snprintf(va->measure, sizeof va->measure, "%s", val);
     else if (!strcmp(kv, "base"))
         va->base = atof(val);
+    else if (!strcmp(kv, "brightness")) {
+        va->brightness = atof(val);
+        if (!(va->brightness > 0))
+            return lf_error_at(err, LF_ERR_PARSE, at, "brightness= wants a factor > 0");
+    }
     else if (!strcmp(kv, "range")) {
         if (sscanf(val, "%lf:%lf", &va->lo, &va->hi) != 2 || !(va->lo > 0) || !(va->hi > va->lo))
             return lf_error_at(err, LF_ERR_PARSE, at, "range= wants LO:HI factors, 0 < LO < HI");

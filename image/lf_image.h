@@ -24,6 +24,7 @@
 #include <stddef.h>
 
 #include "base/lf_error.h"
+#include "base/lf_plot.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -143,6 +144,11 @@ float lf_srgb_decode(unsigned char v);
 int lf_image_mse(const lf_image *a, const lf_image *b, double *mse, lf_error *err);
 /* PSNR in dB with peak 1.0 (+inf when identical). */
 int lf_image_psnr(const lf_image *a, const lf_image *b, double *psnr_db, lf_error *err);
+
+/* A drawing (base/lf_plot.h) in pixels, its labels drawn too (Cairo, the
+ * "sans-serif" face at 12 px as the SVG asks): linear RGB on white, the
+ * drawing's size, for lf_image_write (PNG). */
+int lf_image_from_plot(const lf_plot *plot, lf_image *out, lf_error *err);
 
 #ifdef __cplusplus
 }

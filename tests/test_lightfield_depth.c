@@ -15,6 +15,7 @@
 #include "lf_test.h"
 #include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
+#include "lf_test_texture.h"
 
 enum { N = 7, W = 96, H = 96, SS = 4 };
 static const double F = 96.0, B = 0.02;
@@ -24,22 +25,6 @@ static const double ZB = 1.2, BX0 = -0.16, BX1 = 0.06, BY0 = -0.10, BY1 = 0.13;
 static int g_box;
 static double g_ox, g_oy; /* pixel offset of the rendered view (principal point), section 5 */
 
-static double hash2(int i, int j)
-{
-    uint32_t h = (uint32_t)i * 374761393u + (uint32_t)j * 668265263u;
-    h = (h ^ (h >> 13)) * 1274126177u;
-    return ((h ^ (h >> 16)) & 0xffffff) / 16777216.0;
-}
-
-/* smooth value noise, one unit per cell */
-static double vnoise(double x, double y)
-{
-    int i = (int)floor(x), j = (int)floor(y);
-    double fx = x - i, fy = y - j;
-    fx = fx * fx * (3 - 2 * fx), fy = fy * fy * (3 - 2 * fy);
-    double a = hash2(i, j), b = hash2(i + 1, j), c = hash2(i, j + 1), d = hash2(i + 1, j + 1);
-    return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
-}
 
 static void surface_colour(int box, double X, double Y, float c[3])
 {

@@ -16,26 +16,12 @@
 
 #include "lf_test.h"
 #include "lightfield/lf_source.h"
+#include "lf_test_texture.h"
 
 enum { N = 5, W = 160, H = 160, SS = 2 };
 static const double F = 160.0, B = 0.02, Z0 = 2.0, ZB = 1.0;
 static int g_flat;
 
-static double hash2(int i, int j)
-{
-    uint32_t h = (uint32_t)i * 374761393u + (uint32_t)j * 668265263u;
-    h = (h ^ (h >> 13)) * 1274126177u;
-    return ((h ^ (h >> 16)) & 0xffffff) / 16777216.0;
-}
-
-static double vnoise(double x, double y)
-{
-    int i = (int)floor(x), j = (int)floor(y);
-    double fx = x - i, fy = y - j;
-    fx = fx * fx * (3 - 2 * fx), fy = fy * fy * (3 - 2 * fy);
-    double a = hash2(i, j), b = hash2(i + 1, j), c = hash2(i, j + 1), d = hash2(i + 1, j + 1);
-    return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
-}
 
 /* view (u, v): camera at ((u - 2) B, -(v - 2) B), y up in the world, rows down */
 static void render(int u, int v, float *dst)

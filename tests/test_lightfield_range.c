@@ -19,6 +19,7 @@
 #include "lf_test.h"
 #include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
+#include "lf_test_texture.h"
 
 #define LFTOOL LF_BINARY_DIR "/bin/lftool"
 
@@ -26,21 +27,6 @@ enum { N = 5, W = 128, H = 128, SS = 3 };
 static const double F = 128.0, B = 0.05;
 static const double Z_WALL = F * B / 3.0, Z_NEAR = F * B / 11.5, HALF = 0.09; /* the square: |X|, |Y| < HALF at Z_NEAR */
 
-static double hash2(int i, int j)
-{
-    uint32_t h = (uint32_t)i * 374761393u + (uint32_t)j * 668265263u;
-    h = (h ^ (h >> 13)) * 1274126177u;
-    return ((h ^ (h >> 16)) & 0xffffff) / 16777216.0;
-}
-
-static double vnoise(double x, double y)
-{
-    int i = (int)floor(x), j = (int)floor(y);
-    double fx = x - i, fy = y - j;
-    fx = fx * fx * (3 - 2 * fx), fy = fy * fy * (3 - 2 * fy);
-    double a = hash2(i, j), b = hash2(i + 1, j), c = hash2(i, j + 1), d = hash2(i + 1, j + 1);
-    return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
-}
 
 /* depth of the first hit of the ray from (cx, cy, 0) along (dx, dy, 1), and its colour */
 static double trace(double cx, double cy, double dx, double dy, float c[3])

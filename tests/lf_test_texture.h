@@ -1,0 +1,28 @@
+/* lf_test_texture.h - a smooth procedural texture for the light-field tests
+ * that synthesise views themselves (test_lightfield_depth, _grid, _range):
+ * value noise, one unit per cell, in [0, 1), the same at every view so the
+ * ground truth comes from the geometry alone. */
+#ifndef LF_TEST_TEXTURE_H
+#define LF_TEST_TEXTURE_H
+
+#include <math.h>
+#include <stdint.h>
+
+static inline double hash2(int i, int j)
+{
+    uint32_t h = (uint32_t)i * 374761393u + (uint32_t)j * 668265263u;
+    h = (h ^ (h >> 13)) * 1274126177u;
+    return ((h ^ (h >> 16)) & 0xffffff) / 16777216.0;
+}
+
+/* smooth value noise, one unit per cell */
+static inline double vnoise(double x, double y)
+{
+    int i = (int)floor(x), j = (int)floor(y);
+    double fx = x - i, fy = y - j;
+    fx = fx * fx * (3 - 2 * fx), fy = fy * fy * (3 - 2 * fy);
+    double a = hash2(i, j), b = hash2(i + 1, j), c = hash2(i, j + 1), d = hash2(i + 1, j + 1);
+    return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
+}
+
+#endif

@@ -60,8 +60,9 @@ int main(void)
     CHECK(run("%s 1-thinlens %s/subs/empty %s/subs/missing --cache %s/cache", LFGRADE, dir, dir, dir) == 2);
     CHECK_MSG(strstr(out_text, "lfgrade: no such submission: ") && strstr(out_text, "/subs/missing\n") &&
                   !strstr(out_text, "0/25"), "%s", out_text);
-    CHECK(run("%s 1-thinlens %s/subs/empty %s/subs/half --report %s/rep --cache %s/cache --json --threads 2", LFGRADE,
-              dir, dir, dir, dir) == 0);
+    int batch_rc = run("%s 1-thinlens %s/subs/empty %s/subs/half --report %s/rep --cache %s/cache --json --threads 2",
+                       LFGRADE, dir, dir, dir, dir);
+    CHECK_MSG(batch_rc == 0, "exit %d:\n%s", batch_rc, out_text);
     CHECK(strstr(out_text, "[1/2] empty: 0/25") != NULL);
     CHECK(strstr(out_text, "[2/2] half: 12/25") != NULL);
     CHECK(strstr(out_text, "\"student\": \"half\"") != NULL);

@@ -8,7 +8,7 @@
  *
  *   lf_web_server *s;
  *   if (lf_web_server_open("out/web", 8000, &s, &err) == 0) {
- *       while (!stop) lf_web_server_serve_one(s, &err);   // one request at a time
+ *       lf_web_server_run(s, &stop, &err);   // until a signal handler sets stop
  *       lf_web_server_close(s);
  *   }
  *
@@ -67,21 +67,33 @@ int lf_web_find_assets(char *dir, size_t n, lf_error *err);
 struct lf_strbuf;
 int lf_web_base64(struct lf_strbuf *out, const unsigned char *data, size_t n);
 
-/* ---- the static server: 127.0.0.1 only, GET and HEAD, one request at a
- * time, files inside the root only (no "..", no symlink escapes) ---- */
+/* ---- the static server: 127.0.0.1 only, GET and HEAD, files inside the
+ * root only (no "..", no symlink escapes, regular files only), many clients
+ * at once on one thread; its limits (docs/testing.md says why these): ---- */
+enum {
+    LF_WEB_MAX_CONNECTIONS = 64, /* open client connections; past it the oldest still sending its request goes */
+    LF_WEB_REQUEST_MS = 5000,    /* from connect to the end of the request header */
+    LF_WEB_STALL_MS = 10000,     /* an answer that makes no progress this long is cut */
+    LF_WEB_ANSWER_MS = 300000    /* and no answer takes longer than this */
+};
 typedef struct lf_web_server lf_web_server;
 
 /* Listens on 127.0.0.1:port (0: any free port) serving files under root. */
 int lf_web_server_open(const char *root, int port, lf_web_server **server, lf_error *err);
 int lf_web_server_port(const lf_web_server *server);
 const char *lf_web_server_root(const lf_web_server *server);
-/* Accepts one connection and answers it.  0; LF_ERR_INTERRUPTED when a
- * signal interrupted the wait (the caller checks its stop flag); another
- * code when accepting failed. */
+/* Client connections open now (not safe while another thread polls). */
+int lf_web_server_connections(const lf_web_server *server);
+/* One round: waits up to timeout_ms (-1: until something happens) for
+ * connections and socket readiness, accepts, reads, writes, and closes the
+ * connections that are done or past their deadline.  0; LF_ERR_INTERRUPTED
+ * when a signal interrupted the wait; another code when accepting failed. */
+int lf_web_server_poll(lf_web_server *server, int timeout_ms, lf_error *err);
+/* Runs rounds until one more request has been answered (tests). */
 int lf_web_server_serve_one(lf_web_server *server, lf_error *err);
-/* Serves requests one at a time until *stop becomes non-zero (set by the
- * caller's signal handler; the wait for a connection returns on a signal).
- * 0 when stopped, else the code of the failure to accept. */
+/* Serves until *stop becomes non-zero (set by the caller's signal handler;
+ * checked at least every 250 ms).  0 when stopped, else the code of the
+ * failure to accept. */
 int lf_web_server_run(lf_web_server *server, const volatile sig_atomic_t *stop, lf_error *err);
 void lf_web_server_close(lf_web_server *server);
 

@@ -1296,6 +1296,13 @@ static int compare(compare_job *j, submission *s, lf_error *err)
     lf_grade_check_result *r = j->res;
     subject t = {0};
     lf_image a = {0}, b = {0};
+    /* the submission's image first: a missing or unreadable one costs no
+     * reference (issue 32: references were rendered before looking) */
+    sub_image *early = find_image(s, lf_grade_check_get(j->c, "image", j->c->id));
+    if (!early || early->state < 0) {
+        fail(r, "%s", early ? early->why : "too many images");
+        return 0;
+    }
     int rc = j->make(j, NULL, 0, &a, t.why, sizeof t.why);
     if (!rc)
         rc = j->make(j, NULL, 1, &b, t.why, sizeof t.why);
@@ -1559,6 +1566,11 @@ static int run_focus(lf_grade_ctx *g, const lf_grade_check *c, submission *s, lf
     f.want = atof(lf_grade_check_get(c, "depth", "0"));
     int spp = atoi(lf_grade_check_get(c, "spp", "8")), rc;
     uint32_t seed = (uint32_t)strtoul(lf_grade_check_get(c, "seed", "1000"), NULL, 10);
+    sub_image *early = find_image(s, lf_grade_check_get(c, "image", c->id));
+    if (!early || early->state < 0) { /* no image, no reference to compute */
+        fail(r, "%s", early ? early->why : "too many images");
+        return 0;
+    }
     const lf_image *raw;
     const lf_attrs *meta;
     if (reference(g, lf_grade_check_get(c, "scene", ""), NULL, spp, seed, &raw, &meta, err))
@@ -1729,6 +1741,39 @@ static int check_render(const check_run *k)
     return compare(&j, k->s, k->err);
 }
 
+/* Grading costs what the assignment's own settings cost (issue 32): the
+ * declared synth's samples (width x height x spp) are held to the check's
+ * max_work (default 2^20, a little over twice the handout's 96 x 72 x 64).
+ * More samples per pixel than that allows are re-run with fewer: a student's
+ * image with less noise than the reference still matches it.  An output size
+ * other than the image's, or one with more pixels than max_work, fails here
+ * before any reference is computed.  1 when the check failed. */
+static int declared_over_budget(const lf_grade_check *c, submission *s, declared *d, lf_grade_check_result *r)
+{
+    double max_work = atof(lf_grade_check_get(c, "max_work", "1048576"));
+    sub_image *im = find_image(s, lf_grade_check_get(c, "image", c->id));
+    if (!im || im->state < 0) {
+        fail(r, "%s", im ? im->why : "too many images");
+        return 1;
+    }
+    if (!d->have_outdim)
+        return 0;
+    if (im->state > 0 && (im->w != d->synth.width || im->h != d->synth.height)) {
+        fail(r, "%s: wrong size: %dx%d, but the declared --outputdim is %d %d (not compared)", im->file, im->w,
+             im->h, d->synth.width, d->synth.height);
+        return 1;
+    }
+    double pixels = (double)d->synth.width * d->synth.height;
+    if (pixels > max_work) {
+        fail(r, "the declared --outputdim %d %d is more than this check grades (%.0f pixels x samples at most); "
+                "use the handout's settings", d->synth.width, d->synth.height, max_work);
+        return 1;
+    }
+    if (pixels * d->synth.spp > max_work)
+        d->synth.spp = (int)(max_work / pixels);
+    return 0;
+}
+
 /* kinds synth and refocus: the image against the declared lftool command
  * re-run on the reference light field */
 static int check_lightfield(const check_run *k)
@@ -1749,6 +1794,8 @@ static int check_lightfield(const check_run *k)
         fail(k->r, "%s", j.decl.why);
         return 0;
     }
+    if (!refocus && declared_over_budget(c, k->s, &j.decl, k->r))
+        return 0;
     j.make = refocus ? make_refocus : make_synth;
     return compare(&j, k->s, k->err);
 }

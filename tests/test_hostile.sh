@@ -211,5 +211,26 @@ run "6. lfgrade with students alice, alice and gradebook.csv" 0 'reports in' \
   bad "6. the grade book is missing: $(ls g/R)"
 [ -f g/R/alice/index.html ] && [ -f g/R/alice-2/index.html ] && ok "6. two students named alice get a report each" ||
   bad "6. a report was overwritten: $(ls g/R)"
+# a Submission.md declaring 1024 spp at 2048 x 2048 (the handout: 64 spp at
+# 96 x 72): grading costs what the assignment's settings cost, so both
+# students are graded in seconds (before: minutes of reference synthesis
+# each, here killed by the timeout)
+mkdir -p g/big1 g/big2
+for d in g/big1 g/big2; do
+  printf '## Answers\nx\n## Commands\nlftool synth lf.exr --lensradius 0.1 --outputdim 2048 2048 --samplesperpixel 1024 -o novel.png\n' > $d/Submission.md
+done
+python3 - <<'PY'
+import struct, zlib
+def chunk(t, d): return struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+raw = b''.join(b'\0' + b'\x80' * 24 for _ in range(8))
+open('g/big2/novel.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 8, 8, 8, 2, 0, 0, 0))
+                                    + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
+PY
+run "6. lfgrade: a huge declared synth is not computed" 0 "" \
+  timeout 120 "$bin/lfgrade" "$root/assignments/4-lightfield" g/big1 g/big2 --cache g/cache4 --threads 2
+cat out.txt err.txt > both.txt; grep -q 'novel -7: missing: neither novel.png' both.txt && ok "6. a missing image fails before its reference" ||
+  bad "6. missing image: $(grep novel both.txt)"
+grep -q 'novel -7: novel.png: wrong size: 8x8, but the declared --outputdim is 2048 2048' both.txt &&
+  ok "6. an image of another size than declared fails before its reference" || bad "6. wrong size: $(grep novel both.txt)"
 
 finish

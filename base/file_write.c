@@ -8,6 +8,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -241,4 +242,114 @@ int lf_file_temp_clean(const char *path)
     }
     closedir(d);
     return removed;
+}
+
+/* The process's umask, read without changing it (umask() would race with
+ * other threads creating files); 022 when /proc cannot tell. */
+static mode_t current_umask(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    unsigned m = 022;
+    char line[256];
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "Umask: %o", &m) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return (mode_t)m;
+}
+
+/* Removes the files in the flat folder dir, then dir. */
+static void remove_flat_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        char full[PATH_MAX * 2];
+        for (struct dirent *e; (e = readdir(d));)
+            if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+                snprintf(full, sizeof full, "%s/%s", dir, e->d_name);
+                unlink(full);
+            }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+/* parent folder (with a trailing '/') and base name of dir */
+static int split_dir(const char *dir, char *parent, size_t pn, char *base, size_t bn)
+{
+    char buf[PATH_MAX];
+    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
+        return -1;
+    size_t l = strlen(buf);
+    while (l > 1 && buf[l - 1] == '/')
+        buf[--l] = '\0';
+    char *slash = strrchr(buf, '/');
+    snprintf(parent, pn, "%.*s", slash ? (int)(slash - buf) + 1 : 2, slash ? buf : "./");
+    snprintf(base, bn, "%s", slash ? slash + 1 : buf);
+    return *base && strcmp(base, ".") && strcmp(base, "..") ? 0 : -1;
+}
+
+int lf_dir_stage_begin(const char *dir, char *stage, size_t stage_size, lf_error *err)
+{
+    char parent[PATH_MAX], base[NAME_MAX + 1], prefix[NAME_MAX + 16];
+    if (split_dir(dir, parent, sizeof parent, base, sizeof base))
+        return lf_error_set(err, LF_ERR_PARAM, "'%s' cannot be an output folder", dir);
+    int pl = snprintf(prefix, sizeof prefix, ".%s.stage", base);
+    DIR *d = opendir(parent);
+    for (struct dirent *e; d && (e = readdir(d));) {
+        const char *r = e->d_name + pl;
+        if (strncmp(e->d_name, prefix, (size_t)pl) || strlen(r) != 6)
+            continue;
+        char full[PATH_MAX * 2];
+        snprintf(full, sizeof full, "%s%s", parent, e->d_name);
+        struct stat st;
+        if (lstat(full, &st) == 0 && S_ISDIR(st.st_mode))
+            remove_flat_dir(full); /* a killed run's */
+    }
+    if (d)
+        closedir(d);
+    if (snprintf(stage, stage_size, "%s%sXXXXXX", parent, prefix) >= (int)stage_size)
+        return lf_error_set(err, LF_ERR_PARAM, "path too long: %s", dir);
+    if (!mkdtemp(stage))
+        return lf_error_set(err, LF_ERR_IO, "cannot create directory %s: %s", dir, strerror(errno));
+    chmod(stage, 0777 & ~current_umask());
+    return LF_OK;
+}
+
+int lf_dir_stage_commit(const char *stage, const char *dir, lf_error *err)
+{
+    struct stat st;
+    if (stat(dir, &st) != 0) {
+        if (rename(stage, dir) == 0)
+            return LF_OK;
+        int e = errno;
+        lf_dir_stage_abort(stage);
+        return lf_error_set(err, LF_ERR_IO, "cannot create the folder %s: %s", dir, strerror(e));
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        lf_dir_stage_abort(stage);
+        return lf_error_set(err, LF_ERR_IO, "%s exists and is not a folder", dir);
+    }
+    DIR *d = opendir(stage);
+    int rc = d ? LF_OK : lf_error_set(err, LF_ERR_IO, "cannot read %s: %s", stage, strerror(errno));
+    for (struct dirent *e; !rc && (e = readdir(d));) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        char from[PATH_MAX * 2], to[PATH_MAX * 2];
+        snprintf(from, sizeof from, "%s/%s", stage, e->d_name);
+        snprintf(to, sizeof to, "%s/%s", dir, e->d_name);
+        if (rename(from, to))
+            rc = lf_error_set(err, LF_ERR_IO, "cannot move %s into %s: %s", e->d_name, dir, strerror(errno));
+    }
+    if (d)
+        closedir(d);
+    lf_dir_stage_abort(stage);
+    return rc;
+}
+
+void lf_dir_stage_abort(const char *stage)
+{
+    if (stage && *stage)
+        remove_flat_dir(stage);
 }

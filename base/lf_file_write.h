@@ -45,6 +45,18 @@ int lf_file_check_writable(const char *path, lf_error *err);
  * many.  For a program about to write path itself (nothing else may be
  * writing it then). */
 int lf_file_temp_clean(const char *path);
+/* A folder output built beside its target and moved into place, so a failed
+ * or killed run never leaves a half-written folder (issue 32):
+ * lf_dir_stage_begin creates "<parent>/.<name>.stageXXXXXX" for dir (after
+ * removing such staging folders a killed run left for the same dir) and puts
+ * its path in stage; the writer puts its files there (flat, no
+ * sub-folders); lf_dir_stage_commit moves them into dir: a rename of the
+ * whole folder when dir does not exist, else one rename per file (files of
+ * dir that this run did not write are kept); lf_dir_stage_abort removes the
+ * staging folder and what is in it. */
+int lf_dir_stage_begin(const char *dir, char *stage, size_t stage_size, lf_error *err);
+int lf_dir_stage_commit(const char *stage, const char *dir, lf_error *err);
+void lf_dir_stage_abort(const char *stage);
 /* Before reading: LF_ERR_PARAM when output names one of the n inputs (the
  * same path, or the same file through another name: device and inode),
  * since writing it would destroy what is being read.  NULL entries are

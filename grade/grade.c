@@ -8,6 +8,7 @@
 #define _GNU_SOURCE
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -18,6 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/lf_file_write.h"
 #include "lightfield/lf_lightfield.h"
 #include "render/lf_render.h"
 #include "grade_internal.h"
@@ -1881,12 +1883,16 @@ int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_re
     if (!res->checks)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     res->nchecks = g->rubric.nchecks;
-    char sdir[1400], *student_dir = NULL;
+    /* the student's report is built beside its folder and moved into place
+     * (base/lf_file_write.h): a full disk leaves no half-written report */
+    char sdir[1400], stage[PATH_MAX], *student_dir = NULL;
     if (g->report[0]) {
         snprintf(sdir, sizeof sdir, "%s/%s", g->report, res->student);
-        if (mkdirs(sdir))
-            return lf_error_set(err, LF_ERR_IO, "%s: cannot create: %s", sdir, strerror(errno));
-        student_dir = sdir;
+        if (mkdirs(g->report))
+            return lf_error_set(err, LF_ERR_IO, "%s: cannot create: %s", g->report, strerror(errno));
+        if (lf_dir_stage_begin(sdir, stage, sizeof stage, err))
+            return err->code;
+        student_dir = stage;
     }
     submission s;
     memset(&s, 0, sizeof s);
@@ -1914,5 +1920,9 @@ int lf_grade_submission(lf_grade_ctx *g, const char *submission_dir, lf_grade_re
     res->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     if (!rc && student_dir)
         rc = lf_grade_report_student(student_dir, g->rubric.title, res, err);
+    if (student_dir && rc)
+        lf_dir_stage_abort(stage);
+    else if (student_dir)
+        rc = lf_dir_stage_commit(stage, sdir, err);
     return rc;
 }

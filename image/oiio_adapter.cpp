@@ -4,13 +4,17 @@
 // point catches all exceptions: C callers cannot unwind through C++ frames.
 #include "oiio_adapter.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
 #include <string>
+#include <vector>
 
 
 namespace {
@@ -49,6 +53,19 @@ bool is_linear_colorspace(const std::string &cs)
     return lower.find("linear") != std::string::npos || lower.rfind("lin_", 0) == 0;
 }
 
+int write_bytes(const char *file, const char *name, const std::vector<unsigned char> &bytes, lf_error *err)
+{
+    FILE *f = std::fopen(file, "wb");
+    if (!f)
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", name, std::strerror(errno));
+    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0;
+    int e = errno;
+    ok = std::fclose(f) == 0 && ok;
+    if (!ok)
+        return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", name, std::strerror(e ? e : errno));
+    return LF_OK;
+}
+
 int write_impl(const char *file, const char *name, int width, int height, int channels, lf_oiio_pixel_type type,
                const void *pixels, lf_error *err)
 {
@@ -67,6 +84,12 @@ int write_impl(const char *file, const char *name, int width, int height, int ch
     // Pixels are stored exactly as given: OpenImageIO must not divide colour
     // by alpha on the way out (nor multiply on the way in, see read_impl).
     spec.attribute("oiio:UnassociatedAlpha", 1);
+    // Encoded into memory when the format can, then written here: libjpeg's
+    // default error handler calls exit() on a failed fwrite (a full disk),
+    // which killed the process without a message of ours or any cleanup.
+    std::vector<unsigned char> encoded;
+    OIIO::Filesystem::IOVecOutput vec(encoded);
+    bool in_memory = out->supports("ioproxy") && out->set_ioproxy(&vec);
     if (!out->open(file, spec))
         return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", name, take_error(nullptr, out.get()).c_str());
     bool ok = out->write_image(td, pixels);
@@ -74,7 +97,7 @@ int write_impl(const char *file, const char *name, int width, int height, int ch
     if (!ok)
         return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", name, take_error(nullptr, out.get()).c_str());
     take_error(nullptr, out.get());
-    return LF_OK;
+    return in_memory ? write_bytes(file, name, encoded, err) : LF_OK;
 }
 
 int read_impl(const char *file, const char *name, lf_image *img, lf_oiio_read_info *info, lf_error *err)

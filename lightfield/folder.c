@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/lf_file_write.h"
 #include "lf_lightfield.h"
 
 enum { MAX_SIDE = 4096 };
@@ -576,11 +577,9 @@ int lf_lightfield_folder_load(const lf_lightfield_folder *f, const lf_lightfield
 
 /* ---------- writing the HCI layout ---------- */
 
-int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
+static int write_hci_into(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
 {
-    if (mkdir(dir, 0777) && errno != EEXIST)
-        return lf_error_set(err, LF_ERR_IO, "cannot create the folder '%s': %s", dir, strerror(errno));
-    char path[4096];
+    char path[PATH_MAX + 64];
     int rc = LF_OK;
     for (int iv = 0; iv < lf->nv && !rc; iv++)
         for (int iu = 0; iu < lf->nu && !rc; iu++) {
@@ -596,7 +595,7 @@ int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_i
         return rc;
     /* parameters.cfg, written beside and renamed into place */
     const lf_lightfield_layout *y = &lf->layout;
-    char tmp[4200];
+    char tmp[PATH_MAX + 96];
     snprintf(path, sizeof path, "%s/parameters.cfg", dir);
     snprintf(tmp, sizeof tmp, "%s/.parameters.cfg.tmp", dir);
     FILE *f = fopen(tmp, "w");
@@ -639,4 +638,20 @@ int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_i
         return lf_error_set(err, LF_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
     }
     return LF_OK;
+}
+
+/* Written into a staging folder beside dir and moved into place
+ * (base/lf_file_write.h), so a failure leaves no half-written folder. */
+int lf_lightfield_write_hci(const char *dir, const lf_lightfield *lf, const lf_image *disparity, lf_error *err)
+{
+    char stage[PATH_MAX];
+    int rc = lf_dir_stage_begin(dir, stage, sizeof stage, err);
+    if (rc)
+        return rc;
+    rc = write_hci_into(stage, lf, disparity, err);
+    if (rc) {
+        lf_dir_stage_abort(stage);
+        return rc;
+    }
+    return lf_dir_stage_commit(stage, dir, err);
 }

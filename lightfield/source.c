@@ -316,12 +316,10 @@ int lf_lightfield_read_map(const char *path, const lf_lightfield *lf, lf_image *
     return rc;
 }
 
-int lf_lightfield_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
+static int write_views_into(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
                       lf_error *err)
 {
-    if (lf_dir_create(dir, err))
-        return err ? err->code : LF_ERR_IO;
-    char path[PATH_MAX];
+    char path[PATH_MAX + 64];
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
             lf_image v = {lf->ns, lf->nt, 3, lf_lightfield_view(lf, iu, iv)};
@@ -342,6 +340,23 @@ int lf_lightfield_write_views(const lf_lightfield *lf, const char *dir, const ch
     int rc = lf_image_write(path, &m, NULL, wo, err);
     lf_image_free(&m);
     return rc;
+}
+
+/* Written into a staging folder beside dir and moved into place
+ * (base/lf_file_write.h), so a failure leaves no half-written folder. */
+int lf_lightfield_write_views(const lf_lightfield *lf, const char *dir, const char *ext, const lf_write_opts *wo,
+                              lf_error *err)
+{
+    char stage[PATH_MAX];
+    int rc = lf_dir_stage_begin(dir, stage, sizeof stage, err);
+    if (rc)
+        return rc;
+    rc = write_views_into(lf, stage, ext, wo, err);
+    if (rc) {
+        lf_dir_stage_abort(stage);
+        return rc;
+    }
+    return lf_dir_stage_commit(stage, dir, err);
 }
 
 int lf_lightfield_write_refocused(const char *path, const lf_image *img, double disparity_px, const lf_write_opts *wo,

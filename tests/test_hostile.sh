@@ -203,6 +203,34 @@ run "8. lfrender with checkpoints renders" 0 '' "$bin/lfrender" ck/s.pbrt -o ck/
   bad "8. stale temporaries left: $(ls -a ck)"
 [ -e ck/.out.exr.keep.exr ] && ok "8. a file not named like a temporary is kept" || bad "8. an unrelated file was removed"
 
+# ---- 8. a folder output that fails half-way leaves no folder behind
+# (views are written, then the mosaic, 4 x as large, exceeds ulimit -f)
+sed 's/\[16\]/[256]/; s/\[12\]/[192]/' lf.pbrt > lf8.pbrt && "$bin/lfrender" lf8.pbrt -o raw8.exr --quiet 2>/dev/null ||
+  bad "8. the light field did not render"
+rm -rf dec && "$bin/lftool" decode raw8.exr -o dec --format exr >/dev/null 2>&1 || bad "8. decode failed"
+view_kb=$(( ($(stat -c %s dec/view_00_00.exr) + 1023) / 1024 ))
+mosaic_kb=$(( $(stat -c %s dec/mosaic.exr) / 1024 ))
+if [ "$mosaic_kb" -gt "$view_kb" ]; then
+  halfwrite() { (trap '' XFSZ; ulimit -f "$view_kb"; exec "$@") 2>&1 | cat >&2; }
+  rm -rf dec2
+  run "8. decode whose mosaic cannot be written fails" 1 'File too large|cannot write' halfwrite "$bin/lftool" decode raw8.exr -o dec2 --format exr
+  [ ! -e dec2 ] && ok "8. ... and leaves no folder (views were written before)" || bad "8. a partial folder is left: $(ls dec2)"
+  # into an existing folder: its files stay as they were
+  mkdir -p dec3 && echo mine > dec3/notes.txt
+  run "8. decode into an existing folder fails" 1 'File too large|cannot write' halfwrite "$bin/lftool" decode raw8.exr -o dec3 --format exr
+  [ "$(ls -A dec3)" = notes.txt ] && ok "8. ... and the folder holds only what it held" || bad "8. dec3 now holds: $(ls -A dec3)"
+else
+  bad "8. the mosaic ($mosaic_kb KB) is not larger than a view ($view_kb KB): cannot stage a half-way failure"
+fi
+run "8. decode --layout hci on a full disk fails" 1 'File too large|cannot write|write failed' nowrite "$bin/lftool" decode raw.exr -o hci --layout hci
+[ ! -e hci ] && ok "8. ... and leaves no folder" || bad "8. decode --layout hci left: $(ls -A hci)"
+run "8. export-web on a full disk fails" 1 'File too large|cannot write|write failed' nowrite "$bin/lftool" export-web raw.exr -o web
+[ ! -e web ] && ok "8. ... and leaves no folder" || bad "8. export-web left: $(ls -A web)"
+ls -A | grep -q '\.stage' && bad "8. staging folders left: $(ls -A | grep stage)" || ok "8. no staging folder left"
+mkdir .dec4.stageAb12Cd && : > .dec4.stageAb12Cd/view_00_00.png
+"$bin/lftool" decode raw.exr -o dec4 --format png >/dev/null 2>&1 && [ -f dec4/mosaic.png ] && [ ! -e .dec4.stageAb12Cd ] &&
+  ok "8. a killed decode's staging folder is removed by the next one" || bad "8. stale staging folder: $(ls -A)"
+
 # ---- 6. lfgrade: folder names cannot take the grade book or each other's report
 mkdir -p g/a/alice g/b/alice g/gradebook.csv
 run "6. lfgrade with students alice, alice and gradebook.csv" 0 'reports in' \
@@ -211,6 +239,11 @@ run "6. lfgrade with students alice, alice and gradebook.csv" 0 'reports in' \
   bad "6. the grade book is missing: $(ls g/R)"
 [ -f g/R/alice/index.html ] && [ -f g/R/alice-2/index.html ] && ok "6. two students named alice get a report each" ||
   bad "6. a report was overwritten: $(ls g/R)"
+# 8. a report that cannot be written (ulimit -f 0) leaves no half-written student folder
+nowrite "$bin/lfgrade" "$root/assignments/1-thinlens" g/a/alice --report g/R2 --cache g/cache >/dev/null 2>err8.txt
+[ ! -e g/R2/alice ] && ! ls -A g/R2 2>/dev/null | grep -q stage && ok "8. lfgrade --report on a full disk leaves no partial report" ||
+  bad "8. lfgrade --report left: $(ls -A g/R2 g/R2/alice 2>&1 | head -c 300)"
+grep -q 'File too large\|cannot write' err8.txt && ok "8. ... and says why" || bad "8. lfgrade --report full disk: $(head -c 300 err8.txt)"
 # a Submission.md declaring 1024 spp at 2048 x 2048 (the handout: 64 spp at
 # 96 x 72): grading costs what the assignment's settings cost, so both
 # students are graded in seconds (before: minutes of reference synthesis

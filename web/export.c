@@ -257,7 +257,7 @@ static void safe_name(const char *in, char *out, size_t n)
     out[k] = '\0';
 }
 
-int lf_web_export(const lf_lightfield *lf, const char *out_dir, const lf_web_export_opts *o, lf_web_export_info *info,
+static int export_into(const lf_lightfield *lf, const char *out_dir, const lf_web_export_opts *o, lf_web_export_info *info,
                   lf_error *err)
 {
     memset(info, 0, sizeof *info);
@@ -277,8 +277,6 @@ int lf_web_export(const lf_lightfield *lf, const char *out_dir, const lf_web_exp
         snprintf(assets, sizeof assets, "%s", o->assets_dir);
     else if (lf_web_find_assets(assets, sizeof assets, err))
         return err ? err->code : LF_ERR_IO;
-    if (mkdir(out_dir, 0777) && errno != EEXIST)
-        return lf_error_set(err, LF_ERR_IO, "cannot create directory %s: %s", out_dir, strerror(errno));
 
     /* focus range and per-pixel disparity (docs/lftool.md "Focal stack,
      * all-in-focus, depth"); the page maps a click to the median around it */
@@ -345,4 +343,21 @@ int lf_web_export(const lf_lightfield *lf, const char *out_dir, const lf_web_exp
     info->focus_min = q0;
     info->focus_max = q1;
     return rc;
+}
+
+/* Written into a staging folder beside dir and moved into place
+ * (base/lf_file_write.h), so a failure leaves no half-written folder. */
+int lf_web_export(const lf_lightfield *lf, const char *dir, const lf_web_export_opts *o, lf_web_export_info *info,
+                  lf_error *err)
+{
+    char stage[PATH_MAX];
+    int rc = lf_dir_stage_begin(dir, stage, sizeof stage, err);
+    if (rc)
+        return rc;
+    rc = export_into(lf, stage, o, info, err);
+    if (rc) {
+        lf_dir_stage_abort(stage);
+        return rc;
+    }
+    return lf_dir_stage_commit(stage, dir, err);
 }

@@ -194,6 +194,34 @@ int lf_file_read(const char *path, size_t max_bytes, char **data, size_t *len, i
     return LF_OK;
 }
 
+int lf_file_read_head(const char *path, size_t max_bytes, char **data, size_t *len, int *was_gzip, lf_error *err)
+{
+    *data = NULL, *len = 0;
+    if (max_bytes > (size_t)INT32_MAX)
+        max_bytes = (size_t)INT32_MAX; /* gzread counts in unsigned int */
+    gzFile g = gzopen(path, "rb");
+    if (!g)
+        return lf_error_set(err, LF_ERR_IO, "%s: cannot open: %s", path, strerror(errno ? errno : ENOMEM));
+    char *buf = malloc(max_bytes + 1);
+    int n = buf ? gzread(g, buf, (unsigned)max_bytes) : -1;
+    int errnum = 0;
+    const char *zmsg = n < 0 ? gzerror(g, &errnum) : NULL;
+    if (was_gzip)
+        *was_gzip = !gzdirect(g);
+    int rc = !buf ? lf_error_set(err, LF_ERR_NOMEM, "%s: out of memory reading the file", path)
+             : n < 0 ? lf_error_set(err, LF_ERR_PARSE, "%s: corrupt gzip data (zlib: %s)", path,
+                                     errnum == Z_ERRNO ? strerror(errno) : zmsg)
+                     : LF_OK;
+    gzclose(g);
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    buf[n] = '\0';
+    *data = buf, *len = (size_t)n;
+    return LF_OK;
+}
+
 int lf_path_has_ext(const char *path, const char *ext)
 {
     size_t n = strlen(path), e = strlen(ext);

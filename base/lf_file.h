@@ -35,6 +35,11 @@ extern "C" {
  * gzip data fails with LF_ERR_PARSE naming the file.  Messages start with the
  * path.  *data is NULL on failure. */
 int lf_file_read(const char *path, size_t max_bytes, char **data, size_t *len, int *was_gzip, lf_error *err);
+/* The first max_bytes (at most) of the file's content, gunzipped as
+ * lf_file_read does, without inflating the rest: a format's header read
+ * before the whole file, so the sizes it declares can bound the full read
+ * (NUL-terminated; *len may be less than max_bytes). */
+int lf_file_read_head(const char *path, size_t max_bytes, char **data, size_t *len, int *was_gzip, lf_error *err);
 
 /* Gunzips an in-memory buffer (which must start with the gzip magic) into a
  * malloc'ed, NUL-terminated buffer.  `name` is used in messages. */

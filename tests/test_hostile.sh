@@ -189,6 +189,37 @@ Camera \"perspective\"" ''; yes AttributeBegin | head -n 1000000; } | gzip -9 > 
 run "3. a million nested AttributeBegin refused at the depth limit (1 GB limit)" 1 'nested more than 10000 deep' \
   limited "$bin/lfrender" deep.pbrt.gz -o deep.exr --quiet
 
+# .ply.gz bombs: the header is read first and bounds what is inflated.  One
+# declares a triangle and hides 1.5 GB of zeros after it (4 MB on disk);
+# the other declares 10^12 vertices in a few bytes.
+python3 - <<'PY'
+import struct, zlib
+def gz(members):
+    out, crc, size = [b'\x1f\x8b\x08\x00\0\0\0\0\x00\xff'], 0, 0
+    c = zlib.compressobj(9, zlib.DEFLATED, -15)
+    for data, times in members:
+        block = c.compress(data) + c.flush(zlib.Z_FULL_FLUSH)
+        for _ in range(times):
+            out.append(block); crc = zlib.crc32(data, crc); size += len(data)
+    out.append(c.flush() + struct.pack('<II', crc & 0xffffffff, size & 0xffffffff))
+    return b''.join(out)
+head = (b'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n'
+        b'property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n')
+body = struct.pack('<9f', 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack('<B3i', 3, 0, 1, 2)
+open('bomb.ply.gz', 'wb').write(gz([(head + body, 1), (b'\0' * (1 << 20), 1536)]))
+huge = head.replace(b'vertex 3', b'vertex 1000000000000')
+open('huge.ply.gz', 'wb').write(gz([(huge + body, 1)]))
+PY
+for f in bomb huge; do
+  scene "$look
+Camera \"perspective\"" "LightSource \"infinite\"
+Shape \"plymesh\" \"string filename\" \"$f.ply.gz\"" > $f.pbrt
+done
+run "3. a .ply.gz hiding 1.5 GB after its declared triangle stops at the header's bound (1 GB limit)" 1 \
+  'bomb\.ply\.gz: decompressed data is larger than the limit of [0-9]+ bytes.*\(more than its header declares\)' limited "$bin/lfrender" bomb.pbrt -o bomb.exr --quiet
+run "3. a .ply.gz declaring 10^12 vertices is refused before decompressing" 1 \
+  'huge\.ply\.gz: its header declares at least [0-9]+ bytes of data' limited "$bin/lfrender" huge.pbrt -o huge.exr --quiet
+
 # ---- 9. a FIFO named like a view is refused at once, not waited on
 rm -rf views && "$bin/lftool" decode raw.exr -o views >/dev/null 2>&1 && rm -f views/mosaic.exr views/view_01_01.exr &&
   mkfifo views/view_01_01.exr || bad "9. could not make the folder of views"

@@ -2,7 +2,7 @@
 # Builds the libFuzzer targets (fuzz/) with clang into build-fuzz and runs each
 # for SECONDS (default 60), printing the executions per target.
 #
-#   bash bench/fuzz.sh [SECONDS] [TARGET ...]     # targets: scene_parser ply lens_file lf_attributes image_exr
+#   bash bench/fuzz.sh [SECONDS] [TARGET ...]     # targets: scene_parser ply lens_file lf_attributes image_exr camera_params folder
 #   LF_FUZZ_RUNS=N bash bench/fuzz.sh            # deterministic: seed 1, N inputs per target, one process
 #
 # CI uses the deterministic form: a fixed seed and input count replay the
@@ -20,7 +20,7 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET="${1:-60}"
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(scene_parser ply lens_file lf_attributes image_exr)
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(scene_parser ply lens_file lf_attributes image_exr camera_params folder)
 B="${LF_FUZZ_BUILD:-build-fuzz}"
 
 cmake -S . -B "$B" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \

@@ -57,6 +57,19 @@ static int projective_create(const lf_camera_create_args *a, void **state, int o
     double sw[4];
     int n = p->get_floats(p->ctx, "screenwindow", sw, 4);
     if (n == 4) {
+        /* beyond 1e15 the rays' extent overflows (the renderer's reach
+         * bound, docs/testing.md); an empty window maps every pixel to one point */
+        for (int k = 0; k < 4; k++)
+            if (!(fabs(sw[k]) <= 1e15)) {
+                snprintf(a->error, a->error_size, "\"screenwindow\" values must be within +-1e15, got %g", sw[k]);
+                free(c);
+                return -1;
+            }
+        if (sw[0] == sw[1] || sw[2] == sw[3]) {
+            snprintf(a->error, a->error_size, "\"screenwindow\" [%g %g %g %g] is empty", sw[0], sw[1], sw[2], sw[3]);
+            free(c);
+            return -1;
+        }
         memcpy(c->screen, sw, sizeof sw);
     } else if (n != 0) {
         snprintf(a->error, a->error_size, "\"screenwindow\" needs 4 values (x0 x1 y0 y1), got %d", n);

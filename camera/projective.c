@@ -44,8 +44,8 @@ static int projective_create(const lf_camera_create_args *a, void **state, int o
     c->width = a->image_width;
     c->height = a->image_height;
     double aspect = p->get_float(p->ctx, "frameaspectratio", (double)a->image_width / a->image_height);
-    if (!(aspect > 0.0) || !isfinite(aspect)) {
-        snprintf(a->error, a->error_size, "\"frameaspectratio\" must be positive, got %g", aspect);
+    if (!(aspect >= 1e-15 && aspect <= 1e15)) { /* the screen spans 1/aspect: the same reach bound */
+        snprintf(a->error, a->error_size, "\"frameaspectratio\" must be in 1e-15..1e15, got %g", aspect);
         free(c);
         return -1;
     }
@@ -87,13 +87,13 @@ static int projective_create(const lf_camera_create_args *a, void **state, int o
     }
     c->lens_radius = p->get_float(p->ctx, "lensradius", 0.0);
     c->focal_distance = p->get_float(p->ctx, "focaldistance", 1e6);
-    if (!(c->lens_radius >= 0.0) || !isfinite(c->lens_radius)) {
-        snprintf(a->error, a->error_size, "\"lensradius\" must be >= 0, got %g", c->lens_radius);
+    if (!(c->lens_radius >= 0.0 && c->lens_radius <= 1e15)) { /* the renderer's reach, docs/testing.md */
+        snprintf(a->error, a->error_size, "\"lensradius\" must be in 0..1e15, got %g", c->lens_radius);
         free(c);
         return -1;
     }
-    if (!(c->focal_distance > 0.0) || !isfinite(c->focal_distance)) {
-        snprintf(a->error, a->error_size, "\"focaldistance\" must be > 0, got %g", c->focal_distance);
+    if (!(c->focal_distance > 0.0 && c->focal_distance <= 1e15)) {
+        snprintf(a->error, a->error_size, "\"focaldistance\" must be in (0, 1e15], got %g", c->focal_distance);
         free(c);
         return -1;
     }

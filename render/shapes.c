@@ -415,6 +415,13 @@ static int tessellate(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_mot
                 N[3 * k] = (float)n[0], N[3 * k + 1] = (float)n[1], N[3 * k + 2] = (float)n[2];
             UV[2 * k] = (float)u, UV[2 * k + 1] = (float)v;
         }
+    /* pbrt-v4's quadrics: the normal cross(dp/du, dp/dv) (outward) is
+     * flipped when ReverseOrientation XOR the transform swaps handedness;
+     * the tessellation's vertex normals carry that side (the geometric
+     * normal and an area light's emitting side follow them). */
+    if (N && (sh->reverse_orientation ^ lf_transform_swaps_handedness(&mo->keys[0])))
+        for (int k = 0; k < 3 * nv; k++)
+            N[k] = -N[k];
     int t = 0;
     for (int j = 0; j < nv_; j++)
         for (int i = 0; i < nu; i++) {

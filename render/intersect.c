@@ -224,6 +224,8 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     hit->t = rh.ray.tfar;
+    hit->curve = 0;
+    hit->curve_h = 0;
     lf_shading_ctx *sc = &hit->sc;
     int gi = rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? s->geom_index[rh.hit.geomID] : 0;
     if (gi < 0) {

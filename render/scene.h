@@ -37,6 +37,11 @@ typedef struct lf_mesh {
     int flip_normal;   /* reverse orientation XOR handedness swap */
     int medium_in, medium_out; /* MediumInterface (lf_scene.media indices, -1 vacuum); LF_MEDIUM_SAME: none */
     int bump;          /* its material has a displacement: hits carry (u,v) derivatives */
+    /* pbrt-v4's "alpha": a hit is ignored when a hash of the hit point and
+     * ray direction exceeds alpha (render/alpha.c); alpha_tex NULL and
+     * alpha >= 1: opaque, no filter. */
+    float alpha;
+    const struct lf_texture *alpha_tex;
 } lf_mesh;
 
 typedef struct lf_sphere {
@@ -195,6 +200,11 @@ typedef struct lf_hit {
     int sphere;        /* analytic sphere index, or -1; its uv is filled by lf_scene_sphere_uv */
     float tau;         /* Embree time of the ray that found it */
     int medium_in, medium_out; /* the shape's MediumInterface; medium_in LF_MEDIUM_SAME: no transition */
+    /* On a Shape "curve" hit (curve 1): pbrt-v4's h in [-1,1] across the
+     * width (2 v - 1, v = sc.uv.y), as its HairMaterial reads it; sc.dpdu is
+     * then the tangent dP/du along the curve (docs/scene-format.md, Curves). */
+    int curve;
+    float curve_h;
 } lf_hit;
 
 /* ---- intersection (render/intersect.c) ---- */

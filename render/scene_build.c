@@ -37,6 +37,7 @@ unsigned lf_attach_mesh(RTCDevice device, RTCScene scene, const lf_mesh *me, uns
                                    me->P + (size_t)k * 3 * me->n_verts, 0, 3 * sizeof(float), (size_t)me->n_verts);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, me->idx, 0, 3 * sizeof(int),
                                (size_t)me->n_tris);
+    lf_alpha_attach(g, me);
     rtcCommitGeometry(g);
     if (id == RTC_INVALID_GEOMETRY_ID)
         id = rtcAttachGeometry(scene, g);
@@ -50,7 +51,7 @@ unsigned lf_attach_mesh(RTCDevice device, RTCScene scene, const lf_mesh *me, uns
  * instances) and the lights, as lf_scene data: no Embree yet. */
 static int read_description(lf_scene_desc *d, lf_scene *s, lf_error *err)
 {
-    lf_scene_builder b = {s, d, 0, 0, 0, 0, 0, err, -1, NULL};
+    lf_scene_builder b = {s, d, 0, 0, 0, 0, 0, err, -1, NULL, 1.f, NULL};
     b.object_proto = malloc(sizeof(int) * (d->n_objects ? d->n_objects : 1));
     if (!b.object_proto)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");

@@ -23,7 +23,17 @@ typedef struct lf_scene_builder {
     lf_error *err;
     int proto;         /* the lf_proto being built (meshes go to its space), or -1: world */
     int *object_proto; /* per ObjectBegin: its shared lf_proto, -1 none, -2 not built yet */
+    /* The "alpha" of the shape being built (render/alpha.c), copied into
+     * each mesh it makes: 1 and NULL when opaque. */
+    float alpha;
+    const struct lf_texture *alpha_tex;
 } lf_scene_builder;
+
+/* Reads a shape's "float alpha" / "texture alpha" into b->alpha and
+ * b->alpha_tex (render/alpha.c). */
+int lf_read_shape_alpha(lf_scene_builder *b, lf_shape_desc *sh);
+/* Sets the alpha filter on a mesh's geometry when it is not opaque. */
+void lf_alpha_attach(RTCGeometry g, const lf_mesh *me);
 
 /* One shape (render/shapes.c), its vertices placed by the keyframes mo. */
 int lf_build_shape(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_motion *mo);

@@ -253,6 +253,8 @@ static int finish_mesh(lf_scene_builder *b, const lf_shape_desc *sh, const lf_sh
     m.material = sh->material;
     m.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
     m.bump = lf_material_bumps(lf_materials_get(b->s->materials, sh->material));
+    m.alpha = b->alpha;
+    m.alpha_tex = b->alpha_tex;
     if (shape_media(b, sh, &m.medium_in, &m.medium_out)) {
         free(P), free(N), free(uv), free(idx);
         return b->err->code;
@@ -495,7 +497,8 @@ static int shape_sphere(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_m
     zmax = lf_clampd(fmax(zmin, zmax), -r, r);
     phimax = lf_clampd(phimax, 0, 360);
     double scale = similarity_scale(xf);
-    int full = zmin <= -r && zmax >= r && phimax >= 360.0;
+    /* An alpha-cut sphere is tessellated: the alpha filter is on meshes. */
+    int full = zmin <= -r && zmax >= r && phimax >= 360.0 && b->alpha >= 1 && !b->alpha_tex;
     for (int k = 1; k < mo->n && scale > 0; k++)
         if (similarity_scale(&mo->keys[k]) <= 0)
             scale = 0; /* sheared somewhere along the motion: tessellate */
@@ -659,21 +662,8 @@ int lf_build_shape(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_motion
 {
     char where[512];
     lf_loc_format(where, sizeof where, &sh->e.loc);
-    const lf_param *alpha = sh->e.params.count ? lf_params_peek(&sh->e.params, "alpha") : NULL;
-    if (alpha) {
-        /* "float alpha" 1 changes nothing; anything else cuts the shape,
-         * which lensfield cannot: the shape would show where the scene
-         * has a hole (the unsupported rule, docs/scene-format.md). */
-        int opaque = alpha->type == LF_PT_FLOAT && alpha->n_nums == 1 && alpha->nums[0] == 1.0;
-        lf_params_find(&sh->e.params, "alpha");
-        if (!opaque && !b->d->allow_unsupported)
-            return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
-                                "%s: Shape \"%s\": \"alpha\" cut-outs are not supported (--allow-unsupported renders "
-                                "the shape opaque)",
-                                where, sh->e.type);
-        if (!opaque)
-            lf_warn_at(&b->s->warnings, &sh->e.loc, "\"alpha\" cut-outs are not supported; the shape is opaque");
-    }
+    if (lf_shape_known(sh->e.type) && lf_read_shape_alpha(b, sh))
+        return b->err->code;
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {
             if (shape_table[i].fn(b, sh, mo))

@@ -7,7 +7,12 @@
  *     (pbrt-v4's ParameterDictionary); the same name with another type is
  *     still an unused parameter;
  *   - bdpt, mlt, sppm and lightpath accept pbrt-v4's parameters and render
- *     with the path tracer and a note; a wrong type is still an error.
+ *     with the path tracer and a note; a wrong type is still an error;
+ *   - "alpha": a black plane cut by a float checkerboard alpha (0.25 and 1,
+ *     mean 0.625) passes 1 - 0.625 of a uniform sky to camera rays, and of
+ *     a distant light's irradiance to a floor below it through shadow
+ *     rays (closed forms; Bernoulli noise margins stated below); alpha 0
+ *     hides a sphere.
  * Seeds are fixed; margins are stated at each assertion. */
 #include <math.h>
 #include <stdio.h>
@@ -150,10 +155,73 @@ static void test_integrator_params(void)
     CHECK_MSG(rc != 0 && strstr(msg, "unused parameter"), "path has no radius: %s", msg);
 }
 
+/* ---- alpha cut-outs ---- */
+#define ALPHA_PLANE                                                                                          \
+    "Texture \"a\" \"float\" \"checkerboard\" \"float tex1\" 0.25 \"float tex2\" 1 \"float uscale\" 4 " \
+    "\"float vscale\" 4\n"                                                                                   \
+    "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n"                                     \
+    "Shape \"trianglemesh\" \"texture alpha\" \"a\" \"integer indices\" [0 1 2 0 2 3]\n"                   \
+    "  \"point3 P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] \"point2 uv\" [0 0 1 0 1 1 0 1]\nAttributeEnd\n"
+
+static void test_alpha(void)
+{
+    const double pass = 1 - (0.25 + 1) / 2; /* 1 - mean alpha */
+    char msg[1024] = "";
+    lf_image img = {0};
+    /* camera rays: 16 x 16 pixels x 64 spp, half of them on checks of
+     * alpha 0.25 (Bernoulli 0.75): std of the mean 0.5 sqrt(0.1875 / 8192)
+     * = 0.0024; margin 0.012 (5 sigma) */
+    int rc = render("LookAt 0 0 5  0 0 0  0 1 0\n"
+                    "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
+                    "Film \"rgb\" \"integer xresolution\" [16] \"integer yresolution\" [16]\n"
+                    "Sampler \"independent\" \"integer pixelsamples\" [64] \"integer seed\" [11]\n"
+                    "PixelFilter \"box\"\nWorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n" ALPHA_PLANE,
+                    &img, msg, sizeof msg);
+    CHECK_MSG(rc == 0, "%s", msg);
+    if (!rc) {
+        CHECK_NEAR(mean_channel(&img, 1, 0, 16, 0, 16), pass, 0.012);
+        lf_image_free(&img);
+    }
+    /* shadow rays: a floor (albedo 0.5) at z = -1 under a vertical distant
+     * light of irradiance 1, seen from between plane and floor: radiance
+     * 0.5 / pi x (1 - mean alpha); same noise as above, relative margin 4 % */
+    rc = render("LookAt 0 0 -0.5  0 0 -1  0 1 0\n"
+                "Camera \"orthographic\" \"float screenwindow\" [-1 1 -1 1]\n"
+                "Film \"rgb\" \"integer xresolution\" [16] \"integer yresolution\" [16]\n"
+                "Sampler \"independent\" \"integer pixelsamples\" [64] \"integer seed\" [12]\n"
+                "PixelFilter \"box\"\nWorldBegin\n"
+                "LightSource \"distant\" \"point3 from\" [0 0 1] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1]\n" ALPHA_PLANE
+                "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n"
+                "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n"
+                "  \"point3 P\" [-9 -9 -1  9 -9 -1  9 9 -1  -9 9 -1]\n",
+                &img, msg, sizeof msg);
+    CHECK_MSG(rc == 0, "%s", msg);
+    if (!rc) {
+        double want = 0.5 / M_PI * pass;
+        CHECK_NEAR(mean_channel(&img, 1, 0, 16, 0, 16), want, 0.04 * want);
+        lf_image_free(&img);
+    }
+    /* alpha 0: the sphere is not there (every sample sees the sky of 1) */
+    rc = render("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"orthographic\"\n"
+                "Film \"rgb\" \"integer xresolution\" [4] \"integer yresolution\" [4]\n"
+                "Sampler \"independent\" \"integer pixelsamples\" [4]\nWorldBegin\n"
+                "LightSource \"infinite\" \"rgb L\" [1 1 1]\nShape \"sphere\" \"float alpha\" 0\n",
+                &img, msg, sizeof msg);
+    CHECK_MSG(rc == 0, "%s", msg);
+    if (!rc) {
+        CHECK_NEAR(mean_channel(&img, 0, 0, 4, 0, 4), 1.0, 1e-6);
+        lf_image_free(&img);
+    }
+    /* a texture that is not there names the shape's parameter */
+    rc = render_text("WorldBegin\nShape \"sphere\" \"texture alpha\" \"nope\"\n", NULL, NULL, msg, sizeof msg);
+    CHECK_MSG(rc != 0 && strstr(msg, "test.pbrt:2:") && strstr(msg, "nope"), "%s", msg);
+}
+
 int main(void)
 {
     test_disk_reverse_orientation();
     test_duplicate_parameters();
     test_integrator_params();
+    test_alpha();
     return lf_test_end();
 }

@@ -12,7 +12,11 @@
  *     mean 0.625) passes 1 - 0.625 of a uniform sky to camera rays, and of
  *     a distant light's irradiance to a floor below it through shadow
  *     rays (closed forms; Bernoulli noise margins stated below); alpha 0
- *     hides a sphere.
+ *     hides a sphere;
+ *   - silhouettes: a black cylinder (and a quarter of one), a partial disk
+ *     (inner radius, phimax) and, in test_curves, curves in front of a sky
+ *     of 1 hide the fraction of an orthographic window their projected
+ *     area says (2 r (zmax - zmin) phi-clipped; (phimax / 2) (r^2 - ri^2)).
  * Seeds are fixed; margins are stated at each assertion. */
 #include <math.h>
 #include <stdio.h>
@@ -217,11 +221,60 @@ static void test_alpha(void)
     CHECK_MSG(rc != 0 && strstr(msg, "test.pbrt:2:") && strstr(msg, "nope"), "%s", msg);
 }
 
+/* ---- silhouettes against geometry ---- */
+/* Fraction of an orthographic window [-w,w]^2 the black shapes in `shapes`
+ * hide from a sky of 1 (camera at `eye` looking at the origin, up `up`). */
+static double covered_fraction(const char *eye_up, double w, const char *shapes)
+{
+    char scene[8192], msg[1024] = "";
+    snprintf(scene, sizeof scene,
+             "LookAt %s\nCamera \"orthographic\" \"float screenwindow\" [%g %g %g %g]\n"
+             "Film \"rgb\" \"integer xresolution\" [48] \"integer yresolution\" [48]\n"
+             "Sampler \"stratified\" \"integer xsamples\" [6] \"integer ysamples\" [6] \"integer seed\" [3]\n"
+             "PixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" [1]\nWorldBegin\n"
+             "LightSource \"infinite\" \"rgb L\" [1 1 1]\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n%s",
+             eye_up, -w, w, -w, w, shapes);
+    lf_image img = {0};
+    int rc = render(scene, &img, msg, sizeof msg);
+    CHECK_MSG(rc == 0, "%s", msg);
+    if (rc)
+        return -1;
+    double f = 1 - mean_channel(&img, 0, 0, img.width, 0, img.height);
+    lf_image_free(&img);
+    return f;
+}
+
+/* Stratified 6x6 per pixel on 48x48 pixels: only pixels on an edge are
+ * partly covered; their error is below 1/36 of a pixel's area each, so a
+ * silhouette of perimeter P (in pixels) is off by less than P/36 pixel
+ * areas: ~0.1 % of the window for these shapes.  Margin 0.003 absolute. */
+static void test_silhouettes(void)
+{
+    /* side view of a cylinder r 0.5, z in [-0.6, 0.6]: 2 r x 1.2 of 4 */
+    double f = covered_fraction("0 -5 0  0 0 0  0 0 1", 1,
+                                "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -0.6 \"float zmax\" 0.6\n");
+    CHECK_NEAR(f, 1.0 * 1.2 / 4, 0.003);
+    /* phimax 90: x = r cos(phi) spans [0, r] */
+    f = covered_fraction("0 -5 0  0 0 0  0 0 1", 1,
+                         "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -0.6 \"float zmax\" 0.6 "
+                         "\"float phimax\" 90\n");
+    CHECK_NEAR(f, 0.5 * 1.2 / 4, 0.003);
+    /* zmin > zmax is ordered as pbrt-v4 does */
+    f = covered_fraction("0 -5 0  0 0 0  0 0 1", 1,
+                         "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 0.6 \"float zmax\" -0.6\n");
+    CHECK_NEAR(f, 1.0 * 1.2 / 4, 0.003);
+    /* partial disk, face on: (270/360) pi (1 - 0.25) of 2.4^2 */
+    f = covered_fraction("0 0 5  0 0 0  0 1 0", 1.2,
+                         "Shape \"disk\" \"float radius\" 1 \"float innerradius\" 0.5 \"float phimax\" 270\n");
+    CHECK_NEAR(f, 0.75 * M_PI * 0.75 / (2.4 * 2.4), 0.003);
+}
+
 int main(void)
 {
     test_disk_reverse_orientation();
     test_duplicate_parameters();
     test_integrator_params();
     test_alpha();
+    test_silhouettes();
     return lf_test_end();
 }

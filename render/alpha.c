@@ -120,3 +120,38 @@ void lf_alpha_attach(RTCGeometry g, const lf_mesh *me)
     rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
     rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
 }
+
+/* Curves: pbrt's (u, v) from Embree's segment parameter and its v across
+ * the width (both in [0,1], as pbrt-v4's). */
+static void curve_alpha_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0])
+        return;
+    const lf_curve *c = a->geometryUserPtr;
+    const struct RTCRay *r = (const struct RTCRay *)a->ray;
+    const struct RTCHit *h = (const struct RTCHit *)a->hit;
+    float o[3] = {r->org_x, r->org_y, r->org_z}, d[3] = {r->dir_x, r->dir_y, r->dir_z};
+    float p[3] = {o[0] + r->tfar * d[0], o[1] + r->tfar * d[1], o[2] + r->tfar * d[2]};
+    float al = c->alpha;
+    if (c->alpha_tex) {
+        lf_shading_ctx ctx;
+        memset(&ctx, 0, sizeof ctx);
+        ctx.uv = (lf_vec2){((float)h->primID + h->u) * c->u_step, h->v};
+        ctx.p = lf_v3(p[0], p[1], p[2]);
+        ctx.ng = ctx.ns = lf_v3(0, 0, 1);
+        al = lf_texture_float(c->alpha_tex, &ctx);
+    }
+    if (al >= 1.f)
+        return;
+    if (!(al > 0.f) || hash_float(p, d) > al)
+        a->valid[0] = 0;
+}
+
+void lf_alpha_attach_curve(RTCGeometry g, const lf_curve *c)
+{
+    rtcSetGeometryUserData(g, (void *)c);
+    if (!c->alpha_tex && c->alpha >= 1.f)
+        return;
+    rtcSetGeometryIntersectFilterFunction(g, curve_alpha_filter);
+    rtcSetGeometryOccludedFilterFunction(g, curve_alpha_filter);
+}

@@ -44,6 +44,28 @@ typedef struct lf_mesh {
     const struct lf_texture *alpha_tex;
 } lf_mesh;
 
+/* pbrt-v4's Shape "curve" as Embree curve geometry (render/curves.c):
+ * every segment is a cubic Bezier (B-splines and quadratics are converted,
+ * as pbrt-v4 does), 4 control points of its own in world space.  "flat" and
+ * "cylinder" are Embree's ray-facing flat curves (pbrt-v4's cylinder is a
+ * flat curve whose shading normal is bent across the width); "ribbon" is
+ * Embree's normal-oriented curve. */
+enum { LF_CURVE_FLAT, LF_CURVE_CYLINDER, LF_CURVE_RIBBON };
+typedef struct lf_curve {
+    int n_segs;
+    int type;          /* LF_CURVE_* */
+    float *cp;         /* 4 (x, y, z, radius) per control point, 4 control points per segment */
+    unsigned *first;   /* Embree index buffer: segment k starts at control point 4 k */
+    float *nrm;        /* ribbon: 3 per control point (Bezier of the normal), else NULL */
+    float u_step;      /* segment k covers pbrt's u in [k u_step, (k + 1) u_step] */
+    int tess;          /* Embree's tessellation rate: quads per segment */
+    int material;
+    int flip_normal;
+    int medium_in, medium_out;
+    float alpha;       /* as lf_mesh */
+    const struct lf_texture *alpha_tex;
+} lf_curve;
+
 typedef struct lf_sphere {
     lf_vec3 center;     /* at the first keyframe */
     float radius;
@@ -138,13 +160,15 @@ typedef struct lf_scene {
     lf_sphere *spheres;
     int n_spheres;
     unsigned sphere_geom_id; /* the static spheres' geometry; RTC_INVALID_GEOMETRY_ID if none */
-    int *geom_index;         /* top-level geomID -> mesh index (>= 0) or -1 - sphere index (moving
+    int *geom_index;         /* top-level geomID -> mesh index (>= 0; n_meshes + k: curve k) or -1 - sphere index (moving
                                 sphere); for an instance, the lf_instance index (hit.instID[0]) */
     int n_geom;
     lf_proto *protos;
     int n_protos;
     lf_instance *instances;
     int n_instances;
+    lf_curve *curves;        /* geom_index n_meshes + k is curve k */
+    int n_curves;
     int moving_shapes;       /* meshes or spheres with more than one keyframe, plus moving instances */
     int max_keys;            /* of the keyframed meshes and spheres */
     int motion_rigid_shapes; /* Shape directives (per ObjectInstance) moved as rigid Embree instances */

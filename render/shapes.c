@@ -678,7 +678,7 @@ static const struct {
 } shape_table[] = {
     {"trianglemesh", shape_trianglemesh}, {"plymesh", shape_plymesh}, {"sphere", shape_sphere},
     {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh}, {"loopsubdiv", shape_loopsubdiv},
-    {"cylinder", shape_cylinder},
+    {"cylinder", shape_cylinder},         {"curve", lf_build_curve},
 };
 
 int lf_shape_known(const char *type)

@@ -1621,7 +1621,7 @@ static int d_option(parser *P, lexer *L, const token *dir)
  * --allow-unsupported (lf_parse_opts.allow_unsupported). */
 static const char *const pbrt_shapes[] = {"bilinearmesh", "curve",  "cylinder", "disk", "loopsubdiv",
                                           "plymesh",      "sphere", "trianglemesh", NULL};
-static const char *const refused_shapes[] = {"curve", NULL};
+static const char *const refused_shapes[] = {NULL};
 static const char *const pbrt_lights[] = {"distant", "goniometric", "infinite", "point", "projection", "spot", NULL};
 static const char *const refused_lights[] = {"goniometric", "projection", NULL};
 static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse", "conductor",   "dielectric", "diffuse",

@@ -26,6 +26,7 @@
 #include "lf_test.h"
 #include "lf_test_tools.h"
 #include "render/lf_render.h"
+#include "render/render_internal.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -269,6 +270,100 @@ static void test_silhouettes(void)
     CHECK_NEAR(f, 0.75 * M_PI * 0.75 / (2.4 * 2.4), 0.003);
 }
 
+/* ---- curves ---- */
+static void test_curves(void)
+{
+    static const struct {
+        const char *shape;
+        double area;
+    } cases[] = {
+        /* straight cubic Bezier along x, length 1.6, width 0.2 */
+        {"\"point3 P\" [-0.8 0 0 -0.3 0 0 0.3 0 0 0.8 0 0] \"float width\" 0.2", 1.6 * 0.2},
+        {"\"point3 P\" [-0.8 0 0 -0.3 0 0 0.3 0 0 0.8 0 0] \"float width\" 0.2 \"string type\" \"cylinder\"",
+         1.6 * 0.2},
+        /* tapered 0.1 -> 0.3: a trapezoid of mean width 0.2 */
+        {"\"point3 P\" [-0.8 0 0 -0.3 0 0 0.3 0 0 0.8 0 0] \"float width0\" 0.1 \"float width1\" 0.3", 1.6 * 0.2},
+        /* two segments sharing an end point */
+        {"\"point3 P\" [-0.8 0 0 -0.6 0 0 -0.2 0 0 0 0 0 0.2 0 0 0.6 0 0 0.8 0 0] \"float width\" 0.2", 1.6 * 0.2},
+        /* uniform cubic B-spline of collinear points -1.2 -0.4 0.4 1.2: one
+         * segment from (p0 + 4 p1 + p2) / 6 = -0.4 to 0.4 */
+        {"\"point3 P\" [-1.2 0 0 -0.4 0 0 0.4 0 0 1.2 0 0] \"string basis\" \"bspline\" \"float width\" 0.2",
+         0.8 * 0.2},
+        /* quadratic Bezier (degree 2) */
+        {"\"point3 P\" [-0.8 0 0 0 0 0 0.8 0 0] \"integer degree\" 2 \"float width\" 0.2", 1.6 * 0.2},
+        /* ribbon facing the camera (+z), and edge-on (normals +y) */
+        {"\"point3 P\" [-0.8 0 0 -0.3 0 0 0.3 0 0 0.8 0 0] \"float width\" 0.2 \"string type\" \"ribbon\" "
+         "\"normal N\" [0 0 1 0 0 1] \"integer splitdepth\" 5",
+         1.6 * 0.2},
+        {"\"point3 P\" [-0.8 0 0 -0.3 0 0 0.3 0 0 0.8 0 0] \"float width\" 0.2 \"string type\" \"ribbon\" "
+         "\"normal N\" [0 1 0 0 1 0]",
+         0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char shape[1024];
+        snprintf(shape, sizeof shape, "Shape \"curve\" %s\n", cases[i].shape);
+        double f = covered_fraction("0 0 5  0 0 0  0 1 0", 1, shape);
+        CHECK_MSG(fabs(f - cases[i].area / 4) < 0.003, "%s: covered %g, geometry %g", cases[i].shape, f,
+                  cases[i].area / 4);
+    }
+    /* a bent curve in the view plane: a band of width w around it covers
+     * w x its arc length (Steiner; the ends are cut square), the length by
+     * quadrature of |B'(u)| (2000 midpoint steps) */
+    {
+        static const double P[4][2] = {{-0.8, -0.4}, {-0.4, 0.6}, {0.4, 0.6}, {0.8, -0.4}};
+        double L = 0;
+        for (int i = 0; i < 2000; i++) {
+            double u = (i + 0.5) / 2000, v = 1 - u, dx = 0, dy = 0;
+            double db[4] = {-3 * v * v, 3 * v * v - 6 * u * v, 6 * u * v - 3 * u * u, 3 * u * u};
+            for (int k = 0; k < 4; k++)
+                dx += db[k] * P[k][0], dy += db[k] * P[k][1];
+            L += sqrt(dx * dx + dy * dy) / 2000;
+        }
+        double f = covered_fraction("0 0 5  0 0 0  0 1 0", 1,
+                                    "Shape \"curve\" \"point3 P\" [-0.8 -0.4 0 -0.4 0.6 0 0.4 0.6 0 0.8 -0.4 0] "
+                                    "\"float width\" 0.1\n");
+        CHECK_NEAR(f, 0.1 * L / 4, 0.003);
+    }
+    /* hit data: rays along -z at (x, y) onto a flat curve along +x */
+    lf_scene_desc d;
+    lf_scene s;
+    lf_error err = {0};
+    const char *text = "WorldBegin\nShape \"curve\" \"point3 P\" [-1 0 0 -0.33333333 0 0 0.33333333 0 0 1 0 0] "
+                       "\"float width\" 0.4\n";
+    if (lf_scene_parse_string(text, "curve.pbrt", &d, &err) == 0) {
+        if (lf_scene_build(&d, &s, &err) == 0) {
+            static const float xs[3] = {-0.5f, 0.f, 0.6f}, ys[3] = {0.1f, -0.15f, 0.f};
+            for (int k = 0; k < 3; k++) {
+                lf_hit h;
+                int got = lf_scene_intersect(&s, lf_v3(xs[k], ys[k], 5), lf_v3(0, 0, -1), 100, 0, &h);
+                CHECK(got);
+                if (!got)
+                    continue;
+                CHECK_NEAR(h.t, 5, 1e-4);
+                CHECK(h.curve == 1);
+                CHECK_NEAR(h.curve_h, -2 * ys[k] / 0.4, 2e-3);
+                CHECK_NEAR(h.sc.uv.y, 0.5 - ys[k] / 0.4, 1e-3);
+                /* control points at thirds: x = -1 + 2 u */
+                CHECK_NEAR(h.sc.uv.x, (xs[k] + 1) / 2, 1e-3);
+                CHECK_NEAR(h.sc.dpdu.x, 1, 1e-5);
+                CHECK_NEAR(fabsf(h.sc.ng.z), 1, 1e-5);
+            }
+            lf_scene_free(&s);
+        } else {
+            CHECK_MSG(0, "%s", err.msg);
+        }
+        lf_scene_desc_free(&d);
+    } else {
+        CHECK_MSG(0, "%s", err.msg);
+    }
+    /* ribbons need their normals */
+    char msg[1024] = "";
+    int rc = render_text("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0] \"string type\" "
+                         "\"ribbon\"\n",
+                         NULL, NULL, msg, sizeof msg);
+    CHECK_MSG(rc != 0 && strstr(msg, "test.pbrt:2:") && strstr(msg, "normal N"), "%s", msg);
+}
+
 int main(void)
 {
     test_disk_reverse_orientation();
@@ -276,5 +371,6 @@ int main(void)
     test_integrator_params();
     test_alpha();
     test_silhouettes();
+    test_curves();
     return lf_test_end();
 }

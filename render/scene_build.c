@@ -262,7 +262,7 @@ void lf_scene_free(lf_scene *s)
     if (s->n_lights)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);
-    free(s->media);
+    lf_media_free(s);
     lf_warnings_free(&s->warnings);
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;

@@ -806,8 +806,11 @@ static int check_count(parser *P, const lf_loc *loc, lf_param_type type, const c
             return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" has %zu values, not a multiple of 3", decl, n);
         break;
     case LF_PT_RGB:
-        if (n != 3)
-            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 3 values, got %zu", decl, n);
+        /* several triples only for per-voxel grids (MakeNamedMedium "rgbgrid");
+         * a single colour read from more is an error at its lookup */
+        if (n == 0 || n % 3)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 3 values, got %zu (or 3 per sample of a grid)",
+                        decl, n);
         break;
     case LF_PT_BLACKBODY:
         if (n != 1)

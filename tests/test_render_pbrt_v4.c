@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 
 #include "lf_test.h"
 #include "lf_test_tools.h"
@@ -522,6 +523,60 @@ static void test_grid_furnace(void)
     }
 }
 
+/* ---- the example scenes ---- */
+static void test_scene_files(void)
+{
+    const char *dir = LF_SOURCE_DIR "/scenes/pbrt-v4";
+    DIR *dd = opendir(dir);
+    CHECK_MSG(dd != NULL, "%s", dir);
+    if (!dd)
+        return;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(dd))) {
+        size_t len = strlen(e->d_name);
+        if (len < 6 || strcmp(e->d_name + len - 5, ".pbrt"))
+            continue;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        lf_scene_desc d;
+        lf_error err = {0};
+        if (lf_scene_parse_file(path, &d, &err)) {
+            CHECK_MSG(0, "%s: %s", e->d_name, err.msg);
+            continue;
+        }
+        lf_render_opts o = lf_render_opts_default();
+        o.spp = 2, o.threads = 2;
+        o.crop[0] = 130, o.crop[1] = 178, o.crop[2] = 90, o.crop[3] = 122;
+        lf_renderer *r = NULL;
+        lf_image img = {0};
+        int rc = lf_renderer_create(&d, &o, &r, &err);
+        if (!rc)
+            rc = lf_renderer_render(r, &img, NULL, &err);
+        CHECK_MSG(rc == 0, "%s: %s", e->d_name, err.msg);
+        if (!rc) {
+            const char *w = lf_renderer_warnings(r);
+            CHECK_MSG(!w || !*w, "%s warns: %s", e->d_name, w);
+            double sum = 0;
+            int bad = 0;
+            for (int y = 0; y < img.height; y++)
+                for (int x = 0; x < img.width; x++)
+                    for (int c = 0; c < 3; c++) {
+                        float v = lf_image_px(&img, x, y)[c];
+                        bad += !(v >= 0) || !isfinite(v);
+                        sum += v;
+                    }
+            CHECK_MSG(!bad && sum > 0, "%s: %d bad pixels, sum %g", e->d_name, bad, sum);
+            lf_image_free(&img);
+        }
+        lf_renderer_free(r);
+        lf_scene_desc_free(&d);
+        n++;
+    }
+    closedir(dd);
+    CHECK_MSG(n >= 4, "%d scenes in %s", n, dir);
+}
+
 int main(void)
 {
     test_disk_reverse_orientation();
@@ -532,5 +587,6 @@ int main(void)
     test_curves();
     test_grid_media();
     test_grid_furnace();
+    test_scene_files();
     return lf_test_end();
 }

@@ -155,3 +155,21 @@ void lf_alpha_attach_curve(RTCGeometry g, const lf_curve *c)
     rtcSetGeometryIntersectFilterFunction(g, curve_alpha_filter);
     rtcSetGeometryOccludedFilterFunction(g, curve_alpha_filter);
 }
+
+int lf_alpha_masked(float alpha, const struct lf_texture *tex, lf_vec3 p, lf_vec2 uv)
+{
+    float a = alpha;
+    if (tex) {
+        lf_shading_ctx ctx;
+        memset(&ctx, 0, sizeof ctx);
+        ctx.p = p, ctx.uv = uv;
+        ctx.ng = ctx.ns = lf_v3(0, 0, 1);
+        a = lf_texture_float(tex, &ctx);
+    }
+    if (a >= 1.f)
+        return 0;
+    if (!(a > 0.f))
+        return 1;
+    float pp[3] = {p.x, p.y, p.z}, q[3] = {uv.x, uv.y, 0.f};
+    return hash_float(pp, q) > a;
+}

@@ -34,6 +34,9 @@ typedef struct lf_scene_builder {
 int lf_read_shape_alpha(lf_scene_builder *b, lf_shape_desc *sh);
 /* Sets the alpha filter on a mesh's geometry when it is not opaque. */
 void lf_alpha_attach(RTCGeometry g, const lf_mesh *me);
+/* pbrt-v4's AlphaMasked for area lights: alpha 0 masks, 1 does not, in
+ * between a hash of the point and its (u,v) decides. */
+int lf_alpha_masked(float alpha, const struct lf_texture *tex, lf_vec3 p, lf_vec2 uv);
 /* The same for a curve's geometry. */
 void lf_alpha_attach_curve(RTCGeometry g, const lf_curve *c);
 /* Shape "curve" (render/curves.c). */

@@ -166,7 +166,8 @@ static int add_mesh_lights(lf_scene_builder *b, lf_mesh *m, int area_light)
         total_area += 0.5 * mesh_span(m, m->idx[3 * t], m->idx[3 * t + 1], m->idx[3 * t + 2]);
     lf_vec3 L = ae.L;
     apply_area_power(&L, &ae, total_area);
-    int quads = m->n_keys == 1 && !m->N && m->n_tris % 2 == 0 && m->n_tris > 0;
+    /* an alpha-masked emitter is masked per triangle point: no quads */
+    int quads = m->n_keys == 1 && !m->N && m->n_tris % 2 == 0 && m->n_tris > 0 && m->alpha >= 1 && !m->alpha_tex;
     for (int t = 0; quads && t < m->n_tris; t += 2) {
         int q[3];
         quads = triangle_pair_parallelogram(m, t, q);
@@ -181,6 +182,9 @@ static int add_mesh_lights(lf_scene_builder *b, lf_mesh *m, int area_light)
         l.prim = t;
         l.twosided = ae.twosided;
         l.sphere = -1;
+        l.has_alpha = m->alpha < 1 || m->alpha_tex;
+        l.alpha = m->alpha;
+        l.alpha_tex = m->alpha_tex;
         if (quads) {
             triangle_pair_parallelogram(m, t, l.quad);
             l.kind = LF_LIGHT_PARALLELOGRAM;

@@ -218,6 +218,25 @@ static void test_alpha(void)
         CHECK_NEAR(mean_channel(&img, 0, 0, 4, 0, 4), 1.0, 1e-6);
         lf_image_free(&img);
     }
+    /* an area light with alpha 0 emits nothing, as pbrt-v4's
+     * DiffuseAreaLight where AlphaMasked (kroken's disabled sphere light):
+     * neither seen nor sampled, the floor under it stays black */
+    rc = render("LookAt 0 0 -0.5  0 0 -1  0 1 0\nCamera \"orthographic\"\n"
+                "Film \"rgb\" \"integer xresolution\" [4] \"integer yresolution\" [4]\n"
+                "Sampler \"independent\" \"integer pixelsamples\" [16]\nWorldBegin\n"
+                "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [5 5 5]\nReverseOrientation\n"
+                "Shape \"sphere\" \"float radius\" 0.3 \"float alpha\" 0\nAttributeEnd\n"
+                "AttributeBegin\nTranslate 0 0 1\nAreaLightSource \"diffuse\" \"rgb L\" [5 5 5]\n"
+                "Shape \"trianglemesh\" \"float alpha\" 0 \"integer indices\" [0 1 2 0 2 3] "
+                "\"point3 P\" [-1 -1 0 1 -1 0 1 1 0 -1 1 0]\nAttributeEnd\n"
+                "Material \"diffuse\"\nShape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] "
+                "\"point3 P\" [-9 -9 -1 9 -9 -1 9 9 -1 -9 9 -1]\n",
+                &img, msg, sizeof msg);
+    CHECK_MSG(rc == 0, "%s", msg);
+    if (!rc) {
+        CHECK_NEAR(mean_channel(&img, 0, 0, 4, 0, 4), 0.0, 1e-9);
+        lf_image_free(&img);
+    }
     /* a texture that is not there names the shape's parameter */
     rc = render_text("WorldBegin\nShape \"sphere\" \"texture alpha\" \"nope\"\n", NULL, NULL, msg, sizeof msg);
     CHECK_MSG(rc != 0 && strstr(msg, "test.pbrt:2:") && strstr(msg, "nope"), "%s", msg);

@@ -8,8 +8,8 @@
  * media to the shapes that follow (a ray crossing one leaves for the side
  * its direction points to: outside along the surface normal); the camera
  * starts its rays in the exterior medium current when Camera was declared.
- * Heterogeneous media ("uniformgrid", "rgbgrid", "cloud") are read by
- * render/media_grid.c; "nanovdb" is refused (--allow-unsupported: left out). */
+ * Heterogeneous media ("uniformgrid", "rgbgrid", "cloud", "nanovdb") are
+ * read by render/media_grid.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,24 +31,6 @@ int lf_media_lookup(const lf_scene_desc *d, const char *name, const lf_loc *loc,
     return lf_error_at(err, LF_ERR_PARAM, loc, "%s: no medium named \"%s\" (MakeNamedMedium)", what, name);
 }
 
-/* "nanovdb" media need OpenVDB's NanoVDB reader, which lensfield does not
- * link: refused, or with --allow-unsupported a medium that does nothing
- * (the scene renders without it), with a warning. */
-static int read_nanovdb(const lf_scene_desc *d, lf_medium_desc *md, lf_medium *m, lf_warnings *w, lf_error *err)
-{
-    if (!d->allow_unsupported)
-        return lf_error_at(err, LF_ERR_UNSUPPORTED, &md->e.loc,
-                           "MakeNamedMedium \"%s\": medium type \"nanovdb\" is not supported (--allow-unsupported "
-                           "renders the scene without this medium)",
-                           md->name);
-    lf_warn_at(w, &md->e.loc, "MakeNamedMedium \"%s\": \"nanovdb\" media are not supported; rendered without it",
-               md->name);
-    for (size_t k = 0; k < md->e.params.count; k++)
-        md->e.params.items[k].used = 1;
-    memset(m, 0, sizeof *m); /* sigma 0: nothing happens along a ray in it */
-    return 0;
-}
-
 int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
 {
     s->camera_medium = -1;
@@ -63,13 +45,9 @@ int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
         lf_paramset *ps = &md->e.params;
         const lf_loc *l = &md->e.loc;
         const char *type = lf_params_string(ps, "type", "");
-        if (!strcmp(type, "nanovdb")) {
-            if (read_nanovdb(d, md, &s->media[i], &s->warnings, err))
-                return err->code;
-            continue;
-        }
-        if (!strcmp(type, "uniformgrid") || !strcmp(type, "rgbgrid") || !strcmp(type, "cloud")) {
-            if (lf_media_read_grid(md, &s->media[i], d->allow_unsupported, &s->warnings, err))
+        if (!strcmp(type, "uniformgrid") || !strcmp(type, "rgbgrid") || !strcmp(type, "cloud") ||
+            !strcmp(type, "nanovdb")) {
+            if (lf_media_read_grid(d, md, &s->media[i], &s->warnings, err))
                 return err->code;
             char ctx[300];
             snprintf(ctx, sizeof ctx, "MakeNamedMedium \"%s\"", md->name);

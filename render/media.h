@@ -7,11 +7,13 @@
 
 #include <stdint.h>
 
-enum { LF_MEDIUM_HOMOGENEOUS, LF_MEDIUM_UNIFORMGRID, LF_MEDIUM_RGBGRID, LF_MEDIUM_CLOUD };
+enum { LF_MEDIUM_HOMOGENEOUS, LF_MEDIUM_UNIFORMGRID, LF_MEDIUM_RGBGRID, LF_MEDIUM_CLOUD, LF_MEDIUM_NANOVDB };
+
+struct lf_nvdb;
 
 /* A participating medium, per RGB channel, "scale" applied: homogeneous
  * (pbrt-v4 "homogeneous"), or heterogeneous inside its bounds
- * (render/media_grid.c: "uniformgrid", "rgbgrid", "cloud"). */
+ * (render/media_grid.c: "uniformgrid", "rgbgrid", "cloud", "nanovdb"). */
 struct lf_medium {
     int kind;            /* LF_MEDIUM_* */
     int hetero;          /* kind != homogeneous: null-collision tracking */
@@ -28,6 +30,8 @@ struct lf_medium {
     float *rgb_a, *rgb_s, *rgb_le; /* rgbgrid: 3 per sample, NULL when not given (sigma: 1, Le: 0) */
     float sigma_scale, le_scale;   /* rgbgrid "scale", "Lescale" */
     float cloud_density, wispiness, frequency; /* cloud */
+    struct lf_nvdb *nvdb;  /* nanovdb: the density grid (render/nanovdb_adapter.h) */
+    lf_vec3 box0, box_size; /* nanovdb: the grid's bounds in medium space (unit box -> grid space) */
     float majorant;      /* the largest sigma_t of any channel anywhere in the medium */
 };
 
@@ -40,7 +44,7 @@ int lf_media_lookup(const lf_scene_desc *d, const char *name, const lf_loc *loc,
                     lf_error *err);
 
 /* Heterogeneous media (render/media_grid.c). */
-int lf_media_read_grid(lf_medium_desc *md, lf_medium *m, int allow_unsupported, lf_warnings *w, lf_error *err);
+int lf_media_read_grid(const lf_scene_desc *d, lf_medium_desc *md, lf_medium *m, lf_warnings *w, lf_error *err);
 void lf_media_free(lf_scene *s);
 void lf_medium_noise_init(void);
 /* sigma_a, sigma_s and Le at unit-box point u. */

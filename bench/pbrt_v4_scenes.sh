@@ -10,7 +10,8 @@
 # links under a temporary folder, where the files a scene names and the
 # copy lacks (meshes, textures, spectra, volumes: the repository keeps the
 # big ones in Git LFS) are stubbed: a one-triangle PLY, a 2x2 image, a flat
-# spectrum, an empty Include.  So a row judges the scene's text, not its
+# spectrum, an empty Include or .nvdb (a scene with a nanovdb medium then
+# fails with "has no grid": its volume is data).  So a row judges the scene's text, not its
 # data.  RENDER=1 also renders a 32x32 crop at 1 spp to check the build
 # through to pixels.  Example:
 #   bench/pbrt_v4_scenes.sh ~/pbrt-v4-scenes build/bin/lfrender > rows.md
@@ -69,7 +70,7 @@ for d in */; do
 done
 
 summary() { # a log -> the reasons, one line
-    grep -E 'not supported|error|unknown|unused|no such|cannot' "$1" | sed -E 's/^lfrender: //; s/^[^ ]*:[0-9]+:[0-9]+: (warning: )?//' |
+    grep -E ':[0-9]+:[0-9]+: |not supported|cannot open|No such' "$1" | grep -v ' errors\? in ' | sed -E 's/^lfrender: //; s/^[^ ]*:[0-9]+:[0-9]+: (warning: )?//' |
         sed -E 's/ \(--allow-unsupported[^)]*\)//; s/; (left out|rendered as|the shape)[^;]*$//' | sort | uniq -c |
         sed -E 's/^ *([0-9]+) (.*)/\2 (x\1)/; s/ \(x1\)$//' | head -8 | paste -sd ';' | sed 's/;/; /g; s/|/\\|/g'
 }

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "render/scene.h"
+#include "render/scene_build.h"
 
 /* Embree asserts (and aborts) on a ray whose origin or direction is beyond
  * about 1.8e18 or not finite; the renderer refuses cameras that would make
@@ -224,6 +224,8 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     hit->t = rh.ray.tfar;
+    hit->curve = 0;
+    hit->curve_h = 0;
     lf_shading_ctx *sc = &hit->sc;
     int gi = rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? s->geom_index[rh.hit.geomID] : 0;
     if (gi < 0) {
@@ -303,6 +305,11 @@ int lf_scene_intersect(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, floa
         int swap = xf.cof.x * xf.scale.x < 0; /* det S < 0 */
         mesh_hit(m, t, p, m->N ? nv : NULL, rh.hit.u, rh.hit.v, m->flip_normal ^ swap, &xf, hit);
         sc->p = lf_madd(o, d, rh.ray.tfar);
+        return 1;
+    }
+    if (gi >= s->n_meshes) {
+        lf_curve_hit(&s->curves[gi - s->n_meshes], rh.hit.primID, rh.hit.u, o, d, rh.ray.tfar, hit);
+        hit->tau = tau;
         return 1;
     }
     const lf_mesh *m = &s->meshes[gi];

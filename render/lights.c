@@ -11,6 +11,7 @@
 
 #include "image/lf_image.h"
 #include "render/lights.h"
+#include "render/scene_build.h"
 
 /* Clarberg's equal-area mapping between the unit square and the sphere, as
  * pbrt-v4 uses for environment maps (octahedral layout). */
@@ -135,6 +136,8 @@ lf_vec3 lf_light_area_le(const lf_light *l, const lf_hit *hit, lf_vec3 w)
 {
     if (!l->twosided && lf_dot(hit->sc.ng, w) >= 0)
         return lf_v3(0, 0, 0);
+    if (l->has_alpha && lf_alpha_masked(l->alpha, l->alpha_tex, hit->sc.p, hit->sc.uv))
+        return lf_v3(0, 0, 0);
     return l->L;
 }
 
@@ -214,6 +217,19 @@ static int sample_mesh_li(const lf_scene *s, const lf_light *l, lf_vec3 p, float
         }
         float b2 = 1 - b0 - b1;
         q = lf_add(lf_add(lf_scale(pa, b0), lf_scale(pb, b1)), lf_scale(pc, b2));
+        if (l->has_alpha) {
+            /* pbrt-v4's DiffuseAreaLight emits nothing where alpha masks */
+            lf_vec2 uv0 = {0, 0}, uv1 = {1, 0}, uv2 = {1, 1};
+            if (m->uv) {
+                const float *u = m->uv;
+                uv0 = (lf_vec2){u[2 * m->idx[3 * t]], u[2 * m->idx[3 * t] + 1]};
+                uv1 = (lf_vec2){u[2 * m->idx[3 * t + 1]], u[2 * m->idx[3 * t + 1] + 1]};
+                uv2 = (lf_vec2){u[2 * m->idx[3 * t + 2]], u[2 * m->idx[3 * t + 2] + 1]};
+            }
+            lf_vec2 uv = {b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
+            if (lf_alpha_masked(l->alpha, l->alpha_tex, q, uv))
+                return 0;
+        }
         if (m->N) {
             lf_vec3 na = lf_mesh_normal_at(m, m->idx[3 * t], tau), nb = lf_mesh_normal_at(m, m->idx[3 * t + 1], tau),
                     nc = lf_mesh_normal_at(m, m->idx[3 * t + 2], tau);

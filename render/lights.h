@@ -40,6 +40,11 @@ struct lf_light {
     int twosided;
     lf_envmap *env;     /* infinite image */
     double power;       /* for the light-selection distribution */
+    /* An emitting shape's "alpha" (render/alpha.c): pbrt-v4's area light
+     * emits nothing where AlphaMasked says so (has_alpha 0: no alpha). */
+    int has_alpha;
+    float alpha;
+    const struct lf_texture *alpha_tex;
 };
 
 typedef struct lf_light_sample {

@@ -8,7 +8,8 @@
  * media to the shapes that follow (a ray crossing one leaves for the side
  * its direction points to: outside along the surface normal); the camera
  * starts its rays in the exterior medium current when Camera was declared.
- * Grid media ("uniformgrid", "rgbgrid", "cloud", "nanovdb") are refused. */
+ * Heterogeneous media ("uniformgrid", "rgbgrid", "cloud", "nanovdb") are
+ * read by render/media_grid.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,17 +39,22 @@ int lf_media_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     s->media = calloc(d->n_media, sizeof *s->media);
     if (!s->media)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    s->n_media = (int)d->n_media;
     for (size_t i = 0; i < d->n_media; i++) {
         lf_medium_desc *md = &d->media[i];
         lf_paramset *ps = &md->e.params;
         const lf_loc *l = &md->e.loc;
         const char *type = lf_params_string(ps, "type", "");
         if (!strcmp(type, "uniformgrid") || !strcmp(type, "rgbgrid") || !strcmp(type, "cloud") ||
-            !strcmp(type, "nanovdb"))
-            return lf_error_at(err, LF_ERR_UNSUPPORTED, l,
-                               "MakeNamedMedium \"%s\": medium type \"%s\" is not supported (lensfield "
-                               "renders \"homogeneous\" media only)",
-                               md->name, type);
+            !strcmp(type, "nanovdb")) {
+            if (lf_media_read_grid(d, md, &s->media[i], &s->warnings, err))
+                return err->code;
+            char ctx[300];
+            snprintf(ctx, sizeof ctx, "MakeNamedMedium \"%s\"", md->name);
+            if (lf_params_finish(ps, ctx, err))
+                return err->code;
+            continue;
+        }
         if (strcmp(type, "homogeneous"))
             return lf_error_at(err, LF_ERR_PARAM, l,
                                "MakeNamedMedium \"%s\": unknown or missing \"string type\" \"%s\" (pbrt-v4 "

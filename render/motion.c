@@ -102,7 +102,7 @@ static int shape_can_instance(const lf_shape_desc *sh)
     const lf_paramset *ps = &sh->e.params;
     if (sh->area_light >= 0 || lf_params_peek(ps, "motionsegments"))
         return 0;
-    if (!lf_shape_known(sh->e.type))
+    if (!lf_shape_known(sh->e.type) || strcmp(sh->e.type, "curve") == 0) /* curves live in world space */
         return 0;
     if (strcmp(sh->e.type, "sphere") == 0) {
         double r = peek_num(ps, "radius", 1.0), z0 = peek_num(ps, "zmin", -r), z1 = peek_num(ps, "zmax", r);

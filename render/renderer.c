@@ -23,6 +23,7 @@
 #include "base/lf_progress.h"
 #include "base/lf_color.h"
 #include "render/film.h"
+#include "render/integrator_params.h"
 #include "render/render_internal.h"
 
 #define LF_VERSION_STRING "lensfield " LF_VERSION /* LF_VERSION: CMake's project version (lf_base) */
@@ -392,8 +393,8 @@ static int read_integrator(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     if (strcmp(type, "path") && strcmp(type, "volpath"))
         lf_warn_at(&r->warnings, oe.loc,
                    "Integrator \"%s\" is not implemented; using \"path\", which converges to the same "
-                   "image",
-                   type);
+                   "image%s",
+                   type, lf_integrator_accept_params(type, ps) ? " (its own parameters are read and not used)" : "");
     r->integrator.volumetric = strcmp(type, "path") != 0;
     r->integrator.max_depth = lf_params_int(ps, "maxdepth", 5);
     r->integrator.regularize = lf_params_bool(ps, "regularize", 0);

@@ -37,7 +37,34 @@ typedef struct lf_mesh {
     int flip_normal;   /* reverse orientation XOR handedness swap */
     int medium_in, medium_out; /* MediumInterface (lf_scene.media indices, -1 vacuum); LF_MEDIUM_SAME: none */
     int bump;          /* its material has a displacement: hits carry (u,v) derivatives */
+    /* pbrt-v4's "alpha": a hit is ignored when a hash of the hit point and
+     * ray direction exceeds alpha (render/alpha.c); alpha_tex NULL and
+     * alpha >= 1: opaque, no filter. */
+    float alpha;
+    const struct lf_texture *alpha_tex;
 } lf_mesh;
+
+/* pbrt-v4's Shape "curve" as Embree curve geometry (render/curves.c):
+ * every segment is a cubic Bezier (B-splines and quadratics are converted,
+ * as pbrt-v4 does), 4 control points of its own in world space.  "flat" and
+ * "cylinder" are Embree's ray-facing flat curves (pbrt-v4's cylinder is a
+ * flat curve whose shading normal is bent across the width); "ribbon" is
+ * Embree's normal-oriented curve. */
+enum { LF_CURVE_FLAT, LF_CURVE_CYLINDER, LF_CURVE_RIBBON };
+typedef struct lf_curve {
+    int n_segs;
+    int type;          /* LF_CURVE_* */
+    float *cp;         /* 4 (x, y, z, radius) per control point, 4 control points per segment */
+    unsigned *first;   /* Embree index buffer: segment k starts at control point 4 k */
+    float *nrm;        /* ribbon: 3 per control point (Bezier of the normal), else NULL */
+    float u_step;      /* segment k covers pbrt's u in [k u_step, (k + 1) u_step] */
+    int tess;          /* Embree's tessellation rate: quads per segment */
+    int material;
+    int flip_normal;
+    int medium_in, medium_out;
+    float alpha;       /* as lf_mesh */
+    const struct lf_texture *alpha_tex;
+} lf_curve;
 
 typedef struct lf_sphere {
     lf_vec3 center;     /* at the first keyframe */
@@ -133,13 +160,15 @@ typedef struct lf_scene {
     lf_sphere *spheres;
     int n_spheres;
     unsigned sphere_geom_id; /* the static spheres' geometry; RTC_INVALID_GEOMETRY_ID if none */
-    int *geom_index;         /* top-level geomID -> mesh index (>= 0) or -1 - sphere index (moving
+    int *geom_index;         /* top-level geomID -> mesh index (>= 0; n_meshes + k: curve k) or -1 - sphere index (moving
                                 sphere); for an instance, the lf_instance index (hit.instID[0]) */
     int n_geom;
     lf_proto *protos;
     int n_protos;
     lf_instance *instances;
     int n_instances;
+    lf_curve *curves;        /* geom_index n_meshes + k is curve k */
+    int n_curves;
     int moving_shapes;       /* meshes or spheres with more than one keyframe, plus moving instances */
     int max_keys;            /* of the keyframed meshes and spheres */
     int motion_rigid_shapes; /* Shape directives (per ObjectInstance) moved as rigid Embree instances */
@@ -195,6 +224,11 @@ typedef struct lf_hit {
     int sphere;        /* analytic sphere index, or -1; its uv is filled by lf_scene_sphere_uv */
     float tau;         /* Embree time of the ray that found it */
     int medium_in, medium_out; /* the shape's MediumInterface; medium_in LF_MEDIUM_SAME: no transition */
+    /* On a Shape "curve" hit (curve 1): pbrt-v4's h in [-1,1] across the
+     * width (2 v - 1, v = sc.uv.y), as its HairMaterial reads it; sc.dpdu is
+     * then the tangent dP/du along the curve (docs/scene-format.md, Curves). */
+    int curve;
+    float curve_h;
 } lf_hit;
 
 /* ---- intersection (render/intersect.c) ---- */

@@ -37,6 +37,7 @@ unsigned lf_attach_mesh(RTCDevice device, RTCScene scene, const lf_mesh *me, uns
                                    me->P + (size_t)k * 3 * me->n_verts, 0, 3 * sizeof(float), (size_t)me->n_verts);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, me->idx, 0, 3 * sizeof(int),
                                (size_t)me->n_tris);
+    lf_alpha_attach(g, me);
     rtcCommitGeometry(g);
     if (id == RTC_INVALID_GEOMETRY_ID)
         id = rtcAttachGeometry(scene, g);
@@ -50,7 +51,7 @@ unsigned lf_attach_mesh(RTCDevice device, RTCScene scene, const lf_mesh *me, uns
  * instances) and the lights, as lf_scene data: no Embree yet. */
 static int read_description(lf_scene_desc *d, lf_scene *s, lf_error *err)
 {
-    lf_scene_builder b = {s, d, 0, 0, 0, 0, 0, err, -1, NULL};
+    lf_scene_builder b = {s, d, 0, 0, 0, 0, 0, 0, err, -1, NULL, 1.f, NULL};
     b.object_proto = malloc(sizeof(int) * (d->n_objects ? d->n_objects : 1));
     if (!b.object_proto)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
@@ -99,7 +100,7 @@ static int new_embree_scene(lf_scene *s, lf_error *err)
     int n_moving_spheres = 0;
     for (int i = 0; i < s->n_spheres; i++)
         n_moving_spheres += s->spheres[i].n_keys > 1;
-    s->n_geom = s->n_meshes + 1 + n_moving_spheres + s->n_instances;
+    s->n_geom = s->n_meshes + 1 + n_moving_spheres + s->n_instances + s->n_curves;
     s->geom_index = malloc(sizeof(int) * (size_t)s->n_geom);
     if (!s->geom_index)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
@@ -190,6 +191,7 @@ int lf_scene_build(lf_scene_desc *d, lf_scene *s, lf_error *err)
     attach_world_meshes(s, &bmin, &bmax);
     lf_attach_spheres(s, &bmin, &bmax);
     lf_attach_instances(s, &bmin, &bmax);
+    lf_attach_curves(s, &bmin, &bmax);
     if (commit_embree_scene(s, err))
         goto fail;
     set_bounds(s, bmin, bmax);
@@ -244,6 +246,7 @@ void lf_scene_free(lf_scene *s)
         free(s->meshes[i].uv);
     }
     free(s->meshes);
+    lf_curves_free(s);
     for (int i = 0; i < s->n_spheres; i++)
         free(s->spheres[i].centers);
     free(s->spheres);
@@ -259,7 +262,7 @@ void lf_scene_free(lf_scene *s)
     if (s->n_lights)
         lf_distrib1d_free(&s->light_distrib);
     lf_materials_free(s->materials);
-    free(s->media);
+    lf_media_free(s);
     lf_warnings_free(&s->warnings);
     memset(s, 0, sizeof *s);
     s->sphere_geom_id = RTC_INVALID_GEOMETRY_ID;

@@ -166,7 +166,8 @@ static int add_mesh_lights(lf_scene_builder *b, lf_mesh *m, int area_light)
         total_area += 0.5 * mesh_span(m, m->idx[3 * t], m->idx[3 * t + 1], m->idx[3 * t + 2]);
     lf_vec3 L = ae.L;
     apply_area_power(&L, &ae, total_area);
-    int quads = m->n_keys == 1 && !m->N && m->n_tris % 2 == 0 && m->n_tris > 0;
+    /* an alpha-masked emitter is masked per triangle point: no quads */
+    int quads = m->n_keys == 1 && !m->N && m->n_tris % 2 == 0 && m->n_tris > 0 && m->alpha >= 1 && !m->alpha_tex;
     for (int t = 0; quads && t < m->n_tris; t += 2) {
         int q[3];
         quads = triangle_pair_parallelogram(m, t, q);
@@ -181,6 +182,9 @@ static int add_mesh_lights(lf_scene_builder *b, lf_mesh *m, int area_light)
         l.prim = t;
         l.twosided = ae.twosided;
         l.sphere = -1;
+        l.has_alpha = m->alpha < 1 || m->alpha_tex;
+        l.alpha = m->alpha;
+        l.alpha_tex = m->alpha_tex;
         if (quads) {
             triangle_pair_parallelogram(m, t, l.quad);
             l.kind = LF_LIGHT_PARALLELOGRAM;
@@ -253,6 +257,8 @@ static int finish_mesh(lf_scene_builder *b, const lf_shape_desc *sh, const lf_sh
     m.material = sh->material;
     m.flip_normal = sh->reverse_orientation ^ lf_transform_swaps_handedness(xf);
     m.bump = lf_material_bumps(lf_materials_get(b->s->materials, sh->material));
+    m.alpha = b->alpha;
+    m.alpha_tex = b->alpha_tex;
     if (shape_media(b, sh, &m.medium_in, &m.medium_out)) {
         free(P), free(N), free(uv), free(idx);
         return b->err->code;
@@ -415,6 +421,13 @@ static int tessellate(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_mot
                 N[3 * k] = (float)n[0], N[3 * k + 1] = (float)n[1], N[3 * k + 2] = (float)n[2];
             UV[2 * k] = (float)u, UV[2 * k + 1] = (float)v;
         }
+    /* pbrt-v4's quadrics: the normal cross(dp/du, dp/dv) (outward) is
+     * flipped when ReverseOrientation XOR the transform swaps handedness;
+     * the tessellation's vertex normals carry that side (the geometric
+     * normal and an area light's emitting side follow them). */
+    if (N && (sh->reverse_orientation ^ lf_transform_swaps_handedness(&mo->keys[0])))
+        for (int k = 0; k < 3 * nv; k++)
+            N[k] = -N[k];
     int t = 0;
     for (int j = 0; j < nv_; j++)
         for (int i = 0; i < nu; i++) {
@@ -488,7 +501,8 @@ static int shape_sphere(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_m
     zmax = lf_clampd(fmax(zmin, zmax), -r, r);
     phimax = lf_clampd(phimax, 0, 360);
     double scale = similarity_scale(xf);
-    int full = zmin <= -r && zmax >= r && phimax >= 360.0;
+    /* An alpha-cut sphere is tessellated: the alpha filter is on meshes. */
+    int full = zmin <= -r && zmax >= r && phimax >= 360.0 && b->alpha >= 1 && !b->alpha_tex;
     for (int k = 1; k < mo->n && scale > 0; k++)
         if (similarity_scale(&mo->keys[k]) <= 0)
             scale = 0; /* sheared somewhere along the motion: tessellate */
@@ -572,6 +586,36 @@ static int shape_disk(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_mot
     return tessellate(b, sh, mo, disk_surface, prm, nu < 4 ? 4 : nu, 1, 1);
 }
 
+/* pbrt's cylinder: phi = u phimax around z, z from zmin (v = 0) to zmax;
+ * the outward normal is cross(dp/du, dp/dv). */
+static void cylinder_surface(const double *prm, double u, double v, double out[3], double nrm[3])
+{
+    double r = prm[0], z0 = prm[1], z1 = prm[2], phimax = prm[3];
+    double phi = u * phimax;
+    nrm[0] = cos(phi), nrm[1] = sin(phi), nrm[2] = 0;
+    out[0] = r * nrm[0], out[1] = r * nrm[1], out[2] = z0 + v * (z1 - z0);
+}
+
+static int shape_cylinder(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_motion *mo)
+{
+    lf_paramset *ps = &sh->e.params;
+    double r = lf_params_float(ps, "radius", 1.0), zmin = lf_params_float(ps, "zmin", -1.0),
+           zmax = lf_params_float(ps, "zmax", 1.0), phimax = lf_params_float(ps, "phimax", 360.0);
+    char where[512];
+    lf_loc_format(where, sizeof where, &sh->e.loc);
+    if (!(r > 0) || !isfinite(r) || !isfinite(zmin) || !isfinite(zmax))
+        return lf_error_set(b->err, LF_ERR_PARAM, "%s: Shape \"cylinder\": need a positive radius and finite zmin, zmax",
+                            where);
+    /* pbrt-v4 orders zmin, zmax and clamps phimax to [0, 360] */
+    double prm[4] = {r, fmin(zmin, zmax), fmax(zmin, zmax), lf_clampd(phimax, 0, 360) * LF_PI / 180};
+    if (prm[1] == prm[2] || prm[3] == 0)
+        return 0; /* no area: nothing to intersect, as in pbrt */
+    /* 1024 segments around: the polygon's silhouette width and area differ
+     * from the circle's by 1 - cos(pi/1024) = 4.7e-6 at most. */
+    int nu = (int)ceil(1024 * prm[3] / (2 * LF_PI));
+    return tessellate(b, sh, mo, cylinder_surface, prm, nu < 4 ? 4 : nu, 1, 1);
+}
+
 static void bilinear_surface(const double *prm, double u, double v, double out[3], double nrm[3])
 {
     const double *p00 = prm, *p10 = prm + 3, *p01 = prm + 6, *p11 = prm + 9;
@@ -638,6 +682,7 @@ static const struct {
 } shape_table[] = {
     {"trianglemesh", shape_trianglemesh}, {"plymesh", shape_plymesh}, {"sphere", shape_sphere},
     {"disk", shape_disk},                 {"bilinearmesh", shape_bilinearmesh}, {"loopsubdiv", shape_loopsubdiv},
+    {"cylinder", shape_cylinder},         {"curve", lf_build_curve},
 };
 
 int lf_shape_known(const char *type)
@@ -652,21 +697,8 @@ int lf_build_shape(lf_scene_builder *b, lf_shape_desc *sh, const lf_shape_motion
 {
     char where[512];
     lf_loc_format(where, sizeof where, &sh->e.loc);
-    const lf_param *alpha = sh->e.params.count ? lf_params_peek(&sh->e.params, "alpha") : NULL;
-    if (alpha) {
-        /* "float alpha" 1 changes nothing; anything else cuts the shape,
-         * which lensfield cannot: the shape would show where the scene
-         * has a hole (the unsupported rule, docs/scene-format.md). */
-        int opaque = alpha->type == LF_PT_FLOAT && alpha->n_nums == 1 && alpha->nums[0] == 1.0;
-        lf_params_find(&sh->e.params, "alpha");
-        if (!opaque && !b->d->allow_unsupported)
-            return lf_error_set(b->err, LF_ERR_UNSUPPORTED,
-                                "%s: Shape \"%s\": \"alpha\" cut-outs are not supported (--allow-unsupported renders "
-                                "the shape opaque)",
-                                where, sh->e.type);
-        if (!opaque)
-            lf_warn_at(&b->s->warnings, &sh->e.loc, "\"alpha\" cut-outs are not supported; the shape is opaque");
-    }
+    if (lf_shape_known(sh->e.type) && lf_read_shape_alpha(b, sh))
+        return b->err->code;
     for (size_t i = 0; i < sizeof shape_table / sizeof shape_table[0]; i++)
         if (strcmp(shape_table[i].name, sh->e.type) == 0) {
             if (shape_table[i].fn(b, sh, mo))

@@ -70,6 +70,16 @@ static inline int medium_after(const lf_hit *h, lf_vec3 w, int current)
     return lf_dot(w, h->sc.ng) > 0 ? h->medium_out : h->medium_in;
 }
 
+/* Transmittance of one segment in medium `medium` (>= 0): closed form for
+ * homogeneous media, ratio tracking for heterogeneous ones. */
+static lf_vec3 medium_tr(const lf_scene *s, int medium, lf_vec3 o, lf_vec3 d, float t)
+{
+    const lf_medium *m = &s->media[medium];
+    if (m->hetero)
+        return lf_medium_tr(m, o, d, t, lf_medium_seed(t, 0.f, o, d));
+    return transmittance(m->sigma_t, t);
+}
+
 /* Transmittance from o along unit d over distance tmax (INFINITY: to the
  * environment), starting in `medium`: interface surfaces (no material)
  * are passed and change the medium, any other surface blocks.  Returns
@@ -83,13 +93,13 @@ static lf_vec3 shadow_tr(const lf_scene *s, lf_vec3 o, lf_vec3 d, float tmax, fl
         (*rays)++;
         if (!lf_scene_intersect(s, o, d, tmax, tau, &h)) {
             if (medium >= 0)
-                T = lf_mul(T, transmittance(s->media[medium].sigma_t, tmax));
+                T = lf_mul(T, medium_tr(s, medium, o, d, tmax));
             return T;
         }
         if (!lf_material_is_interface(lf_materials_get(s->materials, h.material)))
             return lf_v3(0, 0, 0);
         if (medium >= 0)
-            T = lf_mul(T, transmittance(s->media[medium].sigma_t, h.t));
+            T = lf_mul(T, medium_tr(s, medium, o, d, h.t));
         if (!(lf_maxc(T) > 0))
             return T;
         medium = medium_after(&h, d, medium);
@@ -166,6 +176,66 @@ static lf_vec3 vol_sample_direct(const lf_scene *s, lf_light_sampler lsm, const 
     return vol_light_direct(s, v, li, pmf, u0, u1, tau, rays);
 }
 
+/* What a path carries through lf_volpath_li, for medium_scatter. */
+typedef struct path_ctx {
+    const lf_scene *s;
+    const lf_integrator *in;
+    lf_light_sampler lsm;
+    float tau;
+    lf_sample_stream *st;
+    long long *rays;
+    lf_path_state *ps;
+    lf_vec3 *L;
+    int *depth;
+} path_ctx;
+
+/* A real scattering event in a medium at p (the path came along *d, its
+ * weight already includes sigma_s): next-event estimation, then the new
+ * direction from the Henyey-Greenstein lobe.  0: the path ends. */
+static int medium_scatter(path_ctx *c, float g, int medium, lf_vec3 p, lf_vec3 *o, lf_vec3 *d)
+{
+    const lf_scene *s = c->s;
+    lf_path_state *ps = c->ps;
+    if (!(lf_maxc(ps->beta) > 0) || (*c->depth)++ == c->in->max_depth)
+        return 0;
+    lf_vec3 wo = lf_neg(*d);
+    float ul = 0.5f, uunused;
+    int need_light_choice = s->n_nee_lights > 1 && c->lsm != LF_LIGHTS_ALL;
+    if (need_light_choice)
+        lf_sample_2d(c->st, &ul, &uunused);
+    else
+        lf_sample_skip(c->st);
+    if (s->n_nee_lights > 0) {
+        vertex v = {p, wo, NULL, NULL, g, medium};
+        *c->L = lf_add(*c->L, lf_mul(ps->beta, vol_sample_direct(s, c->lsm, &v, ul, c->tau, c->st, c->rays)));
+    } else {
+        lf_sample_skip(c->st);
+    }
+    float u0, u1, ppdf;
+    lf_sample_2d(c->st, &u0, &u1);
+    *d = hg_sample(g, wo, u0, u1, &ppdf);
+    ps->p_b = ppdf;
+    ps->specular_bounce = 0;
+    ps->prev_p = p;
+    *o = p;
+    return lf_roulette(c->in, &ps->beta, ps->eta_scale, *c->depth, c->st);
+}
+
+/* A segment of length t_s in heterogeneous medium `medium` by delta
+ * tracking: -1 the path ends, 0 it reaches the segment's end, 1 it
+ * scattered (and *o, *d are the new ray). */
+static int hetero_segment(path_ctx *c, int medium, lf_vec3 *o, lf_vec3 *d, float t_s)
+{
+    const lf_medium *m = &c->s->media[medium];
+    float uc, ut, t_ev = 0;
+    lf_sample_2d(c->st, &uc, &ut);
+    int ev = lf_medium_track(m, *o, *d, t_s, lf_medium_seed(uc, ut, *o, *d), &c->ps->beta, m->emits ? c->L : NULL,
+                             &t_ev);
+    if (ev <= 0)
+        return ev;
+    return medium_scatter(c, m->g, medium, lf_madd(*o, *d, t_ev), o, d) ? 1 : -1;
+}
+
 lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec3 d, float tau, int medium,
                       lf_sample_stream *st, long long *rays)
 {
@@ -174,12 +244,19 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
     int depth = 0;
     const lf_light_sampler lsm = lf_light_sampler_for(in, s);
     int passes = 0;
+    path_ctx pc = {s, in, lsm, tau, st, rays, &ps, &L, &depth};
     for (;;) {
         lf_hit h;
         (*rays)++;
         int hit = lf_scene_intersect(s, o, d, INFINITY, tau, &h);
         float t_s = hit ? h.t : INFINITY;
-        if (medium >= 0) {
+        if (medium >= 0 && s->media[medium].hetero) {
+            int ev = hetero_segment(&pc, medium, &o, &d, t_s);
+            if (ev < 0)
+                break;
+            if (ev > 0)
+                continue;
+        } else if (medium >= 0) {
             const lf_medium *m = &s->media[medium];
             /* Emission along the whole segment, in closed form. */
             if (m->emits) {
@@ -204,29 +281,7 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
                     if (!(pdf > 0))
                         break;
                     ps.beta = lf_scale(lf_mul(ps.beta, lf_mul(m->sigma_s, T)), 1.f / pdf);
-                    if (!(lf_maxc(ps.beta) > 0) || depth++ == in->max_depth)
-                        break;
-                    lf_vec3 p = lf_madd(o, d, t), wo = lf_neg(d);
-                    float ul = 0.5f, uunused;
-                    int need_light_choice = s->n_nee_lights > 1 && lsm != LF_LIGHTS_ALL;
-                    if (need_light_choice)
-                        lf_sample_2d(st, &ul, &uunused);
-                    else
-                        lf_sample_skip(st);
-                    if (s->n_nee_lights > 0) {
-                        vertex v = {p, wo, NULL, NULL, m->g, medium};
-                        L = lf_add(L, lf_mul(ps.beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
-                    } else {
-                        lf_sample_skip(st);
-                    }
-                    float u0, u1, ppdf;
-                    lf_sample_2d(st, &u0, &u1);
-                    d = hg_sample(m->g, wo, u0, u1, &ppdf);
-                    ps.p_b = ppdf;
-                    ps.specular_bounce = 0;
-                    ps.prev_p = p;
-                    o = p;
-                    if (!lf_roulette(in, &ps.beta, ps.eta_scale, depth, st))
+                    if (!medium_scatter(&pc, m->g, medium, lf_madd(o, d, t), &o, &d))
                         break;
                     continue;
                 }

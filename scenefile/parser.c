@@ -806,8 +806,11 @@ static int check_count(parser *P, const lf_loc *loc, lf_param_type type, const c
             return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" has %zu values, not a multiple of 3", decl, n);
         break;
     case LF_PT_RGB:
-        if (n != 3)
-            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 3 values, got %zu", decl, n);
+        /* several triples only for per-voxel grids (MakeNamedMedium "rgbgrid");
+         * a single colour read from more is an error at its lookup */
+        if (n == 0 || n % 3)
+            return perr(P, LF_ERR_PARSE, loc, "parameter \"%s\" needs 3 values, got %zu (or 3 per sample of a grid)",
+                        decl, n);
         break;
     case LF_PT_BLACKBODY:
         if (n != 1)
@@ -911,6 +914,31 @@ static void unget_directive(lexer *L, const token *t)
     }
 }
 
+/* pbrt-v4's ParameterDictionary looks parameters up from the last one
+ * given, and its unused-parameter check lets an earlier parameter of the
+ * same type and name pass as shadowed: so a parameter given twice in one
+ * statement takes its last value, silently.  The earlier one is replaced
+ * here (1), which is that rule.  The same name with another type stays a
+ * separate parameter: pbrt reads only the type it asks for and reports
+ * the other as unused, and so does lensfield. */
+static int replace_duplicate(lf_paramset *out, lf_param *p)
+{
+    for (size_t i = 0; i < out->count; i++) {
+        lf_param *q = &out->items[i];
+        if (q->type != p->type || strcmp(q->name, p->name) != 0)
+            continue;
+        free(q->name);
+        free(q->nums);
+        for (size_t k = 0; k < q->n_strs; k++)
+            free(q->strs[k]);
+        free(q->strs);
+        free(q->bools);
+        *q = *p;
+        return 1;
+    }
+    return 0;
+}
+
 /* Reads the parameter list that follows a directive's fixed arguments:
  * pairs of "type name" and a value or [ values ], up to the next token that
  * is not a quoted string. */
@@ -985,6 +1013,10 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
         p.bools = a.bools;
         p.n_bools = a.n_bools;
         p.loc = t.loc;
+        if (replace_duplicate(out, &p)) {
+            free(decl);
+            continue;
+        }
         if (lf_params_add(out, &p)) {
             rc = nomem(P);
             goto fail;
@@ -1592,7 +1624,7 @@ static int d_option(parser *P, lexer *L, const token *dir)
  * --allow-unsupported (lf_parse_opts.allow_unsupported). */
 static const char *const pbrt_shapes[] = {"bilinearmesh", "curve",  "cylinder", "disk", "loopsubdiv",
                                           "plymesh",      "sphere", "trianglemesh", NULL};
-static const char *const refused_shapes[] = {"curve", "cylinder", NULL};
+static const char *const refused_shapes[] = {NULL};
 static const char *const pbrt_lights[] = {"distant", "goniometric", "infinite", "point", "projection", "spot", NULL};
 static const char *const refused_lights[] = {"goniometric", "projection", NULL};
 static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse", "conductor",   "dielectric", "diffuse",

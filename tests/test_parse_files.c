@@ -406,7 +406,7 @@ static void test_metal_spectrum_rgb(void)
 static void test_errors_collected(void)
 {
     const char *text = "Camera \"perspective\"\nWorldBegin\n"
-                       "Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n" /* 3: unsupported */
+                       "LightSource \"goniometric\" \"string filename\" \"x.exr\"\n" /* 3: unsupported */
                        "Shape \"sphere\" \"float radius\" [ 1\n"                  /* 4: unclosed [ */
                        "Bogus 1 2 3\n"                                             /* 5: unknown directive */
                        "Material \"hair\"\n"                                       /* 6: unsupported */
@@ -421,7 +421,7 @@ static void test_errors_collected(void)
     for (const char *p = errors; p && *p; p++)
         lines += *p == '\n';
     CHECK_MSG(lines == 6, "want 6 errors, got:\n%s", errors ? errors : "");
-    const char *want[] = {"multi.pbrt:3:1: Shape \"curve\" is not supported", "multi.pbrt:5:1: expected a value or ']'",
+    const char *want[] = {"multi.pbrt:3:1: LightSource \"goniometric\" is not supported", "multi.pbrt:5:1: expected a value or ']'",
                           "multi.pbrt:5:1: unknown directive \"Bogus\"",
                           "multi.pbrt:6:1: Material \"hair\" is not supported",
                           "multi.pbrt:7:16: unknown directive \"Shapo\"",
@@ -445,7 +445,7 @@ static void test_errors_collected(void)
 
     /* --allow-unsupported: warnings, the rest is kept */
     const char *text2 = "Camera \"perspective\"\nWorldBegin\n"
-                        "Shape \"cylinder\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
+                        "Shape \"teapot\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
                         "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"measured\"\n"
                         "Texture \"w\" \"spectrum\" \"marble\" \"float scale\" 2\n";
     lf_parse_opts allow = {1, 0};
@@ -456,7 +456,7 @@ static void test_errors_collected(void)
         CHECK(d.n_materials == 2 && strcmp(d.materials[0].e.type, "diffuse") == 0 &&
               d.materials[0].e.params.count == 0 && strcmp(d.materials[1].e.type, "diffuse") == 0);
         CHECK(d.allow_unsupported == 1);
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:3:1: warning: Shape \"cylinder\" is not supported"));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:3:1: warning: Shape: unknown shape \"teapot\" is not supported"));
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material \"subsurface\" is not supported; "
                                                "rendered as \"diffuse\" 0.5"));
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:6:1: warning: LightSource \"goniometric\""));

@@ -85,7 +85,7 @@ int write_impl(const char *file, const char *name, int width, int height, int ch
     // by alpha on the way out (nor multiply on the way in, see read_impl).
     spec.attribute("oiio:UnassociatedAlpha", 1);
     // Encoded into memory when the format can, then written here: libjpeg's
-    // default error handler calls exit() on a failed fwrite (a full disk),
+    // default error handler ends the process on a failed fwrite (a full disk),
     // which killed the process without a message of ours or any cleanup.
     std::vector<unsigned char> encoded;
     OIIO::Filesystem::IOVecOutput vec(encoded);

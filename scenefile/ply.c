@@ -535,7 +535,18 @@ static int gz_bound(const char *path, size_t *max_bytes, lf_error *err)
     ply_element *els = NULL;
     size_t n_els = 0;
     ply_reader r = {path, head, n, 0, 0, PLY_ASCII, err};
+    lf_error herr = {0};
+    r.err = &herr;
     int rc = gz ? parse_header(&r, &els, &n_els) : LF_OK;
+    if (rc && n < (size_t)1 << 20) {
+        /* the whole stream is shorter than the window, or it is corrupt:
+         * the full read says which (and costs no more than this) */
+        free_elements(els, n_els);
+        free(head);
+        return LF_OK;
+    }
+    if (rc)
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: no PLY header in the first MiB of the decompressed data", path);
     double most = (double)r.pos, fewest = (double)r.pos;
     for (size_t i = 0; i < n_els; i++) {
         double hi, lo;

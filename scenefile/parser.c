@@ -1602,8 +1602,7 @@ static const char *const refused_materials[] = {"hair", "measured", "subsurface"
 static const char *const pbrt_textures[] = {"bilerp", "checkerboard", "constant", "directionmix", "dots", "fbm",
                                             "imagemap", "marble", "mix", "ptex", "scale", "windy", "wrinkled",
                                             NULL};
-static const char *const refused_textures[] = {"directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled",
-                                               NULL};
+static const char *const refused_textures[] = {"ptex", NULL};
 
 static int in_list(const char *const *list, const char *s)
 {

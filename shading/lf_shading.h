@@ -233,6 +233,15 @@ void lf_texture_free(lf_texture *t); /* accepts NULL */
 const char *lf_texture_name(const lf_texture *t);
 int lf_texture_is_float(const lf_texture *t);
 
+/* Perlin's improved noise as pbrt-v4 (util/noise.cpp): 0 at every integer
+ * lattice point, in about [-1, 1]; lf_fbm sums `octaves` octaves at
+ * frequencies 1.99^i with weights omega^i; lf_turbulence sums |noise| the
+ * same way plus 0.2 omega^octaves (pbrt's clamped partial octave).  Both are
+ * pbrt's FBm / Turbulence with zero filter width (no ray differentials). */
+float lf_noise3(lf_vec3 p);
+float lf_fbm(lf_vec3 p, float omega, int octaves);
+float lf_turbulence(lf_vec3 p, float omega, int octaves);
+
 /* Index of refraction of pbrt-v4's named glasses ("glass-BK7", ...) at
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */
 float lf_named_glass_eta(const char *name, float lambda_nm);

@@ -447,7 +447,7 @@ static void test_errors_collected(void)
     const char *text2 = "Camera \"perspective\"\nWorldBegin\n"
                         "Shape \"cylinder\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
                         "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"measured\"\n"
-                        "Texture \"w\" \"spectrum\" \"marble\" \"float scale\" 2\n";
+                        "Texture \"w\" \"spectrum\" \"ptex\" \"float scale\" 2\n";
     lf_parse_opts allow = {1, 0};
     rc = lf_scene_parse_string_ex(text2, "allow.pbrt", &allow, &d, &err, &errors);
     CHECK_MSG(rc == 0, "%s", err.msg);
@@ -463,7 +463,7 @@ static void test_errors_collected(void)
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial \"measured\""));
         CHECK(d.n_textures == 1 && strcmp(d.textures[0].e.type, "constant") == 0 &&
               d.textures[0].e.params.count == 0);
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"marble\" is not supported; "
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"ptex\" is not supported; "
                                                "rendered as \"constant\" 1"));
         lf_scene_desc_free(&d);
     }

@@ -654,6 +654,12 @@ void lf_bsdf_set_thin_dielectric(lf_bsdf *b, float eta)
     b->u.thin.eta = eta;
 }
 
+void lf_bsdf_set_measured(lf_bsdf *b, const lf_measured *data)
+{
+    b->kind = LF_LOBE_MEASURED;
+    b->u.measured.data = data;
+}
+
 void lf_bsdf_set_coated_diffuse(lf_bsdf *b, const lf_coat_table *table, lf_microfacet coat, lf_vec3 r)
 {
     b->kind = LF_LOBE_COATED_DIFFUSE;
@@ -715,6 +721,10 @@ lf_vec3 lf_bsdf_f(const lf_bsdf *b, lf_vec3 wo_w, lf_vec3 wi_w)
             wi = lf_neg(wi);
         }
         return coated_f(b, wo, wi);
+    case LF_LOBE_MEASURED:
+        return lf_measured_f(b->u.measured.data, wo, wi);
+    case LF_LOBE_HAIR:
+        return lf_hair_f(&b->u.hair, wo, wi);
     case LF_LOBE_THIN_DIELECTRIC:
     case LF_LOBE_NONE:
         break;
@@ -751,6 +761,10 @@ float lf_bsdf_pdf(const lf_bsdf *b, lf_vec3 wo_w, lf_vec3 wi_w)
             wi = lf_neg(wi);
         }
         return coated_pdf(b, wo, wi);
+    case LF_LOBE_MEASURED:
+        return lf_measured_pdf(b->u.measured.data, wo, wi);
+    case LF_LOBE_HAIR:
+        return lf_hair_pdf(&b->u.hair, wo, wi);
     case LF_LOBE_THIN_DIELECTRIC:
     case LF_LOBE_NONE:
         break;
@@ -827,6 +841,13 @@ static int sample_local(const lf_bsdf *b, lf_vec3 wo, float uc, float u0, float 
             s->wi = lf_neg(s->wi);
         return 1;
     }
+    case LF_LOBE_MEASURED:
+        return lf_measured_sample(b->u.measured.data, wo, u0, u1, &s->wi, &s->f, &s->pdf);
+    case LF_LOBE_HAIR:
+        if (!lf_hair_sample(&b->u.hair, wo, uc, u0, u1, &s->wi, &s->f, &s->pdf))
+            return 0;
+        s->transmission = s->wi.z * wo.z < 0.f;
+        return 1;
     case LF_LOBE_NONE:
         break;
     }
@@ -862,6 +883,8 @@ int lf_bsdf_is_specular(const lf_bsdf *b)
     case LF_LOBE_DIFFUSE:
     case LF_LOBE_DIFFUSE_TRANSMISSION:
     case LF_LOBE_COATED_DIFFUSE:
+    case LF_LOBE_MEASURED:
+    case LF_LOBE_HAIR:
         break;
     }
     return 0;

@@ -3,9 +3,10 @@
  * Parameter names, defaults and semantics follow pbrt-v4 (materials.cpp and
  * the file-format documentation).  Supported: diffuse, conductor,
  * dielectric, thindielectric, diffusetransmission, coateddiffuse,
- * coatedconductor (both approximated: see the comment in bsdf.c), mix, and
- * interface ("", "none").  measured, hair and subsurface are reported as
- * unsupported.  "displacement" bump-maps the shading normal (lf_bump_shading);
+ * coatedconductor (both approximated: see the comment in bsdf.c), mix,
+ * measured (RGL .bsdf files, measured.c), hair (hair.c), subsurface (a
+ * random walk in the renderer, render/subsurface.c) and interface ("",
+ * "none").  "displacement" bump-maps the shading normal (lf_bump_shading);
  * "normalmap" is read and ignored with a
  * warning.
  */
@@ -29,8 +30,14 @@ typedef enum mat_kind {
     MAT_DIFFUSE_TRANSMISSION,
     MAT_COATED_DIFFUSE,
     MAT_COATED_CONDUCTOR,
-    MAT_MIX
+    MAT_MIX,
+    MAT_MEASURED,
+    MAT_HAIR
 } mat_kind;
+
+/* Hair absorption given as sigma_a, as a colour (reflectance) or as
+ * melanin concentrations (pbrt-v4 HairMaterial, in that priority). */
+typedef enum hair_mode { HAIR_SIGMA_A, HAIR_REFLECTANCE, HAIR_MELANIN } hair_mode;
 
 /* Roughness inputs as pbrt-v4 reads them: uroughness / vroughness, each
  * falling back to roughness. */
@@ -53,6 +60,9 @@ struct lf_material {
     const lf_material *mix[2];
     int mix_index[2];
     lf_tex_input amount;
+    lf_measured *measured;     /* measured: the file's tables, owned */
+    hair_mode hair;            /* hair: sigma_a, reflectance (in "reflectance") or melanin */
+    lf_tex_input sigma_a, eumelanin, pheomelanin, beta_m, beta_n, alpha, eta_tex;
     lf_tex_input displacement; /* bump map (pbrt-v4 "float displacement"), when bump */
     int bump;
     lf_loc loc;
@@ -270,6 +280,93 @@ static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_ma
     return LF_OK;
 }
 
+/* Resolves `filename` against the directory of the scene file that wrote
+ * it (pbrt-v4 ResolveFilename). */
+static char *resolve_path(const char *scene_file, const char *filename)
+{
+    size_t dl = 0;
+    if (filename[0] != '/' && scene_file) {
+        const char *slash = strrchr(scene_file, '/');
+        if (slash)
+            dl = (size_t)(slash - scene_file) + 1;
+    }
+    size_t fl = strlen(filename);
+    char *out = malloc(dl + fl + 1);
+    if (!out)
+        return NULL;
+    memcpy(out, scene_file ? scene_file : "", dl);
+    memcpy(out + dl, filename, fl + 1);
+    return out;
+}
+
+static int read_measured(lf_paramset *ps, lf_material *m, const lf_loc *loc, lf_error *err)
+{
+    const char *fn = lf_params_string(ps, "filename", "");
+    const lf_param *p = lf_params_peek(ps, "filename");
+    if (!fn || !*fn)
+        return lf_error_at(err, LF_ERR_PARAM, loc, "measured material: \"string filename\" is required");
+    char *path = resolve_path(p->loc.file, fn);
+    if (!path)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    lf_error lerr = {0};
+    int rc = lf_measured_load(path, &m->measured, &lerr);
+    if (rc)
+        lf_error_at(err, rc, &p->loc, "measured material: %s", lerr.msg);
+    free(path);
+    return rc;
+}
+
+/* pbrt-v4 HairMaterial::Create: sigma_a wins over reflectance (or its old
+ * name "color"), which wins over the melanin concentrations; with none of
+ * them, eumelanin 1.3 (brown hair). */
+static int read_hair(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, lf_warnings *warnings,
+                     const lf_loc *loc, lf_error *err)
+{
+    lf_vec3 z = lf_v3(0, 0, 0);
+    int has_s = lf_params_peek(ps, "sigma_a") != NULL;
+    const char *rname = lf_params_peek(ps, "reflectance") ? "reflectance" : "color";
+    int has_r = lf_params_peek(ps, rname) != NULL;
+    int has_e = lf_params_peek(ps, "eumelanin") != NULL, has_p = lf_params_peek(ps, "pheomelanin") != NULL;
+    int rc = lf_tex_input_read(ps, "sigma_a", 0, LF_SPECTRUM_UNBOUNDED, z, texs, &m->sigma_a, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, rname, 0, LF_SPECTRUM_ALBEDO, z, texs, &m->reflectance, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, "eumelanin", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(has_e || has_p ? 0.f : 1.3f, 0, 0),
+                               texs, &m->eumelanin, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, "pheomelanin", 1, LF_SPECTRUM_UNBOUNDED, z, texs, &m->pheomelanin, err);
+    const struct { const char *name; float def; lf_tex_input *in; } fl[] = {
+        {"eta", 1.55f, &m->eta_tex}, {"beta_m", 0.3f, &m->beta_m}, {"beta_n", 0.3f, &m->beta_n}, {"alpha", 2.f, &m->alpha}};
+    for (int i = 0; i < 4 && !rc; i++)
+        rc = lf_tex_input_read(ps, fl[i].name, 1, LF_SPECTRUM_UNBOUNDED, lf_v3(fl[i].def, fl[i].def, fl[i].def), texs,
+                               fl[i].in, err);
+    if (rc)
+        return rc;
+    m->hair = has_s ? HAIR_SIGMA_A : has_r ? HAIR_REFLECTANCE : HAIR_MELANIN;
+    const char *ignored[] = {has_s ? rname : NULL, has_s || has_r ? "eumelanin" : NULL,
+                             has_s || has_r ? "pheomelanin" : NULL};
+    const char *why = has_s ? "sigma_a" : rname;
+    for (int i = 0; i < 3; i++)
+        if (ignored[i] && lf_params_peek(ps, ignored[i]))
+            lf_warn_at(warnings, &lf_params_peek(ps, ignored[i])->loc,
+                       "hair: ignoring \"%s\" since \"%s\" was provided (as pbrt-v4)", ignored[i], why);
+    (void)loc;
+    return LF_OK;
+}
+
+static int read_measured_or_hair(lf_paramset *ps, const char *type, const lf_texture_list *texs, lf_material *m,
+                                 lf_warnings *warnings, const lf_loc *loc, lf_error *err)
+{
+    if (!strcmp(type, "measured")) {
+        m->kind = MAT_MEASURED;
+        m->type = "measured";
+        return read_measured(ps, m, loc, err);
+    }
+    m->kind = MAT_HAIR;
+    m->type = "hair";
+    return read_hair(ps, texs, m, warnings, loc, err);
+}
+
 static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_error *err)
 {
     lf_paramset *ps = &md->e.params;
@@ -350,7 +447,9 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
         if (!rc)
             rc = lf_tex_input_read(ps, "amount", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(0.5f, 0.5f, 0.5f), texs, &m->amount,
                                    err);
-    } else if (!strcmp(type, "measured") || !strcmp(type, "hair") || !strcmp(type, "subsurface")) {
+    } else if (!strcmp(type, "measured") || !strcmp(type, "hair")) {
+        rc = read_measured_or_hair(ps, type, texs, m, &ms->warnings, loc, err);
+    } else if (!strcmp(type, "subsurface")) {
         return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "material \"%s\" is not supported", type);
     } else {
         return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "unknown material \"%s\"", type);
@@ -485,8 +584,10 @@ void lf_materials_free(lf_materials *ms)
 {
     if (!ms)
         return;
-    for (size_t i = 0; i < ms->count; i++)
+    for (size_t i = 0; i < ms->count; i++) {
         free(ms->items[i].table);
+        lf_measured_free(ms->items[i].measured);
+    }
     free(ms->items);
     for (size_t i = 0; i < ms->texs.count; i++)
         lf_texture_free(ms->texs.items[i]);
@@ -521,10 +622,14 @@ int lf_material_uses_textures(const lf_material *mat)
     for (int depth = 0; depth < 64 && mat; depth++) {
         const lf_tex_input *in[] = {&mat->reflectance, &mat->transmittance, &mat->eta_c,   &mat->k_c,
                                     &mat->rough.u,     &mat->rough.v,       &mat->rough_b.u, &mat->rough_b.v,
-                                    &mat->amount,      &mat->displacement};
+                                    &mat->amount,      &mat->displacement, &mat->sigma_a,   &mat->eumelanin,
+                                    &mat->pheomelanin, &mat->beta_m,       &mat->beta_n,    &mat->alpha,
+                                    &mat->eta_tex};
         for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
             if (in[i]->tex)
                 return 1;
+        if (mat->kind == MAT_HAIR) /* h across the fibre is the hit's v */
+            return 1;
         if (mat->kind != MAT_MIX)
             return 0;
         if (lf_material_uses_textures(mat->mix[0]))
@@ -624,6 +729,28 @@ static lf_vec3 clamp01(lf_vec3 c)
     return lf_v3(lf_clampf(c.x, 0.f, 1.f), lf_clampf(c.y, 0.f, 1.f), lf_clampf(c.z, 0.f, 1.f));
 }
 
+/* pbrt-v4 HairMaterial::GetBxDF: h = -1 + 2 v (curves put v across the
+ * width; on other shapes it is whatever their v is), parameters clamped as
+ * pbrt clamps them. */
+static void hair_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf *out)
+{
+    float bm = lf_clampf(lf_tex_input_float(&mat->beta_m, ctx), 0.f, 1.f);
+    float bn = lf_clampf(lf_tex_input_float(&mat->beta_n, ctx), 0.f, 1.f);
+    float alpha = lf_tex_input_float(&mat->alpha, ctx), eta = lf_tex_input_float(&mat->eta_tex, ctx);
+    lf_vec3 sa;
+    if (mat->hair == HAIR_SIGMA_A) {
+        sa = lf_tex_input_rgb(&mat->sigma_a, ctx);
+        sa = lf_v3(fmaxf(sa.x, 0.f), fmaxf(sa.y, 0.f), fmaxf(sa.z, 0.f));
+    } else if (mat->hair == HAIR_REFLECTANCE) {
+        sa = lf_hair_sigma_a_from_reflectance(clamp01(lf_tex_input_rgb(&mat->reflectance, ctx)), bn);
+    } else {
+        sa = lf_hair_sigma_a_from_concentration(fmaxf(0.f, lf_tex_input_float(&mat->eumelanin, ctx)),
+                                                fmaxf(0.f, lf_tex_input_float(&mat->pheomelanin, ctx)));
+    }
+    out->kind = LF_LOBE_HAIR;
+    lf_hair_setup(&out->u.hair, -1.f + 2.f * ctx->uv.y, eta, sa, bm, bn, alpha);
+}
+
 void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf *out)
 {
     if (mat->kind == MAT_MIX)
@@ -670,5 +797,11 @@ void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf
         out->u.coated.thickness = mat->thickness;
         return;
     }
+    case MAT_MEASURED:
+        lf_bsdf_set_measured(out, mat->measured);
+        return;
+    case MAT_HAIR:
+        hair_bsdf(mat, ctx, out);
+        return;
     }
 }

@@ -409,7 +409,7 @@ static void test_errors_collected(void)
                        "Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n" /* 3: unsupported */
                        "Shape \"sphere\" \"float radius\" [ 1\n"                  /* 4: unclosed [ */
                        "Bogus 1 2 3\n"                                             /* 5: unknown directive */
-                       "Material \"hair\"\n"                                       /* 6: unsupported */
+                       "Texture \"p\" \"float\" \"ptex\"\n"                       /* 6: unsupported */
                        "Shape \"sphere\" Shapo \"disk\"\n"
                        "LightSource \"projection\"\n"; /* 8: unsupported */
     lf_scene_desc d;
@@ -423,7 +423,7 @@ static void test_errors_collected(void)
     CHECK_MSG(lines == 6, "want 6 errors, got:\n%s", errors ? errors : "");
     const char *want[] = {"multi.pbrt:3:1: Shape \"curve\" is not supported", "multi.pbrt:5:1: expected a value or ']'",
                           "multi.pbrt:5:1: unknown directive \"Bogus\"",
-                          "multi.pbrt:6:1: Material \"hair\" is not supported",
+                          "multi.pbrt:6:1: Texture \"ptex\" is not supported",
                           "multi.pbrt:7:16: unknown directive \"Shapo\"",
                           "multi.pbrt:8:1: LightSource \"projection\" is not supported"};
     for (int i = 0; i < 6; i++)
@@ -446,7 +446,7 @@ static void test_errors_collected(void)
     /* --allow-unsupported: warnings, the rest is kept */
     const char *text2 = "Camera \"perspective\"\nWorldBegin\n"
                         "Shape \"cylinder\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
-                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"measured\"\n"
+                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"subsurface\"\n"
                         "Texture \"w\" \"spectrum\" \"ptex\" \"float scale\" 2\n";
     lf_parse_opts allow = {1, 0};
     rc = lf_scene_parse_string_ex(text2, "allow.pbrt", &allow, &d, &err, &errors);
@@ -460,7 +460,7 @@ static void test_errors_collected(void)
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material \"subsurface\" is not supported; "
                                                "rendered as \"diffuse\" 0.5"));
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:6:1: warning: LightSource \"goniometric\""));
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial \"measured\""));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial \"subsurface\""));
         CHECK(d.n_textures == 1 && strcmp(d.textures[0].e.type, "constant") == 0 &&
               d.textures[0].e.params.count == 0);
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"ptex\" is not supported; "

@@ -80,8 +80,47 @@ static void test_textures_scene(void)
     lf_image_free(&img);
 }
 
+/* measured.pbrt: the measured gold (a GGX conductor tabulated in the
+ * file) beside pbrt's analytic rough conductor of a similar colour: both
+ * spheres gold (red above blue), of similar brightness (within 25 %: the
+ * Fresnel curves differ). */
+static void test_measured_scene(void)
+{
+    lf_image img;
+    if (render_file(LF_SOURCE_DIR "/scenes/pbrt-v4/measured.pbrt", 16, &img))
+        return;
+    int bad = 0;
+    double lr = box_mean(&img, 0, 95, 120, 85, 110, &bad), lb = box_mean(&img, 2, 95, 120, 85, 110, &bad);
+    double rr = box_mean(&img, 0, 200, 225, 85, 110, &bad), rb = box_mean(&img, 2, 200, 225, 85, 110, &bad);
+    CHECK_MSG(bad == 0 && lr > 1.2 * lb && rr > 1.2 * rb && fabs(lr / rr - 1) < 0.25,
+              "measured r %g b %g, conductor r %g b %g, %d non-finite", lr, lb, rr, rb, bad);
+    lf_image_free(&img);
+}
+
+/* hair.pbrt: three tufts; the eumelanin one is brown (red above blue), the
+ * sigma_a (0.6, 2.8, 3.5) one red (red well above green), the blonde
+ * reflectance one brighter than the brown one. */
+static void test_hair_scene(void)
+{
+    lf_image img;
+    if (render_file(LF_SOURCE_DIR "/scenes/pbrt-v4/hair.pbrt", 8, &img))
+        return;
+    int bad = 0;
+    double m[3][3];
+    const int cx[3] = {90, 180, 270};
+    for (int t = 0; t < 3; t++)
+        for (int c = 0; c < 3; c++)
+            m[t][c] = box_mean(&img, c, cx[t] - 25, cx[t] + 25, 95, 140, &bad);
+    CHECK_MSG(bad == 0 && m[0][0] > 1.15 * m[0][2] && m[2][0] > 1.3 * m[2][1] && m[1][1] > m[0][1],
+              "brown %g %g %g, blonde %g %g %g, red %g %g %g, %d non-finite", m[0][0], m[0][1], m[0][2], m[1][0],
+              m[1][1], m[1][2], m[2][0], m[2][1], m[2][2], bad);
+    lf_image_free(&img);
+}
+
 int main(void)
 {
     test_textures_scene();
+    test_measured_scene();
+    test_hair_scene();
     return lf_test_end();
 }

@@ -1598,7 +1598,7 @@ static const char *const refused_lights[] = {"goniometric", "projection", NULL};
 static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse", "conductor",   "dielectric", "diffuse",
                                              "diffusetransmission", "hair", "interface", "measured", "mix",
                                              "subsurface",      "thindielectric", "none", "", NULL};
-static const char *const refused_materials[] = {"subsurface", NULL};
+static const char *const refused_materials[] = {NULL};
 static const char *const pbrt_textures[] = {"bilerp", "checkerboard", "constant", "directionmix", "dots", "fbm",
                                             "imagemap", "marble", "mix", "ptex", "scale", "windy", "wrinkled",
                                             NULL};

@@ -85,7 +85,8 @@ typedef enum lf_lobe_kind {
     LF_LOBE_COATED_DIFFUSE,        /* dielectric coat over a Lambertian base */
     LF_LOBE_COATED_CONDUCTOR,      /* dielectric coat over a conductor */
     LF_LOBE_MEASURED,              /* RGL measured BRDF (measured.c) */
-    LF_LOBE_HAIR                   /* Chiang et al. 2016 hair fibre (hair.c) */
+    LF_LOBE_HAIR,                  /* Chiang et al. 2016 hair fibre (hair.c) */
+    LF_LOBE_NORMALIZED_FRESNEL     /* a subsurface walk's exit (pbrt-v4 NormalizedFresnelBxDF) */
 } lf_lobe_kind;
 
 typedef struct lf_measured lf_measured; /* a loaded RGL .bsdf file (measured.c) */
@@ -121,6 +122,7 @@ typedef struct lf_bsdf {
         } coated;
         struct { const lf_measured *data; } measured;
         lf_hair hair; /* frame: s along the fibre (dpdu), n = ns */
+        struct { float eta, c; } nfresnel; /* c: 2 int (1 - Fr(mu)) mu dmu */
     } u;
 } lf_bsdf;
 
@@ -151,6 +153,14 @@ void lf_bsdf_set_coated_conductor(lf_bsdf *b, const lf_coat_table *table, lf_mic
 
 /* data must outlive b. */
 void lf_bsdf_set_measured(lf_bsdf *b, const lf_measured *data);
+/* Light leaving a subsurface medium of index eta through its surface
+ * (pbrt-v4's NormalizedFresnelBxDF, the BSSRDF's S_w): f = eta^2 (1 -
+ * Fr(cos theta_i)) / (c pi) on wo's side of the surface, c its
+ * normalisation (lf_normalized_fresnel_c), so that the cosine-weighted
+ * integral is eta^2: the eta^2 undoes the 1/eta^2 of radiance entering
+ * through the dielectric. */
+void lf_bsdf_set_normalized_fresnel(lf_bsdf *b, float eta, float c);
+float lf_normalized_fresnel_c(float eta);
 
 lf_vec3 lf_bsdf_f(const lf_bsdf *b, lf_vec3 wo, lf_vec3 wi);  /* no cosine; 0 for specular lobes */
 float lf_bsdf_pdf(const lf_bsdf *b, lf_vec3 wo, lf_vec3 wi);  /* pdf of lf_bsdf_sample's non-specular parts */
@@ -302,6 +312,23 @@ int lf_hair_sample(const lf_hair *hp, lf_vec3 wo, float uc, float u0, float u1, 
                    float *pdf);
 lf_vec3 lf_hair_sigma_a_from_concentration(float eumelanin, float pheomelanin);
 lf_vec3 lf_hair_sigma_a_from_reflectance(lf_vec3 c, float beta_n);
+
+/* Subsurface scattering (Material "subsurface"): the medium inside a
+ * surface of this material at ctx, with its coefficients already scaled
+ * by "scale"; returns 0 for any other material.  eta is the boundary's
+ * index. */
+typedef struct lf_subsurface {
+    lf_vec3 sigma_a, sigma_s;
+    float g, eta, exit_c; /* exit_c: lf_normalized_fresnel_c(eta) */
+} lf_subsurface;
+int lf_material_subsurface(const lf_material *mat, const lf_shading_ctx *ctx, lf_subsurface *out);
+/* pbrt-v4's table of measured media (Jensen et al. 2001; Narasimhan et
+ * al. 2006): sigma_a and reduced sigma_s' in mm^-1; 0 if the name is known. */
+int lf_named_medium(const char *name, lf_vec3 *sigma_a, lf_vec3 *sigma_s);
+/* The single-scattering albedo whose random walk in a semi-infinite
+ * medium reflects the diffuse albedo r (Chiang, Kutz and Burley 2016's
+ * fit), per channel. */
+lf_vec3 lf_subsurface_albedo_from_reflectance(lf_vec3 r);
 
 /* Index of refraction of pbrt-v4's named glasses ("glass-BK7", ...) at
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */

@@ -32,7 +32,8 @@ typedef enum mat_kind {
     MAT_COATED_CONDUCTOR,
     MAT_MIX,
     MAT_MEASURED,
-    MAT_HAIR
+    MAT_HAIR,
+    MAT_SUBSURFACE
 } mat_kind;
 
 /* Hair absorption given as sigma_a, as a colour (reflectance) or as
@@ -63,6 +64,10 @@ struct lf_material {
     lf_measured *measured;     /* measured: the file's tables, owned */
     hair_mode hair;            /* hair: sigma_a, reflectance (in "reflectance") or melanin */
     lf_tex_input sigma_a, eumelanin, pheomelanin, beta_m, beta_n, alpha, eta_tex;
+    /* subsurface: sigma_a (above) and sigma_s, or reflectance and mfp */
+    lf_tex_input sigma_s, mfp;
+    int ss_from_reflectance;
+    float ss_g, ss_exit_c;
     lf_tex_input displacement; /* bump map (pbrt-v4 "float displacement"), when bump */
     int bump;
     lf_loc loc;
@@ -354,6 +359,95 @@ static int read_hair(lf_paramset *ps, const lf_texture_list *texs, lf_material *
     return LF_OK;
 }
 
+static lf_vec3 clamp01(lf_vec3 c)
+{
+    return lf_v3(lf_clampf(c.x, 0.f, 1.f), lf_clampf(c.y, 0.f, 1.f), lf_clampf(c.z, 0.f, 1.f));
+}
+
+/* pbrt-v4 SubsurfaceMaterial::Create: the medium by "name" (pbrt's
+ * measured table, g forced to 0), by "sigma_a" and "sigma_s", by
+ * "reflectance" and "mfp", or pbrt's default (skim-milk-like) coefficients;
+ * "scale" multiplies the coefficients (or mfp), "eta" is the boundary's
+ * index, roughness its GGX roughness. */
+static int read_subsurface(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, lf_warnings *warnings,
+                           const lf_loc *loc, lf_error *err)
+{
+    m->kind = MAT_SUBSURFACE;
+    m->type = "subsurface";
+    m->ss_g = (float)lf_params_float(ps, "g", 0.0);
+    const char *name = lf_params_string(ps, "name", "");
+    int rc = LF_OK;
+    if (name && *name) {
+        const lf_param *p = lf_params_peek(ps, "name");
+        lf_vec3 sa, ss;
+        if (lf_named_medium(name, &sa, &ss))
+            return lf_error_at(err, LF_ERR_PARAM, &p->loc,
+                               "subsurface: named medium \"%s\" not found (pbrt-v4's names: \"Skin1\", \"Wholemilk\", "
+                               "\"Ketchup\", ...; docs/scene-format.md)",
+                               name);
+        if (m->ss_g != 0.f)
+            lf_warn_at(warnings, &lf_params_peek(ps, "g")->loc,
+                       "subsurface: non-zero \"g\" ignored with named scattering coefficients (as pbrt-v4)");
+        m->ss_g = 0.f; /* the table holds reduced scattering coefficients */
+        m->sigma_a.value = sa;
+        m->sigma_s.value = ss;
+    } else {
+        int has_a = lf_params_peek(ps, "sigma_a") != NULL, has_s = lf_params_peek(ps, "sigma_s") != NULL;
+        if (has_a != has_s)
+            return lf_error_at(err, LF_ERR_PARAM, loc, "subsurface: \"%s\" given without \"%s\"",
+                               has_a ? "sigma_a" : "sigma_s", has_a ? "sigma_s" : "sigma_a");
+        if (has_a) {
+            rc = lf_tex_input_read(ps, "sigma_a", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs, &m->sigma_a, err);
+            if (!rc)
+                rc = lf_tex_input_read(ps, "sigma_s", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs, &m->sigma_s, err);
+        } else if (lf_params_peek(ps, "reflectance")) {
+            m->ss_from_reflectance = 1;
+            rc = lf_tex_input_read(ps, "reflectance", 0, LF_SPECTRUM_ALBEDO, lf_v3(0, 0, 0), texs, &m->reflectance, err);
+            if (!rc)
+                rc = lf_tex_input_read(ps, "mfp", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(1, 1, 1), texs, &m->mfp, err);
+        } else {
+            m->sigma_a.value = lf_v3(.0011f, .0024f, .014f);
+            m->sigma_s.value = lf_v3(2.55f, 3.21f, 3.77f);
+        }
+    }
+    if (rc)
+        return rc;
+    m->scale = (float)lf_params_float(ps, "scale", 1.0);
+    m->eta = (float)lf_params_float(ps, "eta", 1.33);
+    if (!(m->eta > 0.f))
+        return lf_error_at(err, LF_ERR_PARAM, loc, "subsurface: \"eta\" must be positive, got %g", m->eta);
+    m->ss_exit_c = lf_normalized_fresnel_c(m->eta);
+    return read_roughness(ps, "", texs, &m->rough, err);
+}
+
+int lf_material_subsurface(const lf_material *mat, const lf_shading_ctx *ctx, lf_subsurface *out)
+{
+    if (mat->kind != MAT_SUBSURFACE)
+        return 0;
+    if (mat->ss_from_reflectance) {
+        /* sigma_t = 1 / mfp, split by the albedo whose walk reflects r */
+        lf_vec3 mfp = lf_scale(lf_tex_input_rgb(&mat->mfp, ctx), mat->scale);
+        lf_vec3 a = lf_subsurface_albedo_from_reflectance(clamp01(lf_tex_input_rgb(&mat->reflectance, ctx)));
+        float mf[3] = {mfp.x, mfp.y, mfp.z}, al[3] = {a.x, a.y, a.z}, sa[3], ss[3];
+        for (int c = 0; c < 3; c++) {
+            float st = mf[c] > 0.f ? 1.f / mf[c] : 1e30f;
+            ss[c] = al[c] * st;
+            sa[c] = (1.f - al[c]) * st;
+        }
+        out->sigma_a = lf_v3(sa[0], sa[1], sa[2]);
+        out->sigma_s = lf_v3(ss[0], ss[1], ss[2]);
+    } else {
+        lf_vec3 a = lf_scale(lf_tex_input_rgb(&mat->sigma_a, ctx), mat->scale);
+        lf_vec3 b = lf_scale(lf_tex_input_rgb(&mat->sigma_s, ctx), mat->scale);
+        out->sigma_a = lf_v3(fmaxf(a.x, 0.f), fmaxf(a.y, 0.f), fmaxf(a.z, 0.f));
+        out->sigma_s = lf_v3(fmaxf(b.x, 0.f), fmaxf(b.y, 0.f), fmaxf(b.z, 0.f));
+    }
+    out->g = mat->ss_g;
+    out->eta = mat->eta;
+    out->exit_c = mat->ss_exit_c;
+    return 1;
+}
+
 static int read_measured_or_hair(lf_paramset *ps, const char *type, const lf_texture_list *texs, lf_material *m,
                                  lf_warnings *warnings, const lf_loc *loc, lf_error *err)
 {
@@ -450,7 +544,7 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
     } else if (!strcmp(type, "measured") || !strcmp(type, "hair")) {
         rc = read_measured_or_hair(ps, type, texs, m, &ms->warnings, loc, err);
     } else if (!strcmp(type, "subsurface")) {
-        return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "material \"%s\" is not supported", type);
+        rc = read_subsurface(ps, texs, m, &ms->warnings, loc, err);
     } else {
         return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "unknown material \"%s\"", type);
     }
@@ -624,7 +718,7 @@ int lf_material_uses_textures(const lf_material *mat)
                                     &mat->rough.u,     &mat->rough.v,       &mat->rough_b.u, &mat->rough_b.v,
                                     &mat->amount,      &mat->displacement, &mat->sigma_a,   &mat->eumelanin,
                                     &mat->pheomelanin, &mat->beta_m,       &mat->beta_n,    &mat->alpha,
-                                    &mat->eta_tex};
+                                    &mat->eta_tex,     &mat->sigma_s,      &mat->mfp};
         for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
             if (in[i]->tex)
                 return 1;
@@ -724,10 +818,6 @@ static float hash_position(lf_vec3 p)
     return (float)(h >> 40) * 0x1p-24f;
 }
 
-static lf_vec3 clamp01(lf_vec3 c)
-{
-    return lf_v3(lf_clampf(c.x, 0.f, 1.f), lf_clampf(c.y, 0.f, 1.f), lf_clampf(c.z, 0.f, 1.f));
-}
 
 /* pbrt-v4 HairMaterial::GetBxDF: h = -1 + 2 v (curves put v across the
  * width; on other shapes it is whatever their v is), parameters clamped as
@@ -802,6 +892,9 @@ void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf
         return;
     case MAT_HAIR:
         hair_bsdf(mat, ctx, out);
+        return;
+    case MAT_SUBSURFACE: /* the boundary; the renderer walks the inside (render/subsurface.c) */
+        lf_bsdf_set_dielectric(out, mat->eta, eval_roughness(&mat->rough, ctx));
         return;
     }
 }

@@ -445,8 +445,8 @@ static void test_errors_collected(void)
 
     /* --allow-unsupported: warnings, the rest is kept */
     const char *text2 = "Camera \"perspective\"\nWorldBegin\n"
-                        "Shape \"cylinder\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
-                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"subsurface\"\n"
+                        "Shape \"cylinder\"\nMaterial \"velvet\" \"float eta\" 1.3\nShape \"sphere\"\n"
+                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"velvet\"\n"
                         "Texture \"w\" \"spectrum\" \"ptex\" \"float scale\" 2\n";
     lf_parse_opts allow = {1, 0};
     rc = lf_scene_parse_string_ex(text2, "allow.pbrt", &allow, &d, &err, &errors);
@@ -457,10 +457,10 @@ static void test_errors_collected(void)
               d.materials[0].e.params.count == 0 && strcmp(d.materials[1].e.type, "diffuse") == 0);
         CHECK(d.allow_unsupported == 1);
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:3:1: warning: Shape \"cylinder\" is not supported"));
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material \"subsurface\" is not supported; "
-                                               "rendered as \"diffuse\" 0.5"));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material: unknown material \"velvet\" is not "
+                                               "supported; rendered as \"diffuse\" 0.5"));
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:6:1: warning: LightSource \"goniometric\""));
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial \"subsurface\""));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial: unknown material \"velvet\""));
         CHECK(d.n_textures == 1 && strcmp(d.textures[0].e.type, "constant") == 0 &&
               d.textures[0].e.params.count == 0);
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"ptex\" is not supported; "

@@ -8,6 +8,7 @@
 #include "lf_test.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -117,8 +118,27 @@ static void test_hair_scene(void)
     lf_image_free(&img);
 }
 
+/* subsurface.pbrt: skin (Skin1) is red above blue, ketchup red far above
+ * green, and the back-lit 1 mm slab passes light (brighter than the grey
+ * wall behind the spheres would be without it: above the sky's 0.15). */
+static void test_subsurface_scene(void)
+{
+    lf_image img;
+    if (render_file(LF_SOURCE_DIR "/scenes/pbrt-v4/subsurface.pbrt", 8, &img))
+        return;
+    int bad = 0;
+    double skin_r = box_mean(&img, 0, 63, 83, 90, 110, &bad), skin_b = box_mean(&img, 2, 63, 83, 90, 110, &bad);
+    double ket_r = box_mean(&img, 0, 150, 170, 90, 110, &bad), ket_g = box_mean(&img, 1, 150, 170, 90, 110, &bad);
+    double slab = box_mean(&img, 1, 140, 180, 25, 45, &bad);
+    printf("skin r %g b %g, ketchup r %g g %g, slab %g\n", skin_r, skin_b, ket_r, ket_g, slab);
+    CHECK_MSG(bad == 0 && skin_r > 1.2 * skin_b && ket_r > 3 * ket_g && slab > 0.3,
+              "skin r %g b %g, ketchup r %g g %g, slab %g, %d non-finite", skin_r, skin_b, ket_r, ket_g, slab, bad);
+    lf_image_free(&img);
+}
+
 int main(void)
 {
+    test_subsurface_scene();
     test_textures_scene();
     test_measured_scene();
     test_hair_scene();

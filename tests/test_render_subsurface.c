@@ -37,12 +37,12 @@ static double urand(void)
 static double h_function(double a, double mu)
 {
     enum { N = 800 };
-    static double H[N], m[N];
-    for (int i = 0; i < N; i++) {
+    static double H[N], m[N], last_a = -1;
+    for (int i = 0; i < N && a != last_a; i++) {
         m[i] = (i + 0.5) / N;
         H[i] = 1;
     }
-    for (int it = 0; it < 2000; it++) {
+    for (int it = 0; it < 2000 && a != last_a; it++) {
         double change = 0;
         for (int i = 0; i < N; i++) {
             double s = 0;
@@ -55,6 +55,7 @@ static double h_function(double a, double mu)
         if (change < 1e-10)
             break;
     }
+    last_a = a; /* the table is kept for the next call with this albedo */
     double s = 0;
     for (int j = 0; j < N; j++)
         s += H[j] / (mu + m[j]) / N;
@@ -192,6 +193,31 @@ static void test_fresnel_boundary(void)
     }
 }
 
+/* "reflectance" r and "mfp": sigma_t = 1 / mfp and the albedo a from
+ * Chiang, Kutz and Burley's fit.  The walk's normal-incidence reflectance
+ * must be 1 - H(1) sqrt(1 - a) for that a (index matched), and the fit
+ * should make the hemispherical albedo 2 int (1 - H(mu) sqrt(1 - a)) mu dmu
+ * close to r (the fit's own accuracy: a few percent). */
+static void test_reflectance_mode(void)
+{
+    double m[3], se[3];
+    if (render_slab("path", "\"float eta\" [1] \"rgb reflectance\" [0.2 0.5 0.8] \"rgb mfp\" [1 1 1]", 64, m, se))
+        return;
+    lf_vec3 a3 = lf_subsurface_albedo_from_reflectance(lf_v3(0.2f, 0.5f, 0.8f));
+    const double r[3] = {0.2, 0.5, 0.8}, a[3] = {a3.x, a3.y, a3.z};
+    for (int c = 0; c < 3; c++) {
+        double normal = 1 - h_function(a[c], 1.0) * sqrt(1 - a[c]), hemi = 0;
+        for (int i = 0; i < 100; i++) {
+            double mu = (i + 0.5) / 100;
+            hemi += 2 * (1 - h_function(a[c], mu) * sqrt(1 - a[c])) * mu / 100;
+        }
+        printf("reflectance %.1f: albedo %.4f, walk %.4f +- %.4f, normal incidence %.4f, hemispherical %.4f\n", r[c],
+               a[c], m[c], se[c], normal, hemi);
+        CHECK_MSG(fabs(m[c] - normal) < 3 * se[c] + 0.005, "%g vs %g", m[c], normal);
+        CHECK_MSG(fabs(hemi - r[c]) < 0.05 * r[c] + 0.01, "hemispherical albedo %g for reflectance %g", hemi, r[c]);
+    }
+}
+
 static void test_named_and_errors(void)
 {
     lf_vec3 a, s;
@@ -212,6 +238,7 @@ int main(void)
 {
     test_index_matched();
     test_fresnel_boundary();
+    test_reflectance_mode();
     test_named_and_errors();
     return lf_test_end();
 }

@@ -99,10 +99,8 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
                 lf_sample_skip(st);
             if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
                 break;
-            if (walked || !lf_subsurface_enters(mat, &h, wo, d, &sss)) {
-                alive = 1;
+            if ((alive = walked || !lf_subsurface_enters(mat, &h, wo, d, &sss)))
                 break;
-            }
             wo = d;
             if (!lf_subsurface_walk(s, &sss, tau, st, rays, &ps, &h, &bsdf, &wo, &ul))
                 break;

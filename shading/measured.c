@@ -357,7 +357,8 @@ static const tensor_field *tensor_get(const tensor_field *f, int n, const char *
 }
 
 /* The field as floats (float32 in the files pbrt reads; copied, since the
- * buffer need not be aligned). */
+ * buffer need not be aligned; the files are little-endian, as is every
+ * host lensfield builds on). */
 static float *tensor_floats(const tensor_field *f)
 {
     float *out = malloc(sizeof(float) * (f->count ? f->count : 1));
@@ -493,6 +494,21 @@ static int build_tables(lf_measured *m, const tensor_field *const *f)
     return rc;
 }
 
+/* A 1-D float32 field of strictly increasing finite values (the tables
+ * interpolate between neighbours). */
+static int increasing(const tensor_field *f)
+{
+    float prev = -INFINITY;
+    for (size_t i = 0; i < f->count; i++) {
+        float v;
+        memcpy(&v, f->data + 4 * i, 4);
+        if (!isfinite(v) || !(v > prev))
+            return 0;
+        prev = v;
+    }
+    return 1;
+}
+
 int lf_measured_load(const char *path, lf_measured **out, lf_error *err)
 {
     *out = NULL;
@@ -509,7 +525,9 @@ int lf_measured_load(const char *path, lf_measured **out, lf_error *err)
     const tensor_field *f[10];
     for (int i = 0; i < 10; i++)
         f[i] = rc ? NULL : tensor_get(fields, n, names[i]);
-    if (!rc && !check_structure(f))
+    if (!rc && check_structure(f) && (!increasing(f[0]) || !increasing(f[1]) || !increasing(f[7])))
+        rc = lf_error_set(err, LF_ERR_PARSE, "%s: theta_i, phi_i and wavelengths must be finite and increasing", path);
+    else if (!rc && !check_structure(f))
         rc = lf_error_set(err, LF_ERR_PARSE,
                           "%s: invalid BRDF file structure (pbrt-v4 reads theta_i, phi_i, ndf, sigma, vndf, "
                           "luminance, spectra, wavelengths, description and jacobian with their shapes)",

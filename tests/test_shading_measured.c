@@ -339,9 +339,10 @@ static void test_material(void)
     /* errors name the file:line:col of "filename" */
     const char *bad[] = {"WorldBegin\nMaterial \"measured\" \"string filename\" \"nope.bsdf\"\n",
                          "WorldBegin\nMaterial \"measured\" \"string filename\" \"scene.pbrt\"\n",
-                         "WorldBegin\nMaterial \"measured\"\n"};
-    const char *want[] = {"nope.bsdf", "not a tensor file", "filename\" is required"};
-    for (int i = 0; i < 3; i++) {
+                         "WorldBegin\nMaterial \"measured\"\n",
+                         "WorldBegin\nMaterial \"measured\" \"string filename\" \"trunc.bsdf\"\n"};
+    const char *want[] = {"nope.bsdf", "not a tensor file", "filename\" is required", "truncated or corrupt"};
+    for (int i = 0; i < 4; i++) {
         CHECK(lf_scene_parse_string(bad[i], DIR "/scene.pbrt", &d, &err) == 0);
         ms = NULL;
         memset(&err, 0, sizeof err);
@@ -359,6 +360,15 @@ int main(void)
     if (s)
         fputs("# not a tensor file\n", s), fclose(s);
     CHECK(write_lambertian(DIR "/lambert.bsdf") == 0);
+    /* the same file cut inside its field table */
+    FILE *in = fopen(DIR "/lambert.bsdf", "rb"), *cut = fopen(DIR "/trunc.bsdf", "wb");
+    char head[100];
+    if (in && cut && fread(head, 1, sizeof head, in) == sizeof head)
+        fwrite(head, 1, sizeof head, cut);
+    if (in)
+        fclose(in);
+    if (cut)
+        fclose(cut);
     test_warp();
     test_material();
     return lf_test_end();

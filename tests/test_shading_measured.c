@@ -341,7 +341,7 @@ static void test_material(void)
                          "WorldBegin\nMaterial \"measured\" \"string filename\" \"scene.pbrt\"\n",
                          "WorldBegin\nMaterial \"measured\"\n",
                          "WorldBegin\nMaterial \"measured\" \"string filename\" \"trunc.bsdf\"\n"};
-    const char *want[] = {"nope.bsdf", "not a tensor file", "filename\" is required", "truncated or corrupt"};
+    const char *want[] = {"nope.bsdf", "not a tensor file", "filename\" is required", "runs past the end of the file"};
     for (int i = 0; i < 4; i++) {
         CHECK(lf_scene_parse_string(bad[i], DIR "/scene.pbrt", &d, &err) == 0);
         ms = NULL;

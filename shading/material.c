@@ -420,8 +420,12 @@ static int read_subsurface(lf_paramset *ps, const lf_texture_list *texs, lf_mate
     return read_roughness(ps, "", texs, &m->rough, err);
 }
 
+static float hash_position(lf_vec3 p);
+
 int lf_material_subsurface(const lf_material *mat, const lf_shading_ctx *ctx, lf_subsurface *out)
 {
+    if (mat->kind == MAT_MIX) /* the component lf_material_bsdf chose at this point */
+        mat = lf_material_resolve(mat, ctx, hash_position(ctx->p));
     if (mat->kind != MAT_SUBSURFACE)
         return 0;
     if (mat->ss_from_reflectance) {

@@ -206,19 +206,17 @@ static void test_refused(void)
         "Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]",
         "Shape \"cylinder\"",
         "Shape \"teapot\"",
-        "Material \"hair\"\nShape \"sphere\"",
-        "Material \"measured\" \"string filename\" \"x.bsdf\"\nShape \"sphere\"",
-        "Material \"subsurface\"\nShape \"sphere\"",
-        "MakeNamedMaterial \"m\" \"string type\" \"hair\"\nShape \"sphere\"",
+        "Material \"velvet\"\nShape \"sphere\"",
+        "MakeNamedMaterial \"m\" \"string type\" \"velvet\"\nShape \"sphere\"",
         "LightSource \"goniometric\" \"string filename\" \"x.exr\"",
         "LightSource \"projection\" \"string filename\" \"x.exr\"",
         "Shape \"sphere\" \"float alpha\" 0.5",
-        "Texture \"t\" \"float\" \"wrinkled\"\nShape \"sphere\"",
+        "Texture \"t\" \"float\" \"ptex\" \"string filename\" \"t.ptx\"\nShape \"sphere\"",
     };
     const char *directive[] = {"Shape \"curve\"", "Shape \"cylinder\"", "unknown shape \"teapot\"",
-                               "Material \"hair\"", "Material \"measured\"", "Material \"subsurface\"",
-                               "MakeNamedMaterial \"hair\"", "LightSource \"goniometric\"",
-                               "LightSource \"projection\"", "\"alpha\" cut-outs", "Texture \"wrinkled\" is not supported"};
+                               "unknown material \"velvet\"", "MakeNamedMaterial: unknown material \"velvet\"",
+                               "LightSource \"goniometric\"", "LightSource \"projection\"", "\"alpha\" cut-outs",
+                               "Texture \"ptex\" is not supported"};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
         char text[2048];
         snprintf(text, sizeof text, "%s%s\n", HEAD, refused[i]);
@@ -243,13 +241,13 @@ static void test_refused(void)
     char text[2048];
     snprintf(text, sizeof text,
              "%sShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"sphere\" \"float radius\" \"big\"\n"
-             "Shape \"sphere\"\nMaterial \"hair\"\nShape \"disk\"\n",
+             "Shape \"sphere\"\nTexture \"p\" \"float\" \"ptex\"\nShape \"disk\"\n",
              HEAD);
     write_file("three.pbrt", text);
     CHECK(run("%s three.pbrt -o three.exr --quiet", LF_LFRENDER) == 1);
     CHECK_MSG(strstr(out_text, "three.pbrt:8:1: Shape \"curve\" is not supported") &&
                   strstr(out_text, "three.pbrt:9:31: parameter \"float radius\" expects numbers") &&
-                  strstr(out_text, "three.pbrt:11:1: Material \"hair\" is not supported") &&
+                  strstr(out_text, "three.pbrt:11:1: Texture \"ptex\" is not supported") &&
                   strstr(out_text, "3 errors in three.pbrt"),
               "%s", out_text);
     CHECK(!exists("three.exr"));

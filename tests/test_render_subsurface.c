@@ -220,6 +220,25 @@ static void test_reflectance_mode(void)
 
 static void test_named_and_errors(void)
 {
+    /* a mix resolves to its subsurface component as lf_material_bsdf does */
+    lf_scene_desc d;
+    lf_error err = {0};
+    const char *mix = "WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"subsurface\" \"string name\" \"Skin2\"\n"
+                      "MakeNamedMaterial \"b\" \"string type\" \"diffuse\"\n"
+                      "Material \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0\n";
+    CHECK(lf_scene_parse_string(mix, "mix.pbrt", &d, &err) == 0);
+    lf_materials *ms = NULL;
+    CHECK_MSG(lf_materials_build(&d, &ms, &err) == 0, "%s", err.msg);
+    if (ms) {
+        lf_shading_ctx c;
+        memset(&c, 0, sizeof c);
+        lf_subsurface sub;
+        CHECK(lf_material_subsurface(lf_materials_get(ms, 2), &c, &sub) == 1 && fabsf(sub.sigma_s.x - 1.09f) < 1e-6f);
+        CHECK(lf_material_subsurface(lf_materials_get(ms, 1), &c, &sub) == 0);
+    }
+    lf_materials_free(ms);
+    lf_scene_desc_free(&d);
+
     lf_vec3 a, s;
     CHECK(lf_named_medium("Skin1", &a, &s) == 0 && fabsf(a.z - 0.48f) < 1e-6f && fabsf(s.x - 0.74f) < 1e-6f);
     CHECK(lf_named_medium("Wholemilk", &a, &s) == 0 && fabsf(s.z - 3.77f) < 1e-6f);

@@ -86,6 +86,17 @@ typedef struct lf_path_state {
     lf_vec3 prev_p;      /* the last vertex */
 } lf_path_state;
 
+/* Material "subsurface" (render/subsurface.c).  lf_subsurface_enters: did
+ * the BSDF sample d at hit h (reached from wo) cross into a subsurface
+ * material?  Then lf_subsurface_walk walks its medium from h along *w (the
+ * refracted direction) until the walker leaves, and turns the exit into
+ * the path's next vertex: *h the exit hit, *bsdf its exit lobe, *w the
+ * outward side (the vertex's wo), *ul a fresh light-choice value.
+ * Returns 0 when the walk ends inside (absorbed, or lost on an open mesh). */
+int lf_subsurface_enters(const lf_material *mat, const lf_hit *h, lf_vec3 wo, lf_vec3 d, lf_subsurface *out);
+int lf_subsurface_walk(const lf_scene *s, const lf_subsurface *m, float tau, lf_sample_stream *st, long long *rays,
+                       lf_path_state *ps, lf_hit *h, lf_bsdf *bsdf, lf_vec3 *w, float *ul);
+
 /* Continues a path from surface hit h by sampling its BSDF (the vertex's
  * direction pair is drawn here): updates the state and the ray (o, d).
  * Returns 0 when the path ends (no valid sample). */

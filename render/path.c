@@ -90,12 +90,23 @@ lf_vec3 lf_path_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_vec
             break;
         lf_bsdf bsdf;
         float ul, uc;
-        int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc);
-        if (!specular && s->n_nee_lights > 0)
-            L = lf_add(L, lf_mul(ps.beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
-        else
-            lf_sample_skip(st);
-        if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
+        int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc), alive = 0;
+        lf_subsurface sss;
+        for (int walked = 0;; walked = 1) { /* the vertex; for subsurface, then the walk's exit */
+            if (!specular && s->n_nee_lights > 0)
+                L = lf_add(L, lf_mul(ps.beta, sample_direct(s, lsm, &h, &bsdf, wo, ul, st, rays)));
+            else
+                lf_sample_skip(st);
+            if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
+                break;
+            if ((alive = walked || !lf_subsurface_enters(mat, &h, wo, d, &sss)))
+                break;
+            wo = d;
+            if (!lf_subsurface_walk(s, &sss, tau, st, rays, &ps, &h, &bsdf, &wo, &ul))
+                break;
+            specular = 0;
+        }
+        if (!alive)
             break;
         /* Russian roulette (render_internal.h).  pbrt-v4's rule: p = max
          * component, after depth 1.  The default, "sqrt": p = sqrt(max

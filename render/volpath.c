@@ -315,14 +315,24 @@ lf_vec3 lf_volpath_li(const lf_scene *s, const lf_integrator *in, lf_vec3 o, lf_
             break;
         lf_bsdf bsdf;
         float ul, uc;
-        int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc);
-        if (!specular && s->n_nee_lights > 0) {
+        int specular = lf_surface_vertex(s, lsm, &h, mat, st, &bsdf, &ul, &uc), alive = 0;
+        lf_subsurface sss;
+        for (int walked = 0;; walked = 1) { /* the vertex; for subsurface, then the walk's exit */
             vertex v = {h.sc.p, wo, &h, &bsdf, 0.f, medium};
-            L = lf_add(L, lf_mul(ps.beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
-        } else {
-            lf_sample_skip(st);
+            if (!specular && s->n_nee_lights > 0)
+                L = lf_add(L, lf_mul(ps.beta, vol_sample_direct(s, lsm, &v, ul, tau, st, rays)));
+            else
+                lf_sample_skip(st);
+            if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
+                break;
+            if ((alive = walked || !lf_subsurface_enters(mat, &h, wo, d, &sss)))
+                break;
+            wo = d; /* the walk's medium is the material's, not the scene's */
+            if (!lf_subsurface_walk(s, &sss, tau, st, rays, &ps, &h, &bsdf, &wo, &ul))
+                break;
+            specular = 0;
         }
-        if (!lf_bsdf_continue(&bsdf, &h, wo, uc, st, &ps, &o, &d))
+        if (!alive)
             break;
         medium = medium_after(&h, d, medium);
         if (!lf_roulette(in, &ps.beta, ps.eta_scale, depth, st))

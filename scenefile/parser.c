@@ -1630,12 +1630,11 @@ static const char *const refused_lights[] = {"goniometric", "projection", NULL};
 static const char *const pbrt_materials[] = {"coatedconductor", "coateddiffuse", "conductor",   "dielectric", "diffuse",
                                              "diffusetransmission", "hair", "interface", "measured", "mix",
                                              "subsurface",      "thindielectric", "none", "", NULL};
-static const char *const refused_materials[] = {"hair", "measured", "subsurface", NULL};
+static const char *const refused_materials[] = {NULL};
 static const char *const pbrt_textures[] = {"bilerp", "checkerboard", "constant", "directionmix", "dots", "fbm",
                                             "imagemap", "marble", "mix", "ptex", "scale", "windy", "wrinkled",
                                             NULL};
-static const char *const refused_textures[] = {"directionmix", "dots", "fbm", "marble", "ptex", "windy", "wrinkled",
-                                               NULL};
+static const char *const refused_textures[] = {"ptex", NULL};
 
 static int in_list(const char *const *list, const char *s)
 {

@@ -654,6 +654,40 @@ void lf_bsdf_set_thin_dielectric(lf_bsdf *b, float eta)
     b->u.thin.eta = eta;
 }
 
+void lf_bsdf_set_normalized_fresnel(lf_bsdf *b, float eta, float c)
+{
+    b->kind = LF_LOBE_NORMALIZED_FRESNEL;
+    b->u.nfresnel.eta = eta;
+    b->u.nfresnel.c = c;
+}
+
+/* c = 2 int_0^1 (1 - Fr(mu, eta)) mu dmu by the midpoint rule (Fr is
+ * smooth; 256 points are exact to ~1e-5). */
+float lf_normalized_fresnel_c(float eta)
+{
+    double sum = 0.0;
+    for (int i = 0; i < 256; i++) {
+        double mu = (i + 0.5) / 256.0;
+        sum += (1.0 - lf_fresnel_dielectric((float)mu, eta)) * mu;
+    }
+    return (float)(2.0 * sum / 256.0);
+}
+
+static lf_vec3 nfresnel_f(const lf_bsdf *b, lf_vec3 wo, lf_vec3 wi)
+{
+    if (!same_hemisphere(wo, wi) || !(b->u.nfresnel.c > 0.f))
+        return lf_v3(0, 0, 0);
+    float eta = b->u.nfresnel.eta;
+    float v = eta * eta * (1.f - lf_fresnel_dielectric(fabsf(wi.z), eta)) / (b->u.nfresnel.c * PI_F);
+    return lf_v3(v, v, v);
+}
+
+void lf_bsdf_set_measured(lf_bsdf *b, const lf_measured *data)
+{
+    b->kind = LF_LOBE_MEASURED;
+    b->u.measured.data = data;
+}
+
 void lf_bsdf_set_coated_diffuse(lf_bsdf *b, const lf_coat_table *table, lf_microfacet coat, lf_vec3 r)
 {
     b->kind = LF_LOBE_COATED_DIFFUSE;
@@ -715,6 +749,12 @@ lf_vec3 lf_bsdf_f(const lf_bsdf *b, lf_vec3 wo_w, lf_vec3 wi_w)
             wi = lf_neg(wi);
         }
         return coated_f(b, wo, wi);
+    case LF_LOBE_MEASURED:
+        return lf_measured_f(b->u.measured.data, wo, wi);
+    case LF_LOBE_HAIR:
+        return lf_hair_f(&b->u.hair, wo, wi);
+    case LF_LOBE_NORMALIZED_FRESNEL:
+        return nfresnel_f(b, wo, wi);
     case LF_LOBE_THIN_DIELECTRIC:
     case LF_LOBE_NONE:
         break;
@@ -751,6 +791,12 @@ float lf_bsdf_pdf(const lf_bsdf *b, lf_vec3 wo_w, lf_vec3 wi_w)
             wi = lf_neg(wi);
         }
         return coated_pdf(b, wo, wi);
+    case LF_LOBE_MEASURED:
+        return lf_measured_pdf(b->u.measured.data, wo, wi);
+    case LF_LOBE_HAIR:
+        return lf_hair_pdf(&b->u.hair, wo, wi);
+    case LF_LOBE_NORMALIZED_FRESNEL:
+        return same_hemisphere(wo, wi) ? fabsf(wi.z) * (float)LF_INV_PI : 0.f;
     case LF_LOBE_THIN_DIELECTRIC:
     case LF_LOBE_NONE:
         break;
@@ -827,6 +873,24 @@ static int sample_local(const lf_bsdf *b, lf_vec3 wo, float uc, float u0, float 
             s->wi = lf_neg(s->wi);
         return 1;
     }
+    case LF_LOBE_MEASURED:
+        return lf_measured_sample(b->u.measured.data, wo, u0, u1, &s->wi, &s->f, &s->pdf);
+    case LF_LOBE_NORMALIZED_FRESNEL: {
+        if (wo.z == 0.f)
+            return 0;
+        lf_vec3 wi = sample_cosine(u0, u1);
+        if (wo.z < 0.f)
+            wi.z = -wi.z;
+        s->wi = wi;
+        s->f = nfresnel_f(b, wo, wi);
+        s->pdf = fabsf(wi.z) * (float)LF_INV_PI;
+        return s->pdf > 0.f;
+    }
+    case LF_LOBE_HAIR:
+        if (!lf_hair_sample(&b->u.hair, wo, uc, u0, u1, &s->wi, &s->f, &s->pdf))
+            return 0;
+        s->transmission = s->wi.z * wo.z < 0.f;
+        return 1;
     case LF_LOBE_NONE:
         break;
     }
@@ -862,6 +926,9 @@ int lf_bsdf_is_specular(const lf_bsdf *b)
     case LF_LOBE_DIFFUSE:
     case LF_LOBE_DIFFUSE_TRANSMISSION:
     case LF_LOBE_COATED_DIFFUSE:
+    case LF_LOBE_MEASURED:
+    case LF_LOBE_HAIR:
+    case LF_LOBE_NORMALIZED_FRESNEL:
         break;
     }
     return 0;

@@ -83,8 +83,21 @@ typedef enum lf_lobe_kind {
     LF_LOBE_DIELECTRIC,            /* Fresnel dielectric, smooth or GGX (Walter 2007) */
     LF_LOBE_THIN_DIELECTRIC,       /* thin slab: specular reflection + straight transmission */
     LF_LOBE_COATED_DIFFUSE,        /* dielectric coat over a Lambertian base */
-    LF_LOBE_COATED_CONDUCTOR       /* dielectric coat over a conductor */
+    LF_LOBE_COATED_CONDUCTOR,      /* dielectric coat over a conductor */
+    LF_LOBE_MEASURED,              /* RGL measured BRDF (measured.c) */
+    LF_LOBE_HAIR,                  /* Chiang et al. 2016 hair fibre (hair.c) */
+    LF_LOBE_NORMALIZED_FRESNEL     /* a subsurface walk's exit (pbrt-v4 NormalizedFresnelBxDF) */
 } lf_lobe_kind;
+
+typedef struct lf_measured lf_measured; /* a loaded RGL .bsdf file (measured.c) */
+
+/* pbrt-v4's HairBxDF at one hit, precomputed (hair.c, lf_hair_setup). */
+typedef struct lf_hair {
+    float h, eta, gamma_o, s;
+    lf_vec3 sigma_a;
+    float v[4];                          /* longitudinal variances, p = 0, 1, 2, 3+ */
+    float sin2k_alpha[3], cos2k_alpha[3]; /* scale tilt for p = 0, 1, 2 */
+} lf_hair;
 
 /* A BSDF: a shading frame and one tagged lobe set (the coated ones hold a
  * coat lobe plus a base lobe).  Fixed size, no allocation; the coated kinds
@@ -107,6 +120,9 @@ typedef struct lf_bsdf {
             lf_microfacet base;
             float thickness;             /* layer depth for exp(-thickness / cos) attenuation; 0 by default */
         } coated;
+        struct { const lf_measured *data; } measured;
+        lf_hair hair; /* frame: s along the fibre (dpdu), n = ns */
+        struct { float eta, c; } nfresnel; /* c: 2 int (1 - Fr(mu)) mu dmu */
     } u;
 } lf_bsdf;
 
@@ -134,6 +150,17 @@ void lf_bsdf_set_coated_diffuse(lf_bsdf *b, const lf_coat_table *table, lf_micro
 /* eta_b, k_b: the conductor's own index (divided by the coat's here, as pbrt-v4 does). */
 void lf_bsdf_set_coated_conductor(lf_bsdf *b, const lf_coat_table *table, lf_microfacet coat, lf_vec3 eta_b,
                                   lf_vec3 k_b, lf_microfacet base);
+
+/* data must outlive b. */
+void lf_bsdf_set_measured(lf_bsdf *b, const lf_measured *data);
+/* Light leaving a subsurface medium of index eta through its surface
+ * (pbrt-v4's NormalizedFresnelBxDF, the BSSRDF's S_w): f = eta^2 (1 -
+ * Fr(cos theta_i)) / (c pi) on wo's side of the surface, c its
+ * normalisation (lf_normalized_fresnel_c), so that the cosine-weighted
+ * integral is eta^2: the eta^2 undoes the 1/eta^2 of radiance entering
+ * through the dielectric. */
+void lf_bsdf_set_normalized_fresnel(lf_bsdf *b, float eta, float c);
+float lf_normalized_fresnel_c(float eta);
 
 lf_vec3 lf_bsdf_f(const lf_bsdf *b, lf_vec3 wo, lf_vec3 wi);  /* no cosine; 0 for specular lobes */
 float lf_bsdf_pdf(const lf_bsdf *b, lf_vec3 wo, lf_vec3 wi);  /* pdf of lf_bsdf_sample's non-specular parts */
@@ -232,6 +259,76 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings
 void lf_texture_free(lf_texture *t); /* accepts NULL */
 const char *lf_texture_name(const lf_texture *t);
 int lf_texture_is_float(const lf_texture *t);
+
+/* Perlin's improved noise as pbrt-v4 (util/noise.cpp): 0 at every integer
+ * lattice point, in about [-1, 1]; lf_fbm sums `octaves` octaves at
+ * frequencies 1.99^i with weights omega^i; lf_turbulence sums |noise| the
+ * same way plus 0.2 omega^octaves (pbrt's clamped partial octave).  Both are
+ * pbrt's FBm / Turbulence with zero filter width (no ray differentials). */
+float lf_noise3(lf_vec3 p);
+float lf_fbm(lf_vec3 p, float omega, int octaves);
+float lf_turbulence(lf_vec3 p, float omega, int octaves);
+
+/* pbrt-v4's PiecewiseLinear2D: a bilinearly interpolated table of nx x ny
+ * values over [0,1]^2, optionally one per point of a grid of up to three
+ * parameters (interpolated linearly between grid points; the data is laid
+ * out [param 0][param 1]...[y][x]).  With build_cdf the table is a density
+ * normalised over the square that can be sampled and inverted; without, it
+ * is only evaluated and keeps its values. */
+#define LF_PL2D_MAX_PARAMS 3
+typedef struct lf_pl2d {
+    int nx, ny, ndim;
+    int param_size[LF_PL2D_MAX_PARAMS], param_stride[LF_PL2D_MAX_PARAMS];
+    float *param_values[LF_PL2D_MAX_PARAMS];
+    float *data, *marginal_cdf, *conditional_cdf;
+} lf_pl2d;
+int lf_pl2d_init(lf_pl2d *t, const float *data, int nx, int ny, int ndim, const int *param_res,
+                 const float *const *param_values, int build_cdf);
+void lf_pl2d_free(lf_pl2d *t);
+float lf_pl2d_eval(const lf_pl2d *t, float x, float y, const float *param);
+/* (*x, *y): uniform in, warped out; returns the density there. */
+float lf_pl2d_sample(const lf_pl2d *t, float *x, float *y, const float *param);
+/* The inverse of lf_pl2d_sample; returns the density at the input point. */
+float lf_pl2d_invert(const lf_pl2d *t, float *x, float *y, const float *param);
+
+/* An RGL ".bsdf" file (Dupuy & Jakob 2018) read as pbrt-v4 reads it;
+ * errors name the path.  The BRDF functions work in the local shading frame
+ * (z = normal) and are two-sided like pbrt's. */
+int lf_measured_load(const char *path, lf_measured **out, lf_error *err);
+void lf_measured_free(lf_measured *m); /* accepts NULL */
+lf_vec3 lf_measured_f(const lf_measured *m, lf_vec3 wo, lf_vec3 wi);
+float lf_measured_pdf(const lf_measured *m, lf_vec3 wo, lf_vec3 wi);
+int lf_measured_sample(const lf_measured *m, lf_vec3 wo, float u0, float u1, lf_vec3 *wi, lf_vec3 *f, float *pdf);
+
+/* pbrt-v4's HairBxDF (hair.c), in the local frame (x along the fibre, z
+ * the surface normal): h in [-1, 1] across the fibre, eta its index,
+ * sigma_a its absorption per unit of fibre radius, beta_m / beta_n the
+ * longitudinal / azimuthal roughness in [0, 1], alpha the scale tilt in
+ * degrees.  f includes pbrt's 1/|cos theta_i|. */
+void lf_hair_setup(lf_hair *hp, float h, float eta, lf_vec3 sigma_a, float beta_m, float beta_n, float alpha_deg);
+lf_vec3 lf_hair_f(const lf_hair *hp, lf_vec3 wo, lf_vec3 wi);
+float lf_hair_pdf(const lf_hair *hp, lf_vec3 wo, lf_vec3 wi);
+int lf_hair_sample(const lf_hair *hp, lf_vec3 wo, float uc, float u0, float u1, lf_vec3 *wi, lf_vec3 *f,
+                   float *pdf);
+lf_vec3 lf_hair_sigma_a_from_concentration(float eumelanin, float pheomelanin);
+lf_vec3 lf_hair_sigma_a_from_reflectance(lf_vec3 c, float beta_n);
+
+/* Subsurface scattering (Material "subsurface"): the medium inside a
+ * surface of this material at ctx, with its coefficients already scaled
+ * by "scale"; returns 0 for any other material.  eta is the boundary's
+ * index. */
+typedef struct lf_subsurface {
+    lf_vec3 sigma_a, sigma_s;
+    float g, eta, exit_c; /* exit_c: lf_normalized_fresnel_c(eta) */
+} lf_subsurface;
+int lf_material_subsurface(const lf_material *mat, const lf_shading_ctx *ctx, lf_subsurface *out);
+/* pbrt-v4's table of measured media (Jensen et al. 2001; Narasimhan et
+ * al. 2006): sigma_a and reduced sigma_s' in mm^-1; 0 if the name is known. */
+int lf_named_medium(const char *name, lf_vec3 *sigma_a, lf_vec3 *sigma_s);
+/* The single-scattering albedo whose random walk in a semi-infinite
+ * medium reflects the diffuse albedo r (Chiang, Kutz and Burley 2016's
+ * fit), per channel. */
+lf_vec3 lf_subsurface_albedo_from_reflectance(lf_vec3 r);
 
 /* Index of refraction of pbrt-v4's named glasses ("glass-BK7", ...) at
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */

@@ -3,9 +3,10 @@
  * Parameter names, defaults and semantics follow pbrt-v4 (materials.cpp and
  * the file-format documentation).  Supported: diffuse, conductor,
  * dielectric, thindielectric, diffusetransmission, coateddiffuse,
- * coatedconductor (both approximated: see the comment in bsdf.c), mix, and
- * interface ("", "none").  measured, hair and subsurface are reported as
- * unsupported.  "displacement" bump-maps the shading normal (lf_bump_shading);
+ * coatedconductor (both approximated: see the comment in bsdf.c), mix,
+ * measured (RGL .bsdf files, measured.c), hair (hair.c), subsurface (a
+ * random walk in the renderer, render/subsurface.c) and interface ("",
+ * "none").  "displacement" bump-maps the shading normal (lf_bump_shading);
  * "normalmap" is read and ignored with a
  * warning.
  */
@@ -29,8 +30,15 @@ typedef enum mat_kind {
     MAT_DIFFUSE_TRANSMISSION,
     MAT_COATED_DIFFUSE,
     MAT_COATED_CONDUCTOR,
-    MAT_MIX
+    MAT_MIX,
+    MAT_MEASURED,
+    MAT_HAIR,
+    MAT_SUBSURFACE
 } mat_kind;
+
+/* Hair absorption given as sigma_a, as a colour (reflectance) or as
+ * melanin concentrations (pbrt-v4 HairMaterial, in that priority). */
+typedef enum hair_mode { HAIR_SIGMA_A, HAIR_REFLECTANCE, HAIR_MELANIN } hair_mode;
 
 /* Roughness inputs as pbrt-v4 reads them: uroughness / vroughness, each
  * falling back to roughness. */
@@ -53,6 +61,13 @@ struct lf_material {
     const lf_material *mix[2];
     int mix_index[2];
     lf_tex_input amount;
+    lf_measured *measured;     /* measured: the file's tables, owned */
+    hair_mode hair;            /* hair: sigma_a, reflectance (in "reflectance") or melanin */
+    lf_tex_input sigma_a, eumelanin, pheomelanin, beta_m, beta_n, alpha, eta_tex;
+    /* subsurface: sigma_a (above) and sigma_s, or reflectance and mfp */
+    lf_tex_input sigma_s, mfp;
+    int ss_from_reflectance;
+    float ss_g, ss_exit_c;
     lf_tex_input displacement; /* bump map (pbrt-v4 "float displacement"), when bump */
     int bump;
     lf_loc loc;
@@ -270,6 +285,186 @@ static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_ma
     return LF_OK;
 }
 
+/* Resolves `filename` against the directory of the scene file that wrote
+ * it (pbrt-v4 ResolveFilename). */
+static char *resolve_path(const char *scene_file, const char *filename)
+{
+    size_t dl = 0;
+    if (filename[0] != '/' && scene_file) {
+        const char *slash = strrchr(scene_file, '/');
+        if (slash)
+            dl = (size_t)(slash - scene_file) + 1;
+    }
+    size_t fl = strlen(filename);
+    char *out = malloc(dl + fl + 1);
+    if (!out)
+        return NULL;
+    memcpy(out, scene_file ? scene_file : "", dl);
+    memcpy(out + dl, filename, fl + 1);
+    return out;
+}
+
+static int read_measured(lf_paramset *ps, lf_material *m, const lf_loc *loc, lf_error *err)
+{
+    const char *fn = lf_params_string(ps, "filename", "");
+    const lf_param *p = lf_params_peek(ps, "filename");
+    if (!fn || !*fn)
+        return lf_error_at(err, LF_ERR_PARAM, loc, "measured material: \"string filename\" is required");
+    char *path = resolve_path(p->loc.file, fn);
+    if (!path)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    lf_error lerr = {0};
+    int rc = lf_measured_load(path, &m->measured, &lerr);
+    if (rc)
+        lf_error_at(err, rc, &p->loc, "measured material: %s", lerr.msg);
+    free(path);
+    return rc;
+}
+
+/* pbrt-v4 HairMaterial::Create: sigma_a wins over reflectance (or its old
+ * name "color"), which wins over the melanin concentrations; with none of
+ * them, eumelanin 1.3 (brown hair). */
+static int read_hair(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, lf_warnings *warnings,
+                     const lf_loc *loc, lf_error *err)
+{
+    lf_vec3 z = lf_v3(0, 0, 0);
+    int has_s = lf_params_peek(ps, "sigma_a") != NULL;
+    const char *rname = lf_params_peek(ps, "reflectance") ? "reflectance" : "color";
+    int has_r = lf_params_peek(ps, rname) != NULL;
+    int has_e = lf_params_peek(ps, "eumelanin") != NULL, has_p = lf_params_peek(ps, "pheomelanin") != NULL;
+    int rc = lf_tex_input_read(ps, "sigma_a", 0, LF_SPECTRUM_UNBOUNDED, z, texs, &m->sigma_a, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, rname, 0, LF_SPECTRUM_ALBEDO, z, texs, &m->reflectance, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, "eumelanin", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(has_e || has_p ? 0.f : 1.3f, 0, 0),
+                               texs, &m->eumelanin, err);
+    if (!rc)
+        rc = lf_tex_input_read(ps, "pheomelanin", 1, LF_SPECTRUM_UNBOUNDED, z, texs, &m->pheomelanin, err);
+    const struct { const char *name; float def; lf_tex_input *in; } fl[] = {
+        {"eta", 1.55f, &m->eta_tex}, {"beta_m", 0.3f, &m->beta_m}, {"beta_n", 0.3f, &m->beta_n}, {"alpha", 2.f, &m->alpha}};
+    for (int i = 0; i < 4 && !rc; i++)
+        rc = lf_tex_input_read(ps, fl[i].name, 1, LF_SPECTRUM_UNBOUNDED, lf_v3(fl[i].def, fl[i].def, fl[i].def), texs,
+                               fl[i].in, err);
+    if (rc)
+        return rc;
+    m->hair = has_s ? HAIR_SIGMA_A : has_r ? HAIR_REFLECTANCE : HAIR_MELANIN;
+    const char *ignored[] = {has_s ? rname : NULL, has_s || has_r ? "eumelanin" : NULL,
+                             has_s || has_r ? "pheomelanin" : NULL};
+    const char *why = has_s ? "sigma_a" : rname;
+    for (int i = 0; i < 3; i++)
+        if (ignored[i] && lf_params_peek(ps, ignored[i]))
+            lf_warn_at(warnings, &lf_params_peek(ps, ignored[i])->loc,
+                       "hair: ignoring \"%s\" since \"%s\" was provided (as pbrt-v4)", ignored[i], why);
+    (void)loc;
+    return LF_OK;
+}
+
+static lf_vec3 clamp01(lf_vec3 c)
+{
+    return lf_v3(lf_clampf(c.x, 0.f, 1.f), lf_clampf(c.y, 0.f, 1.f), lf_clampf(c.z, 0.f, 1.f));
+}
+
+/* pbrt-v4 SubsurfaceMaterial::Create: the medium by "name" (pbrt's
+ * measured table, g forced to 0), by "sigma_a" and "sigma_s", by
+ * "reflectance" and "mfp", or pbrt's default (skim-milk-like) coefficients;
+ * "scale" multiplies the coefficients (or mfp), "eta" is the boundary's
+ * index, roughness its GGX roughness. */
+static int read_subsurface(lf_paramset *ps, const lf_texture_list *texs, lf_material *m, lf_warnings *warnings,
+                           const lf_loc *loc, lf_error *err)
+{
+    m->kind = MAT_SUBSURFACE;
+    m->type = "subsurface";
+    m->ss_g = (float)lf_params_float(ps, "g", 0.0);
+    const char *name = lf_params_string(ps, "name", "");
+    int rc = LF_OK;
+    if (name && *name) {
+        const lf_param *p = lf_params_peek(ps, "name");
+        lf_vec3 sa, ss;
+        if (lf_named_medium(name, &sa, &ss))
+            return lf_error_at(err, LF_ERR_PARAM, &p->loc,
+                               "subsurface: named medium \"%s\" not found (pbrt-v4's names: \"Skin1\", \"Wholemilk\", "
+                               "\"Ketchup\", ...; docs/scene-format.md)",
+                               name);
+        if (m->ss_g != 0.f)
+            lf_warn_at(warnings, &lf_params_peek(ps, "g")->loc,
+                       "subsurface: non-zero \"g\" ignored with named scattering coefficients (as pbrt-v4)");
+        m->ss_g = 0.f; /* the table holds reduced scattering coefficients */
+        m->sigma_a.value = sa;
+        m->sigma_s.value = ss;
+    } else {
+        int has_a = lf_params_peek(ps, "sigma_a") != NULL, has_s = lf_params_peek(ps, "sigma_s") != NULL;
+        if (has_a != has_s)
+            return lf_error_at(err, LF_ERR_PARAM, loc, "subsurface: \"%s\" given without \"%s\"",
+                               has_a ? "sigma_a" : "sigma_s", has_a ? "sigma_s" : "sigma_a");
+        if (has_a) {
+            rc = lf_tex_input_read(ps, "sigma_a", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs, &m->sigma_a, err);
+            if (!rc)
+                rc = lf_tex_input_read(ps, "sigma_s", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(0, 0, 0), texs, &m->sigma_s, err);
+        } else if (lf_params_peek(ps, "reflectance")) {
+            m->ss_from_reflectance = 1;
+            rc = lf_tex_input_read(ps, "reflectance", 0, LF_SPECTRUM_ALBEDO, lf_v3(0, 0, 0), texs, &m->reflectance, err);
+            if (!rc)
+                rc = lf_tex_input_read(ps, "mfp", 0, LF_SPECTRUM_UNBOUNDED, lf_v3(1, 1, 1), texs, &m->mfp, err);
+        } else {
+            m->sigma_a.value = lf_v3(.0011f, .0024f, .014f);
+            m->sigma_s.value = lf_v3(2.55f, 3.21f, 3.77f);
+        }
+    }
+    if (rc)
+        return rc;
+    m->scale = (float)lf_params_float(ps, "scale", 1.0);
+    m->eta = (float)lf_params_float(ps, "eta", 1.33);
+    if (!(m->eta > 0.f))
+        return lf_error_at(err, LF_ERR_PARAM, loc, "subsurface: \"eta\" must be positive, got %g", m->eta);
+    m->ss_exit_c = lf_normalized_fresnel_c(m->eta);
+    return read_roughness(ps, "", texs, &m->rough, err);
+}
+
+static float hash_position(lf_vec3 p);
+
+int lf_material_subsurface(const lf_material *mat, const lf_shading_ctx *ctx, lf_subsurface *out)
+{
+    if (mat->kind == MAT_MIX) /* the component lf_material_bsdf chose at this point */
+        mat = lf_material_resolve(mat, ctx, hash_position(ctx->p));
+    if (mat->kind != MAT_SUBSURFACE)
+        return 0;
+    if (mat->ss_from_reflectance) {
+        /* sigma_t = 1 / mfp, split by the albedo whose walk reflects r */
+        lf_vec3 mfp = lf_scale(lf_tex_input_rgb(&mat->mfp, ctx), mat->scale);
+        lf_vec3 a = lf_subsurface_albedo_from_reflectance(clamp01(lf_tex_input_rgb(&mat->reflectance, ctx)));
+        float mf[3] = {mfp.x, mfp.y, mfp.z}, al[3] = {a.x, a.y, a.z}, sa[3], ss[3];
+        for (int c = 0; c < 3; c++) {
+            float st = mf[c] > 0.f ? 1.f / mf[c] : 1e30f;
+            ss[c] = al[c] * st;
+            sa[c] = (1.f - al[c]) * st;
+        }
+        out->sigma_a = lf_v3(sa[0], sa[1], sa[2]);
+        out->sigma_s = lf_v3(ss[0], ss[1], ss[2]);
+    } else {
+        lf_vec3 a = lf_scale(lf_tex_input_rgb(&mat->sigma_a, ctx), mat->scale);
+        lf_vec3 b = lf_scale(lf_tex_input_rgb(&mat->sigma_s, ctx), mat->scale);
+        out->sigma_a = lf_v3(fmaxf(a.x, 0.f), fmaxf(a.y, 0.f), fmaxf(a.z, 0.f));
+        out->sigma_s = lf_v3(fmaxf(b.x, 0.f), fmaxf(b.y, 0.f), fmaxf(b.z, 0.f));
+    }
+    out->g = mat->ss_g;
+    out->eta = mat->eta;
+    out->exit_c = mat->ss_exit_c;
+    return 1;
+}
+
+static int read_measured_or_hair(lf_paramset *ps, const char *type, const lf_texture_list *texs, lf_material *m,
+                                 lf_warnings *warnings, const lf_loc *loc, lf_error *err)
+{
+    if (!strcmp(type, "measured")) {
+        m->kind = MAT_MEASURED;
+        m->type = "measured";
+        return read_measured(ps, m, loc, err);
+    }
+    m->kind = MAT_HAIR;
+    m->type = "hair";
+    return read_hair(ps, texs, m, warnings, loc, err);
+}
+
 static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_error *err)
 {
     lf_paramset *ps = &md->e.params;
@@ -350,8 +545,10 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
         if (!rc)
             rc = lf_tex_input_read(ps, "amount", 1, LF_SPECTRUM_UNBOUNDED, lf_v3(0.5f, 0.5f, 0.5f), texs, &m->amount,
                                    err);
-    } else if (!strcmp(type, "measured") || !strcmp(type, "hair") || !strcmp(type, "subsurface")) {
-        return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "material \"%s\" is not supported", type);
+    } else if (!strcmp(type, "measured") || !strcmp(type, "hair")) {
+        rc = read_measured_or_hair(ps, type, texs, m, &ms->warnings, loc, err);
+    } else if (!strcmp(type, "subsurface")) {
+        rc = read_subsurface(ps, texs, m, &ms->warnings, loc, err);
     } else {
         return lf_error_at(err, LF_ERR_UNSUPPORTED, loc, "unknown material \"%s\"", type);
     }
@@ -485,8 +682,10 @@ void lf_materials_free(lf_materials *ms)
 {
     if (!ms)
         return;
-    for (size_t i = 0; i < ms->count; i++)
+    for (size_t i = 0; i < ms->count; i++) {
         free(ms->items[i].table);
+        lf_measured_free(ms->items[i].measured);
+    }
     free(ms->items);
     for (size_t i = 0; i < ms->texs.count; i++)
         lf_texture_free(ms->texs.items[i]);
@@ -521,10 +720,14 @@ int lf_material_uses_textures(const lf_material *mat)
     for (int depth = 0; depth < 64 && mat; depth++) {
         const lf_tex_input *in[] = {&mat->reflectance, &mat->transmittance, &mat->eta_c,   &mat->k_c,
                                     &mat->rough.u,     &mat->rough.v,       &mat->rough_b.u, &mat->rough_b.v,
-                                    &mat->amount,      &mat->displacement};
+                                    &mat->amount,      &mat->displacement, &mat->sigma_a,   &mat->eumelanin,
+                                    &mat->pheomelanin, &mat->beta_m,       &mat->beta_n,    &mat->alpha,
+                                    &mat->eta_tex,     &mat->sigma_s,      &mat->mfp};
         for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
             if (in[i]->tex)
                 return 1;
+        if (mat->kind == MAT_HAIR) /* h across the fibre is the hit's v */
+            return 1;
         if (mat->kind != MAT_MIX)
             return 0;
         if (lf_material_uses_textures(mat->mix[0]))
@@ -619,9 +822,27 @@ static float hash_position(lf_vec3 p)
     return (float)(h >> 40) * 0x1p-24f;
 }
 
-static lf_vec3 clamp01(lf_vec3 c)
+
+/* pbrt-v4 HairMaterial::GetBxDF: h = -1 + 2 v (curves put v across the
+ * width; on other shapes it is whatever their v is), parameters clamped as
+ * pbrt clamps them. */
+static void hair_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf *out)
 {
-    return lf_v3(lf_clampf(c.x, 0.f, 1.f), lf_clampf(c.y, 0.f, 1.f), lf_clampf(c.z, 0.f, 1.f));
+    float bm = lf_clampf(lf_tex_input_float(&mat->beta_m, ctx), 0.f, 1.f);
+    float bn = lf_clampf(lf_tex_input_float(&mat->beta_n, ctx), 0.f, 1.f);
+    float alpha = lf_tex_input_float(&mat->alpha, ctx), eta = lf_tex_input_float(&mat->eta_tex, ctx);
+    lf_vec3 sa;
+    if (mat->hair == HAIR_SIGMA_A) {
+        sa = lf_tex_input_rgb(&mat->sigma_a, ctx);
+        sa = lf_v3(fmaxf(sa.x, 0.f), fmaxf(sa.y, 0.f), fmaxf(sa.z, 0.f));
+    } else if (mat->hair == HAIR_REFLECTANCE) {
+        sa = lf_hair_sigma_a_from_reflectance(clamp01(lf_tex_input_rgb(&mat->reflectance, ctx)), bn);
+    } else {
+        sa = lf_hair_sigma_a_from_concentration(fmaxf(0.f, lf_tex_input_float(&mat->eumelanin, ctx)),
+                                                fmaxf(0.f, lf_tex_input_float(&mat->pheomelanin, ctx)));
+    }
+    out->kind = LF_LOBE_HAIR;
+    lf_hair_setup(&out->u.hair, -1.f + 2.f * ctx->uv.y, eta, sa, bm, bn, alpha);
 }
 
 void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf *out)
@@ -670,5 +891,14 @@ void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf
         out->u.coated.thickness = mat->thickness;
         return;
     }
+    case MAT_MEASURED:
+        lf_bsdf_set_measured(out, mat->measured);
+        return;
+    case MAT_HAIR:
+        hair_bsdf(mat, ctx, out);
+        return;
+    case MAT_SUBSURFACE: /* the boundary; the renderer walks the inside (render/subsurface.c) */
+        lf_bsdf_set_dielectric(out, mat->eta, eval_roughness(&mat->rough, ctx));
+        return;
     }
 }

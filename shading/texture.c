@@ -2,9 +2,12 @@
  * (u, v) or position.
  *
  * Supported classes (pbrt-v4 parameter names and defaults, textures.cpp):
- * constant, scale, mix, bilerp, checkerboard (2D and 3D) and imagemap, with
- * the uv, spherical, cylindrical and planar mappings.  There are no ray
- * differentials here, so textures are point-sampled: checkerboard is not
+ * constant, scale, mix, directionmix, bilerp, checkerboard (2D and 3D),
+ * dots, imagemap, and the noise textures fbm, wrinkled, windy (float only)
+ * and marble (spectrum only), with the uv, spherical, cylindrical and
+ * planar mappings.  The noise textures use pbrt's Perlin noise (noise.c)
+ * with all their octaves, as pbrt does where a lookup's footprint is zero.
+ * There are no ray differentials here, so textures are point-sampled: checkerboard is not
  * box-filtered and image maps are looked up bilinearly in the full-resolution
  * image whatever "filter" says ("point" is honoured).
  */
@@ -26,7 +29,13 @@ typedef enum tex_class {
     TEX_BILERP,
     TEX_CHECKER2D,
     TEX_CHECKER3D,
-    TEX_IMAGE
+    TEX_IMAGE,
+    TEX_DIRECTIONMIX,
+    TEX_DOTS,
+    TEX_FBM,
+    TEX_WRINKLED,
+    TEX_WINDY,
+    TEX_MARBLE
 } tex_class;
 
 typedef enum map_kind { MAP_UV, MAP_SPHERICAL, MAP_CYLINDRICAL, MAP_PLANAR } map_kind;
@@ -50,7 +59,10 @@ struct lf_texture {
     lf_image img;                    /* imagemap */
     wrap_mode wrap;
     int point_filter, invert;
-    float scale;
+    float scale;                     /* imagemap, marble */
+    lf_vec3 dir;                     /* directionmix: unit, world space */
+    int octaves;                     /* fbm, wrinkled, marble */
+    float omega, variation;          /* fbm, wrinkled, marble: "roughness"; marble: "variation" */
 };
 
 /* ------------------------------------------------------------- inputs */
@@ -354,9 +366,91 @@ static float checker_weight(const lf_texture *t, const lf_shading_ctx *ctx)
     return (sum & 1) ? 1.f : 0.f;
 }
 
+/* pbrt-v4 InsidePolkaDot: one dot of radius 0.35 in the cells noise
+ * switches on, its centre jittered by noise within the cell. */
+static int inside_polka_dot(float s, float t)
+{
+    float sc = floorf(s + .5f), tc = floorf(t + .5f);
+    if (!(lf_noise3(lf_v3(sc + .5f, tc + .5f, 0.5f)) > 0.f))
+        return 0;
+    const float radius = .35f, max_shift = 0.5f - radius;
+    float s0 = sc + max_shift * lf_noise3(lf_v3(sc + 1.5f, tc + 2.8f, 0.5f));
+    float t0 = tc + max_shift * lf_noise3(lf_v3(sc + 4.5f, tc + 9.8f, 0.5f));
+    return (s - s0) * (s - s0) + (t - t0) * (t - t0) < radius * radius;
+}
+
+/* pbrt-v4 MarbleTexture: t = 0.5 + 0.5 sin(y + variation fbm(p)) picks a
+ * point on a cubic Bezier spline through nine rock colours, times 1.5. */
+static lf_vec3 marble(const lf_texture *t, lf_vec3 p)
+{
+    static const float colors[9][3] = {{.58f, .58f, .6f}, {.58f, .58f, .6f}, {.58f, .58f, .6f},
+                                       {.5f, .5f, .5f},   {.6f, .59f, .58f}, {.58f, .58f, .6f},
+                                       {.58f, .58f, .6f}, {.2f, .2f, .33f},  {.58f, .58f, .6f}};
+    p = lf_scale(p, t->scale);
+    float m = p.y + t->variation * lf_fbm(p, t->omega, t->octaves);
+    float u = .5f + .5f * sinf(m);
+    const int nseg = 9 - 3;
+    int first = (int)floorf(u * (float)nseg);
+    first = first < 0 ? 0 : first > nseg - 1 ? nseg - 1 : first;
+    u = u * (float)nseg - (float)first;
+    float out[3];
+    for (int c = 0; c < 3; c++) { /* de Casteljau on the four control points */
+        float a = lf_lerpf(u, colors[first][c], colors[first + 1][c]);
+        float b = lf_lerpf(u, colors[first + 1][c], colors[first + 2][c]);
+        float d = lf_lerpf(u, colors[first + 2][c], colors[first + 3][c]);
+        out[c] = 1.5f * lf_lerpf(u, lf_lerpf(u, a, b), lf_lerpf(u, b, d));
+    }
+    return lf_v3(out[0], out[1], out[2]);
+}
+
+/* The noise-based and direction classes (pbrt-v4 textures.h). */
+static lf_vec3 eval_procedural(const lf_texture *t, const lf_shading_ctx *ctx)
+{
+    lf_vec3 p = lf_xform_point(&t->map.tex_from_world, ctx->p);
+    float v = 0.f;
+    switch (t->cls) {
+    case TEX_DIRECTIONMIX: {
+        /* amount = |n . dir| with the geometric normal (pbrt's ctx.n). */
+        float amt = lf_absdot(ctx->ng, t->dir);
+        lf_vec3 r = lf_v3(0, 0, 0);
+        if (amt != 0.f)
+            r = lf_scale(lf_tex_input_rgb(&t->a, ctx), amt);
+        if (amt != 1.f)
+            r = lf_add(r, lf_scale(lf_tex_input_rgb(&t->b, ctx), 1.f - amt));
+        return r;
+    }
+    case TEX_DOTS: {
+        float s, tt;
+        map2d(&t->map, ctx, &s, &tt);
+        return inside_polka_dot(s, tt) ? lf_tex_input_rgb(&t->a, ctx) : lf_tex_input_rgb(&t->b, ctx);
+    }
+    case TEX_FBM:
+        v = lf_fbm(p, t->omega, t->octaves);
+        break;
+    case TEX_WRINKLED:
+        v = lf_turbulence(p, t->omega, t->octaves);
+        break;
+    case TEX_WINDY:
+        v = fabsf(lf_fbm(lf_scale(p, .1f), .5f, 3)) * lf_fbm(p, .5f, 6);
+        break;
+    case TEX_MARBLE:
+        return marble(t, p);
+    default:
+        break;
+    }
+    return lf_v3(v, v, v);
+}
+
 static lf_vec3 eval(const lf_texture *t, const lf_shading_ctx *ctx)
 {
     switch (t->cls) {
+    case TEX_DIRECTIONMIX:
+    case TEX_DOTS:
+    case TEX_FBM:
+    case TEX_WRINKLED:
+    case TEX_WINDY:
+    case TEX_MARBLE:
+        return eval_procedural(t, ctx);
     case TEX_CONSTANT:
         return t->a.value;
     case TEX_SCALE: {
@@ -440,6 +534,75 @@ static int float_input(lf_texture_desc *td, const lf_texture_list *texs, const c
     return lf_tex_input_read(&td->e.params, name, 1, LF_SPECTRUM_UNBOUNDED, lf_v3(def, def, def), texs, out, err);
 }
 
+/* The classes of eval_procedural.  Returns 1 (with *rc set) when cls is
+ * one of them, 0 otherwise.  pbrt-v4 has fbm, wrinkled and windy only as
+ * float textures and marble only as a spectrum one. */
+static int read_procedural(lf_texture_desc *td, const lf_texture_list *texs, lf_texture *t, const char *cls,
+                           int *rc, lf_error *err)
+{
+    lf_paramset *ps = &td->e.params;
+    static const struct {
+        const char *name;
+        tex_class cls;
+        int kinds; /* 1: float, 2: spectrum */
+    } table[] = {{"directionmix", TEX_DIRECTIONMIX, 3}, {"dots", TEX_DOTS, 3},     {"fbm", TEX_FBM, 1},
+                 {"wrinkled", TEX_WRINKLED, 1},        {"windy", TEX_WINDY, 1},   {"marble", TEX_MARBLE, 2}};
+    size_t i = 0, n = sizeof table / sizeof table[0];
+    while (i < n && strcmp(table[i].name, cls) != 0)
+        i++;
+    if (i == n)
+        return 0;
+    if (!(table[i].kinds & (td->is_float ? 1 : 2))) {
+        *rc = lf_error_at(err, LF_ERR_PARAM, &td->e.loc, "texture \"%s\": pbrt-v4 has no %s \"%s\" texture (only %s)",
+                          td->name, td->is_float ? "float" : "spectrum", cls, td->is_float ? "spectrum" : "float");
+        return 1;
+    }
+    t->cls = table[i].cls;
+    t->octaves = 8;
+    t->omega = .5f;
+    *rc = LF_OK;
+    /* Only fbm, wrinkled and marble read octaves and roughness (elsewhere
+     * pbrt leaves them unused, hence an error). */
+    if (t->cls == TEX_FBM || t->cls == TEX_WRINKLED || t->cls == TEX_MARBLE) {
+        t->octaves = lf_params_int(ps, "octaves", 8);
+        t->omega = (float)lf_params_float(ps, "roughness", 0.5);
+        if (t->octaves < 0 || t->octaves > 30) {
+            const lf_param *p = lf_params_peek(ps, "octaves");
+            *rc = lf_error_at(err, LF_ERR_PARAM, p ? &p->loc : &td->e.loc,
+                              "texture \"%s\": \"octaves\" %d outside [0, 30]", td->name, t->octaves);
+            return 1;
+        }
+    }
+    switch (t->cls) {
+    case TEX_DIRECTIONMIX: {
+        double v[3];
+        lf_vec3 d = lf_params_vector3(ps, "dir", v) ? lf_v3((float)v[0], (float)v[1], (float)v[2]) : lf_v3(0, 1, 0);
+        d = lf_xform_vector(&td->object_to_world, d);
+        if (!(lf_length(d) > 0.f))
+            return (*rc = lf_error_at(err, LF_ERR_PARAM, &td->e.loc, "texture \"%s\": \"dir\" is zero", td->name)), 1;
+        t->dir = lf_normalize(d);
+        *rc = input(td, texs, "tex1", 0.f, &t->a, err);
+        if (!*rc)
+            *rc = input(td, texs, "tex2", 1.f, &t->b, err);
+        break;
+    }
+    case TEX_DOTS:
+        *rc = read_mapping(td, &t->map, err);
+        if (!*rc)
+            *rc = input(td, texs, "inside", 1.f, &t->a, err);
+        if (!*rc)
+            *rc = input(td, texs, "outside", 0.f, &t->b, err);
+        break;
+    case TEX_MARBLE:
+        t->scale = (float)lf_params_float(ps, "scale", 1.0);
+        t->variation = (float)lf_params_float(ps, "variation", 0.2);
+        break;
+    default:
+        break;
+    }
+    return 1;
+}
+
 int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings *warnings, lf_texture **out,
                    lf_error *err)
 {
@@ -453,7 +616,7 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings
     t->is_float = td->is_float;
     t->map.tex_from_world = lf_transform_inverse(&td->object_to_world);
     int rc = t->name ? LF_OK : lf_error_set(err, LF_ERR_NOMEM, "out of memory");
-    if (rc) {
+    if (rc || read_procedural(td, texs, t, cls, &rc, err)) {
     } else if (!strcmp(cls, "constant")) {
         t->cls = TEX_CONSTANT;
         rc = input(td, NULL, "value", 1.f, &t->a, err);
@@ -504,7 +667,7 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings
     } else {
         rc = lf_error_at(err, LF_ERR_UNSUPPORTED, l,
                          "texture \"%s\": %s texture class \"%s\" not supported (constant, scale, mix, "
-                         "bilerp, checkerboard, imagemap)",
+                         "directionmix, bilerp, checkerboard, dots, fbm, wrinkled, windy, marble, imagemap)",
                          td->name, td->is_float ? "float" : "spectrum", cls);
     }
     if (!rc) {

@@ -204,18 +204,15 @@ static void test_refused(void)
      * and "not supported", and writes nothing */
     const char *refused[] = {
         "Shape \"teapot\"",
-        "Material \"hair\"\nShape \"sphere\"",
-        "Material \"measured\" \"string filename\" \"x.bsdf\"\nShape \"sphere\"",
-        "Material \"subsurface\"\nShape \"sphere\"",
-        "MakeNamedMaterial \"m\" \"string type\" \"hair\"\nShape \"sphere\"",
+        "Material \"velvet\"\nShape \"sphere\"",
+        "MakeNamedMaterial \"m\" \"string type\" \"velvet\"\nShape \"sphere\"",
         "LightSource \"goniometric\" \"string filename\" \"x.exr\"",
         "LightSource \"projection\" \"string filename\" \"x.exr\"",
-        "Texture \"t\" \"float\" \"wrinkled\"\nShape \"sphere\"",
+        "Texture \"t\" \"float\" \"ptex\" \"string filename\" \"t.ptx\"\nShape \"sphere\"",
     };
-    const char *directive[] = {"unknown shape \"teapot\"",
-                               "Material \"hair\"", "Material \"measured\"", "Material \"subsurface\"",
-                               "MakeNamedMaterial \"hair\"", "LightSource \"goniometric\"",
-                               "LightSource \"projection\"", "Texture \"wrinkled\" is not supported"};
+    const char *directive[] = {"unknown shape \"teapot\"", "unknown material \"velvet\"",
+                               "MakeNamedMaterial: unknown material \"velvet\"", "LightSource \"goniometric\"",
+                               "LightSource \"projection\"", "Texture \"ptex\" is not supported"};
     for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++) {
         char text[2048];
         snprintf(text, sizeof text, "%s%s\n", HEAD, refused[i]);
@@ -240,13 +237,13 @@ static void test_refused(void)
     char text[2048];
     snprintf(text, sizeof text,
              "%sLightSource \"projection\" \"string filename\" \"x.exr\"\nShape \"sphere\" \"float radius\" \"big\"\n"
-             "Shape \"sphere\"\nMaterial \"hair\"\nShape \"disk\"\n",
+             "Shape \"sphere\"\nTexture \"p\" \"float\" \"ptex\"\nShape \"disk\"\n",
              HEAD);
     write_file("three.pbrt", text);
     CHECK(run("%s three.pbrt -o three.exr --quiet", LF_LFRENDER) == 1);
     CHECK_MSG(strstr(out_text, "three.pbrt:8:1: LightSource \"projection\" is not supported") &&
                   strstr(out_text, "three.pbrt:9:31: parameter \"float radius\" expects numbers") &&
-                  strstr(out_text, "three.pbrt:11:1: Material \"hair\" is not supported") &&
+                  strstr(out_text, "three.pbrt:11:1: Texture \"ptex\" is not supported") &&
                   strstr(out_text, "3 errors in three.pbrt"),
               "%s", out_text);
     CHECK(!exists("three.exr"));

@@ -409,7 +409,7 @@ static void test_errors_collected(void)
                        "LightSource \"goniometric\" \"string filename\" \"x.exr\"\n" /* 3: unsupported */
                        "Shape \"sphere\" \"float radius\" [ 1\n"                  /* 4: unclosed [ */
                        "Bogus 1 2 3\n"                                             /* 5: unknown directive */
-                       "Material \"hair\"\n"                                       /* 6: unsupported */
+                       "Texture \"p\" \"float\" \"ptex\"\n"                       /* 6: unsupported */
                        "Shape \"sphere\" Shapo \"disk\"\n"
                        "LightSource \"projection\"\n"; /* 8: unsupported */
     lf_scene_desc d;
@@ -423,7 +423,7 @@ static void test_errors_collected(void)
     CHECK_MSG(lines == 6, "want 6 errors, got:\n%s", errors ? errors : "");
     const char *want[] = {"multi.pbrt:3:1: LightSource \"goniometric\" is not supported", "multi.pbrt:5:1: expected a value or ']'",
                           "multi.pbrt:5:1: unknown directive \"Bogus\"",
-                          "multi.pbrt:6:1: Material \"hair\" is not supported",
+                          "multi.pbrt:6:1: Texture \"ptex\" is not supported",
                           "multi.pbrt:7:16: unknown directive \"Shapo\"",
                           "multi.pbrt:8:1: LightSource \"projection\" is not supported"};
     for (int i = 0; i < 6; i++)
@@ -445,9 +445,9 @@ static void test_errors_collected(void)
 
     /* --allow-unsupported: warnings, the rest is kept */
     const char *text2 = "Camera \"perspective\"\nWorldBegin\n"
-                        "Shape \"teapot\"\nMaterial \"subsurface\" \"float eta\" 1.3\nShape \"sphere\"\n"
-                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"measured\"\n"
-                        "Texture \"w\" \"spectrum\" \"marble\" \"float scale\" 2\n";
+                        "Shape \"teapot\"\nMaterial \"velvet\" \"float eta\" 1.3\nShape \"sphere\"\n"
+                        "LightSource \"goniometric\"\nMakeNamedMaterial \"m\" \"string type\" \"velvet\"\n"
+                        "Texture \"w\" \"spectrum\" \"ptex\" \"float scale\" 2\n";
     lf_parse_opts allow = {1, 0};
     rc = lf_scene_parse_string_ex(text2, "allow.pbrt", &allow, &d, &err, &errors);
     CHECK_MSG(rc == 0, "%s", err.msg);
@@ -457,13 +457,13 @@ static void test_errors_collected(void)
               d.materials[0].e.params.count == 0 && strcmp(d.materials[1].e.type, "diffuse") == 0);
         CHECK(d.allow_unsupported == 1);
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:3:1: warning: Shape: unknown shape \"teapot\" is not supported"));
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material \"subsurface\" is not supported; "
-                                               "rendered as \"diffuse\" 0.5"));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:4:1: warning: Material: unknown material \"velvet\" is not "
+                                               "supported; rendered as \"diffuse\" 0.5"));
         CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:6:1: warning: LightSource \"goniometric\""));
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial \"measured\""));
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:7:1: warning: MakeNamedMaterial: unknown material \"velvet\""));
         CHECK(d.n_textures == 1 && strcmp(d.textures[0].e.type, "constant") == 0 &&
               d.textures[0].e.params.count == 0);
-        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"marble\" is not supported; "
+        CHECK(d.warnings && strstr(d.warnings, "allow.pbrt:8:1: warning: Texture \"ptex\" is not supported; "
                                                "rendered as \"constant\" 1"));
         lf_scene_desc_free(&d);
     }

@@ -351,8 +351,7 @@ static void test_errors(void)
                  3, "\"b\" is not defined");
     expect_error("WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] \"spectrum eta\" \"metal-Au-eta\"\n",
                  2, "not both");
-    expect_error("WorldBegin\nMaterial \"hair\"\n", 2, "not supported");
-    expect_error("WorldBegin\nTexture \"t\" \"float\" \"wrinkled\"\n", 2, "not supported");
+    expect_error("WorldBegin\nTexture \"t\" \"float\" \"ptex\"\n", 2, "not supported");
     expect_error("WorldBegin\nTexture \"t\" \"float\" \"imagemap\" \"string filename\" \"missing.exr\"\n", 2,
                  "missing.exr");
     expect_error("WorldBegin\nTexture \"t\" \"float\" \"checkerboard\" \"string mapping\" \"uvw\"\n", 2, "uvw");

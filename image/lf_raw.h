@@ -44,6 +44,17 @@ static inline int lf_cfa_color(lf_cfa cfa, int x, int y)
     return pat[cfa][((y & 1) << 1) | (x & 1)];
 }
 
+/* The layout seen from site (dx, dy) of cfa: a crop's own pattern. */
+static inline lf_cfa lf_cfa_shift(lf_cfa cfa, int dx, int dy)
+{
+    static const lf_cfa by_origin[4][5] = {
+        {LF_CFA_NONE, LF_CFA_RGGB, LF_CFA_BGGR, LF_CFA_GRBG, LF_CFA_GBRG},  /* even, even */
+        {LF_CFA_NONE, LF_CFA_GRBG, LF_CFA_GBRG, LF_CFA_RGGB, LF_CFA_BGGR},  /* odd x */
+        {LF_CFA_NONE, LF_CFA_GBRG, LF_CFA_GRBG, LF_CFA_BGGR, LF_CFA_RGGB},  /* odd y */
+        {LF_CFA_NONE, LF_CFA_BGGR, LF_CFA_RGGB, LF_CFA_GBRG, LF_CFA_GRBG}}; /* odd x and y */
+    return by_origin[((dy & 1) << 1) | (dx & 1)][cfa];
+}
+
 typedef struct lf_raw_info {
     lf_cfa cfa;
     double black_level, white_level; /* DN */

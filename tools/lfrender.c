@@ -48,6 +48,7 @@ static int write_raw(const char *out, const lf_sensor *s, const lf_image *film, 
         return rc;
     lf_raw_info ri;
     lf_sensor_raw_info(s, &ri);
+    ri.cfa = lf_cfa_shift(ri.cfa, x0, y0); /* a crop's pattern starts at its own first site */
     rc = lf_raw_write(out, &raw, &ri, meta, err);
     lf_image_free(&raw);
     return rc;

@@ -90,8 +90,10 @@ int lf_demosaic_mhc(const lf_image *in, lf_cfa cfa, const int *mask, lf_image *o
 
 typedef struct lf_develop_opts {
     int no_white_balance; /* keep the camera's white */
+    int film_units;       /* scale by dn_per_unit (the renderer's film values) instead of white - black */
 } lf_develop_opts;
-/* Black level, normalisation ((DN - black) / (dn_per_unit or white - black)),
+/* Black level, normalisation ((DN - black) / (white - black): the white
+ * level develops to 1; or / dn_per_unit with film_units),
  * demosaic (Malvar-He-Cutler), white balance (divide by AsShotNeutral),
  * colour matrix (camera -> XYZ -> linear sRGB).  opts may be NULL. */
 int lf_raw_develop(const lf_image *raw, const lf_raw_info *ri, const lf_develop_opts *opts, lf_image *out,

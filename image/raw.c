@@ -267,7 +267,7 @@ int lf_raw_develop(const lf_image *raw, const lf_raw_info *ri, const lf_develop_
                    lf_error *err)
 {
     lf_develop_opts o = opts ? *opts : (lf_develop_opts){0};
-    double scale = ri->dn_per_unit > 0 ? ri->dn_per_unit : ri->white_level - ri->black_level;
+    double scale = o.film_units && ri->dn_per_unit > 0 ? ri->dn_per_unit : ri->white_level - ri->black_level;
     if (!(scale > 0))
         return lf_error_set(err, LF_ERR_PARAM, "develop: white level must be above the black level");
     lf_image lin;

@@ -91,6 +91,7 @@ int lf_demosaic_mhc(const lf_image *in, lf_cfa cfa, const int *mask, lf_image *o
 typedef struct lf_develop_opts {
     int no_white_balance; /* keep the camera's white */
     int film_units;       /* scale by dn_per_unit (the renderer's film values) instead of white - black */
+    const int *mask;      /* demosaic within regions (lf_demosaic_mhc), NULL: none */
 } lf_develop_opts;
 /* Black level, normalisation ((DN - black) / (white - black): the white
  * level develops to 1; or / dn_per_unit with film_units),

@@ -275,7 +275,7 @@ int lf_raw_develop(const lf_image *raw, const lf_raw_info *ri, const lf_develop_
         return err->code;
     for (size_t i = 0; i < (size_t)raw->width * raw->height; i++)
         lin.data[i] = (float)((raw->data[i] - ri->black_level) / scale);
-    int rc = lf_demosaic_mhc(&lin, ri->cfa, NULL, out, err);
+    int rc = lf_demosaic_mhc(&lin, ri->cfa, o.mask, out, err);
     lf_image_free(&lin);
     if (rc || ri->cfa == LF_CFA_NONE)
         return rc;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/lf_color.h"
+#include "base/lf_parallel.h"
 #include "render/lf_sensor.h"
 
 /* ---- radiometry ---- */
@@ -26,9 +27,8 @@ static int band_of(double l)
     return l < band_edge[1] ? 2 : l < band_edge[2] ? 1 : 0; /* k: 0 red, 1 green, 2 blue */
 }
 
-static const double srgb_to_xyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
-                                         {0.2126729, 0.7151522, 0.0721750},
-                                         {0.0193339, 0.1191920, 0.9503041}};
+static const double srgb_to_xyz[3][3] = {
+    {0.4124564, 0.3575761, 0.1804375}, {0.2126729, 0.7151522, 0.0721750}, {0.0193339, 0.1191920, 0.9503041}};
 
 static int invert3(const double a[3][3], double o[3][3])
 {
@@ -129,8 +129,8 @@ int lf_sensor_prepare(lf_sensor *s, lf_error *err)
                             "Film \"raw\": needs 0 < qe <= 1, fullwell > 0, gain > 0, readnoise, darkcurrent, dsnu, "
                             "blacklevel >= 0, 0 <= prnu < 1, 1 <= bits <= 16 (got qe %g fullwell %g gain %g "
                             "readnoise %g darkcurrent %g dsnu %g prnu %g blacklevel %g bits %d)",
-                            s->qe, s->fullwell, s->gain, s->readnoise, s->darkcurrent, s->dsnu, s->prnu,
-                            s->blacklevel, s->bits);
+                            s->qe, s->fullwell, s->gain, s->readnoise, s->darkcurrent, s->dsnu, s->prnu, s->blacklevel,
+                            s->bits);
     if (s->blacklevel >= ldexp(1.0, s->bits) - 1)
         return lf_error_set(err, LF_ERR_PARAM, "Film \"raw\": \"blacklevel\" %g leaves no room in %d bits",
                             s->blacklevel, s->bits);
@@ -244,14 +244,17 @@ static float site_dn(const lf_sensor *s, double mu_e, uint64_t pixel, uint64_t t
 {
     double e;
     if (s->noise) {
+        /* the fixed patterns' draws have fixed places in the pixel's stream
+         * (PRNU first, DSNU second), drawn only when asked for */
         stream fpn = stream_at(FPN_KEY, pixel);
-        double g_prnu = next_gauss(&fpn), g_dsnu = next_gauss(&fpn);
         if (s->prnu > 0)
-            mu_e *= fmax(0.0, 1.0 + s->prnu * g_prnu);
+            mu_e *= fmax(0.0, 1.0 + s->prnu * next_gauss(&fpn));
         stream tmp = stream_at(temporal_key, pixel);
         e = next_poisson(&tmp, mu_e + s->darkcurrent * s->exposure_s);
-        if (s->dsnu > 0)
-            e += s->dsnu * g_dsnu;
+        if (s->dsnu > 0) {
+            fpn.n = 2;
+            e += s->dsnu * next_gauss(&fpn);
+        }
         e = fmin(fmax(e, 0.0), s->fullwell);
         if (s->readnoise > 0)
             e += s->readnoise * next_gauss(&tmp);
@@ -262,25 +265,46 @@ static float site_dn(const lf_sensor *s, double mu_e, uint64_t pixel, uint64_t t
     return (float)(dn < 0 ? 0 : dn > top ? top : dn);
 }
 
+typedef struct expose_job {
+    const lf_sensor *s;
+    const lf_image *film;
+    lf_image *raw;
+    int x0, y0;
+    uint64_t temporal_key;
+    double top;
+} expose_job;
+
+/* Rows [y0, y1): every site's value depends on its pixel alone, so rows can
+ * run on any thread in any order. */
+static void expose_rows(void *ctx, int y_begin, int y_end, int tid)
+{
+    (void)tid;
+    const expose_job *j = ctx;
+    const lf_sensor *s = j->s;
+    for (int y = y_begin; y < y_end; y++) {
+        int gy = y + j->y0;
+        for (int x = 0; x < j->film->width; x++) {
+            int gx = x + j->x0;
+            const float *v = lf_image_px(j->film, x, y);
+            const double *row = s->e_per_unit[lf_cfa_color(s->cfa, gx, gy)];
+            double mu = row[0] * v[0] + row[1] * v[1] + row[2] * v[2];
+            if (!(mu > 0)) /* out-of-gamut colours can ask for negative light; NaN
+                              never reaches here */
+                mu = 0;
+            uint64_t pixel = (uint64_t)gy * (uint64_t)s->full_width + (uint64_t)gx;
+            j->raw->data[(size_t)y * j->raw->width + x] = site_dn(s, mu, pixel, j->temporal_key, j->top);
+        }
+    }
+}
+
 int lf_sensor_expose(const lf_sensor *s, const lf_image *film, int x0, int y0, lf_image *raw, lf_error *err)
 {
     if (film->channels < 3)
         return lf_error_set(err, LF_ERR_PARAM, "sensor: the film needs 3 channels, got %d", film->channels);
     if (lf_image_alloc(raw, film->width, film->height, 1, err))
         return err->code;
-    double top = ldexp(1.0, s->bits) - 1;
-    uint64_t temporal_key = mix64(0x7e3a0a11c0ffee5ull ^ (uint64_t)s->seed);
-    for (int y = 0; y < film->height; y++)
-        for (int x = 0; x < film->width; x++) {
-            int gx = x + x0, gy = y + y0;
-            const float *v = lf_image_px(film, x, y);
-            const double *row = s->e_per_unit[lf_cfa_color(s->cfa, gx, gy)];
-            double mu = row[0] * v[0] + row[1] * v[1] + row[2] * v[2];
-            if (!(mu > 0)) /* out-of-gamut colours can ask for negative light; NaN never reaches here */
-                mu = 0;
-            uint64_t pixel = (uint64_t)gy * (uint64_t)s->full_width + (uint64_t)gx;
-            raw->data[(size_t)y * raw->width + x] = site_dn(s, mu, pixel, temporal_key, top);
-        }
+    expose_job j = {s, film, raw, x0, y0, mix64(0x7e3a0a11c0ffee5ull ^ (uint64_t)s->seed), ldexp(1.0, s->bits) - 1};
+    lf_parallel_for(film->height, 0, 8, expose_rows, &j);
     return 0;
 }
 
@@ -321,8 +345,9 @@ int lf_sensor_read_params(lf_sensor *s, lf_paramset *ps, const char *where, lf_e
     const char *cfa = lf_params_string(ps, "cfa", lf_cfa_name(s->cfa));
     if (lf_cfa_parse(cfa, &s->cfa))
         return lf_error_set(err, LF_ERR_PARAM,
-                            "%s: \"cfa\" must be \"rggb\", \"bggr\", \"grbg\", \"gbrg\" or \"none\", got \"%s\"", where,
-                            cfa);
+                            "%s: \"cfa\" must be \"rggb\", \"bggr\", \"grbg\", "
+                            "\"gbrg\" or \"none\", got \"%s\"",
+                            where, cfa);
     s->qe = lf_params_float(ps, "qe", s->qe);
     s->fullwell = lf_params_float(ps, "fullwell", s->fullwell);
     s->gain = lf_params_float(ps, "gain", s->gain);
@@ -343,18 +368,18 @@ int lf_sensor_read_params(lf_sensor *s, lf_paramset *ps, const char *where, lf_e
 
 int lf_sensor_to_attrs(const lf_sensor *s, lf_attrs *a, lf_error *err)
 {
-    int rc = lf_attrs_set_string(a, LF_KEY_FILM, "raw", err) | lf_attrs_set_string(a, K("curves"), s->curves, err) |
-             lf_attrs_set_string(a, K("cfa"), lf_cfa_name(s->cfa), err) |
-             lf_attrs_set_double(a, K("qe"), s->qe, err) | lf_attrs_set_double(a, K("fullwell"), s->fullwell, err) |
-             lf_attrs_set_double(a, K("gain"), s->gain, err) |
-             lf_attrs_set_double(a, K("readnoise"), s->readnoise, err) |
-             lf_attrs_set_double(a, K("darkcurrent"), s->darkcurrent, err) |
-             lf_attrs_set_double(a, K("dsnu"), s->dsnu, err) | lf_attrs_set_double(a, K("prnu"), s->prnu, err) |
-             lf_attrs_set_double(a, K("blacklevel"), s->blacklevel, err) | lf_attrs_set_int(a, K("bits"), s->bits, err) |
-             lf_attrs_set_int(a, K("noise"), s->noise, err) | lf_attrs_set_double(a, K("iso"), s->iso, err) |
-             lf_attrs_set_double(a, K("exposure_s"), s->exposure_s, err) |
-             lf_attrs_set_double(a, K("pixel_pitch_m"), s->pixel_pitch_m, err) |
-             lf_attrs_set_int(a, K("seed"), (int)s->seed, err) | lf_attrs_set_int(a, K("full_width"), s->full_width, err);
+    int rc =
+        lf_attrs_set_string(a, LF_KEY_FILM, "raw", err) | lf_attrs_set_string(a, K("curves"), s->curves, err) |
+        lf_attrs_set_string(a, K("cfa"), lf_cfa_name(s->cfa), err) | lf_attrs_set_double(a, K("qe"), s->qe, err) |
+        lf_attrs_set_double(a, K("fullwell"), s->fullwell, err) | lf_attrs_set_double(a, K("gain"), s->gain, err) |
+        lf_attrs_set_double(a, K("readnoise"), s->readnoise, err) |
+        lf_attrs_set_double(a, K("darkcurrent"), s->darkcurrent, err) |
+        lf_attrs_set_double(a, K("dsnu"), s->dsnu, err) | lf_attrs_set_double(a, K("prnu"), s->prnu, err) |
+        lf_attrs_set_double(a, K("blacklevel"), s->blacklevel, err) | lf_attrs_set_int(a, K("bits"), s->bits, err) |
+        lf_attrs_set_int(a, K("noise"), s->noise, err) | lf_attrs_set_double(a, K("iso"), s->iso, err) |
+        lf_attrs_set_double(a, K("exposure_s"), s->exposure_s, err) |
+        lf_attrs_set_double(a, K("pixel_pitch_m"), s->pixel_pitch_m, err) |
+        lf_attrs_set_int(a, K("seed"), (int)s->seed, err) | lf_attrs_set_int(a, K("full_width"), s->full_width, err);
     return rc ? (err && err->code ? err->code : LF_ERR_NOMEM) : 0;
 }
 
@@ -380,11 +405,11 @@ int lf_sensor_from_attrs(const lf_attrs *a, lf_sensor *s, lf_error *err)
     lf_sensor_defaults(s);
     const lf_attr *cv = lf_attrs_get(a, K("curves")), *cfa = lf_attrs_get(a, K("cfa"));
     double v[15];
-    static const char *const names[15] = {K("qe"),   K("fullwell"),   K("gain"),       K("readnoise"), K("darkcurrent"),
-                                          K("dsnu"), K("prnu"),       K("blacklevel"), K("bits"),      K("noise"),
-                                          K("iso"),  K("exposure_s"), K("pixel_pitch_m"), K("seed"),   K("full_width")};
-    int bad = !cv || cv->type != LF_ATTR_STRING || !cfa || cfa->type != LF_ATTR_STRING ||
-              lf_cfa_parse(cfa->s, &s->cfa);
+    static const char *const names[15] = {
+        K("qe"),   K("fullwell"),   K("gain"),          K("readnoise"), K("darkcurrent"),
+        K("dsnu"), K("prnu"),       K("blacklevel"),    K("bits"),      K("noise"),
+        K("iso"),  K("exposure_s"), K("pixel_pitch_m"), K("seed"),      K("full_width")};
+    int bad = !cv || cv->type != LF_ATTR_STRING || !cfa || cfa->type != LF_ATTR_STRING || lf_cfa_parse(cfa->s, &s->cfa);
     for (int i = 0; i < 15 && !bad; i++)
         bad = attr_num(a, names[i], &v[i]);
     if (bad)
@@ -401,7 +426,9 @@ void lf_sensor_explain(const lf_sensor *s, lf_strbuf *b)
     double K = s->gain * s->iso / 100.0;
     lf_strbuf_printf(b, "sensor (Film \"raw\"): %s curves, CFA %s, pixel pitch %.4g um, qe %g\n", s->curves,
                      lf_cfa_name(s->cfa), s->pixel_pitch_m * 1e6, s->qe);
-    lf_strbuf_printf(b, "  electrons per film unit (R,G,B film -> site R,G,B): [%.4g %.4g %.4g] [%.4g %.4g %.4g] "
+    lf_strbuf_printf(b,
+                     "  electrons per film unit (R,G,B film -> site R,G,B): [%.4g %.4g %.4g] "
+                     "[%.4g %.4g %.4g] "
                      "[%.4g %.4g %.4g]\n",
                      s->e_per_unit[0][0], s->e_per_unit[0][1], s->e_per_unit[0][2], s->e_per_unit[1][0],
                      s->e_per_unit[1][1], s->e_per_unit[1][2], s->e_per_unit[2][0], s->e_per_unit[2][1],
@@ -410,14 +437,15 @@ void lf_sensor_explain(const lf_sensor *s, lf_strbuf *b)
         lf_strbuf_printf(b, "  noise: off (\"noise\" false: the noiseless mean, nothing drawn)\n");
     else {
         lf_strbuf_printf(b, "  PRNU: %s\n", s->prnu > 0 ? "on (fixed gain pattern)" : "off (prnu 0)");
-        lf_strbuf_printf(b, "  shot noise: on (Poisson on signal%s)\n",
-                         s->darkcurrent > 0 ? " + dark current" : "");
+        lf_strbuf_printf(b, "  shot noise: on (Poisson on signal%s)\n", s->darkcurrent > 0 ? " + dark current" : "");
         lf_strbuf_printf(b, "  DSNU: %s\n", s->dsnu > 0 ? "on (fixed offset pattern)" : "off (dsnu 0)");
         lf_strbuf_printf(b, "  read noise: %s\n", s->readnoise > 0 ? "on (Gaussian)" : "off (readnoise 0)");
     }
     lf_strbuf_printf(b, "  dark current: %s (%g e-/s x %g s)\n", s->darkcurrent > 0 ? "on" : "off", s->darkcurrent,
                      s->exposure_s);
-    lf_strbuf_printf(b, "  full well %g e-, conversion gain %g DN/e- (gain %g x ISO %g/100), black level %g DN, "
+    lf_strbuf_printf(b,
+                     "  full well %g e-, conversion gain %g DN/e- (gain %g x ISO "
+                     "%g/100), black level %g DN, "
                      "%d-bit converter, white level %g DN\n",
                      s->fullwell, K, s->gain, s->iso, s->blacklevel, s->bits, lf_sensor_white_level(s));
 }

@@ -6,14 +6,15 @@
 #include <string.h>
 
 #include "base/lf_file.h"
+#include "base/lf_keys.h"
 #include "image/lf_raw.h"
 
-#define KEY_CFA "lensfield:cfa"
-#define KEY_BLACK "lensfield:blacklevel"
-#define KEY_WHITE "lensfield:whitelevel"
-#define KEY_MATRIX "lensfield:color_matrix"
-#define KEY_NEUTRAL "lensfield:as_shot_neutral"
-#define KEY_DN_PER_UNIT "lensfield:dn_per_unit"
+#define KEY_CFA LF_KEY_CFA
+#define KEY_BLACK LF_KEY_BLACKLEVEL
+#define KEY_WHITE LF_KEY_WHITELEVEL
+#define KEY_MATRIX LF_KEY_COLOR_MATRIX
+#define KEY_NEUTRAL LF_KEY_AS_SHOT_NEUTRAL
+#define KEY_DN_PER_UNIT LF_KEY_DN_PER_UNIT
 
 static const char *const cfa_names[5] = {"none", "rggb", "bggr", "grbg", "gbrg"};
 

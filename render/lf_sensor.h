@@ -30,6 +30,7 @@
 
 #include "base/lf_buf.h"
 #include "base/lf_error.h"
+#include "base/lf_keys.h"
 #include "base/lf_params.h"
 #include "image/lf_image.h"
 #include "image/lf_raw.h"
@@ -38,8 +39,6 @@
 extern "C" {
 #endif
 
-#define LF_KEY_FILM "lensfield:film"
-#define LF_KEY_SENSOR_PREFIX "lensfield:sensor:"
 
 typedef struct lf_sensor {
     /* Film "raw" parameters (docs/scene-format.md) */

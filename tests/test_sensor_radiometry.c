@@ -6,7 +6,8 @@
  *    1 % with every noise term on and 0.1 % without;
  *  - a scene of one primary fills only its CFA sites with the "ideal" sensor;
  *  - nothing is drawn when a term is zero, and --explain says so;
- *  - frames differ by seed only in their temporal noise. */
+ *  - frames differ by seed only in their temporal noise;
+ *  - Film "rgb" "whitebalance" neutralises its illuminant (pbrt-v4). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -234,8 +235,38 @@ static void seeds(void)
     }
 }
 
+/* Film "rgb" "whitebalance" (pbrt-v4): a white lit by CIE illuminant A
+ * (2856 K) comes out neutral when balanced for 2856 K, orange when not. */
+static void white_balance(void)
+{
+    for (int wb = 0; wb < 2; wb++) {
+        char scene[1024];
+        snprintf(scene, sizeof scene,
+                 "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\n"
+                 "Film \"rgb\" \"integer xresolution\" [8] \"integer yresolution\" [8] \"float whitebalance\" [%d]\n"
+                 "Sampler \"independent\" \"integer pixelsamples\" [1]\nWorldBegin\n"
+                 "LightSource \"infinite\" \"spectrum L\" \"stdillum-A\"\n",
+                 wb ? 2856 : 0);
+        lf_image img;
+        char msg[1024];
+        if (render_text(scene, NULL, &img, msg, sizeof msg)) {
+            CHECK_MSG(0, "%s", msg);
+            return;
+        }
+        const float *p = img.data;
+        double lo = fmin(p[0], fmin(p[1], p[2])), hi = fmax(p[0], fmax(p[1], p[2]));
+        printf("illuminant A, whitebalance %d: (%.4f %.4f %.4f)\n", wb ? 2856 : 0, p[0], p[1], p[2]);
+        if (wb)
+            CHECK_MSG(hi / lo < 1.01, "balanced A is (%g %g %g)", p[0], p[1], p[2]);
+        else
+            CHECK_MSG(p[0] / p[2] > 3, "unbalanced A is (%g %g %g)", p[0], p[1], p[2]);
+        lf_image_free(&img);
+    }
+}
+
 int main(void)
 {
+    white_balance();
     flat_field();
     monochromatic();
     seeds();

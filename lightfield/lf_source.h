@@ -61,6 +61,10 @@ int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_li
 int lf_lightfield_lens_labels(const lf_lightfield_layout *l, int w, int h, int **labels, lf_error *err);
 /* A mosaic as grey: each site minus black, divided by the mean of its CFA colour. */
 int lf_lightfield_mosaic_grey(const lf_image *raw, const lf_raw_info *ri, lf_image *grey, lf_error *err);
+/* The microlens grid from a white image alone: lf_lightfield_calibrate,
+ * then again on the white image with each microlens image flattened (its
+ * outline kept, its shading removed; lightfield/mosaic.c). */
+int lf_lightfield_calibrate_white(const lf_image *white, lf_lightfield_layout *lay, lf_error *err);
 /* A mosaic developed to RGB, demosaicing within microlens cells. */
 int lf_lightfield_develop_mosaic(const lf_image *raw, const lf_raw_info *ri, const lf_lightfield_layout *l,
                                  lf_image *rgb, lf_error *err);

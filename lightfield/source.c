@@ -170,7 +170,7 @@ static int resolve_layout(const lf_lightfield_open_opts *o, const lf_lightfield_
     lf_lightfield_layout cal;
     lf_lightfield_layout_init(&cal);
     if (!rc)
-        rc = lf_lightfield_calibrate(white_mosaic ? &grey : white, &cal, e);
+        rc = lf_lightfield_calibrate_white(white_mosaic ? &grey : white, &cal, e);
     lf_image_free(&grey);
     if (!rc)
         rc = lf_lightfield_layout_resolve(&cal, flags, src->raw.width, src->raw.height, &src->layout, e);

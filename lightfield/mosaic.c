@@ -103,8 +103,7 @@ static int flatten_white(const lf_image *w, int r, lf_image *out, lf_error *err)
 
 int lf_lightfield_calibrate_white(const lf_image *white, lf_lightfield_layout *lay, lf_error *err)
 {
-    lf_lightfield_layout first;
-    lf_lightfield_layout_init(&first);
+    lf_lightfield_layout first = *lay; /* a grid kind the caller fixed holds for both passes */
     int rc = lf_lightfield_calibrate(white, &first, err);
     if (rc)
         return rc;

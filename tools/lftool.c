@@ -607,7 +607,7 @@ static int cmd_calibrate(void *ctx, int n, char **pos)
     if (o->flags.have & LF_LIGHTFIELD_HAVE_GRID)
         lay.grid = o->flags.grid, lay.have |= LF_LIGHTFIELD_HAVE_GRID;
     int rc = LF_EXIT_FAIL;
-    if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
+    if (lf_lightfield_calibrate_white(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
     else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1, &err))
         fail(&err, NULL);

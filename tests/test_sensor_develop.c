@@ -90,22 +90,31 @@ int main(void)
     strcpy(rgb_text, text);
     replace(rgb_text, "Film \"raw\"", "Film \"rgb\"");
     replace(rgb_text, "\"string cfa\" \"rggb\"", "");
-    /* 64 samples: the render's own Monte Carlo noise is white at the pixel
-     * scale, which no mosaic can carry (16 spp: 34.6 dB) */
-    replace(text, "pixelsamples\" [16]", "pixelsamples\" [64]");
-    replace(rgb_text, "pixelsamples\" [16]", "pixelsamples\" [64]");
     lf_image film, film_rgb, raw, dev;
     lf_attrs meta = {0};
     char msg[1024];
     lf_error err = {0};
     lf_sensor s;
-    int ok = render_text(text, &(lf_test_scene){.crop = crop, .meta = &meta}, &film, msg, sizeof msg) == 0 &&
-             render_text(rgb_text, &(lf_test_scene){.crop = crop}, &film_rgb, msg, sizeof msg) == 0 &&
-             lf_sensor_from_attrs(&meta, &s, &err) == 0;
-    CHECK_MSG(ok, "%s %s", msg, err.msg);
+    /* the Film "rgb" render is the raw film's own exposure, bit for bit (a
+     * small crop at the scene's 16 spp) ... */
+    static const int small[4] = {300, 340, 200, 230};
+    int ok = render_text(text, &(lf_test_scene){.crop = small}, &film, msg, sizeof msg) == 0 &&
+             render_text(rgb_text, &(lf_test_scene){.crop = small}, &film_rgb, msg, sizeof msg) == 0;
+    CHECK_MSG(ok, "%s", msg);
     if (!ok)
         return lf_test_end();
     CHECK(!memcmp(film.data, film_rgb.data, sizeof(float) * 3 * film.width * film.height));
+    lf_image_free(&film), lf_image_free(&film_rgb);
+    /* ... so the raw render's film at 64 spp is the Film "rgb" render: the
+     * render's own Monte Carlo noise is white at the pixel scale, which no
+     * mosaic can carry (16 spp: 34.6 dB) */
+    replace(text, "pixelsamples\" [16]", "pixelsamples\" [64]");
+    ok = render_text(text, &(lf_test_scene){.crop = crop, .meta = &meta}, &film, msg, sizeof msg) == 0 &&
+         lf_sensor_from_attrs(&meta, &s, &err) == 0 && lf_image_alloc(&film_rgb, film.width, film.height, 3, &err) == 0;
+    CHECK_MSG(ok, "%s %s", msg, err.msg);
+    if (!ok)
+        return lf_test_end();
+    memcpy(film_rgb.data, film.data, sizeof(float) * 3 * film.width * film.height);
     s.noise = 0;
     lf_raw_info ri;
     lf_sensor_raw_info(&s, &ri);
@@ -128,13 +137,13 @@ int main(void)
     CHECK(lf_image_psnr(&dev, &film_rgb, &psnr, &err) == 0);
     printf("demo (%dx%d centre), noiseless mosaic developed vs Film \"rgb\": %.2f dB\n", film.width, film.height,
            psnr);
+    CHECK_MSG(psnr >= 38, "%.2f dB", psnr);
     bin2(&dev_lin), bin2(&film_lin);
     picture(&dev_lin, 0.18 / mean), picture(&film_lin, 0.18 / mean);
     double psnr2 = 0;
     lf_image_psnr(&dev_lin, &film_lin, &psnr2, &err);
     printf("  ... both binned 2x2 (the mosaic's own resolution): %.2f dB\n", psnr2);
     lf_image_free(&dev_lin), lf_image_free(&film_lin);
-    CHECK_MSG(psnr >= 38, "%.2f dB", psnr);
     lf_image_free(&film), lf_image_free(&film_rgb), lf_image_free(&raw), lf_image_free(&dev);
     lf_attrs_free(&meta);
     free(text), free(rgb_text);

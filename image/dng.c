@@ -69,7 +69,7 @@ static tag t_rational(uint16_t id, int type, int n, const double *v)
     return t;
 }
 
-enum { N_TAGS = 27 };
+enum { N_TAGS = 29 };
 
 /* The IFD's tags in ascending order (TIFF requires it); strip offset last
  * patched once the layout is known. */
@@ -100,6 +100,14 @@ static int make_tags(const lf_image *raw, const lf_raw_info *ri, tag *t)
             pat[i] = (unsigned char)lf_cfa_color(ri->cfa, i & 1, i >> 1);
         t[n++] = t_bytes(33422, T_BYTE, 4, pat);
     }
+    if (ri->exposure_s > 0) { /* ExposureTime, rational seconds */
+        tag e = {33434, T_RATIONAL, 1, {0}};
+        double den = ri->exposure_s < 1 ? 1e9 : 1e3, num = round(ri->exposure_s * den);
+        put32(e.data, (uint32_t)(num < 4e9 ? num : 4e9)), put32(e.data + 4, (uint32_t)den);
+        t[n++] = e;
+    }
+    if (ri->iso > 0 && ri->iso < 65536)
+        v[0] = (uint32_t)lround(ri->iso), t[n++] = t_short(34855, 1, v); /* ISOSpeedRatings */
     static const unsigned char version[4] = {1, 4, 0, 0}, backward[4] = {1, 1, 0, 0}, planes[3] = {0, 1, 2};
     t[n++] = t_bytes(50706, T_BYTE, 4, version);
     t[n++] = t_bytes(50707, T_BYTE, 4, backward);

@@ -61,6 +61,7 @@ typedef struct lf_raw_info {
     double color_matrix[9];          /* XYZ (D65) -> camera, row-major (DNG ColorMatrix1) */
     double as_shot_neutral[3];       /* camera response to white, largest 1 (DNG AsShotNeutral) */
     double dn_per_unit;              /* DN per unit of the film's white, after white balance; 0: unknown */
+    double iso, exposure_s;          /* EXIF ISOSpeedRatings and ExposureTime in the DNG; 0: not written */
 } lf_raw_info;
 
 /* Raw attributes <-> lf_raw_info.  lf_raw_info_from_attrs: LF_ERR_PARAM when

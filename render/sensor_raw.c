@@ -336,6 +336,7 @@ void lf_sensor_raw_info(const lf_sensor *s, lf_raw_info *ri)
         }
     }
     ri->dn_per_unit = nmax * s->gain * s->iso / 100.0;
+    ri->iso = s->iso, ri->exposure_s = s->exposure_s;
 }
 
 /* ---- parameters, attributes, explanation ---- */

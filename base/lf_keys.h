@@ -87,4 +87,14 @@
 #define LF_KEY_FISHEYE_FOV_DEG                   "lensfield:fisheye_fov_deg"
 #define LF_KEY_FISHEYE_MAPPING                   "lensfield:fisheye_mapping"
 
+/* raw sensor mosaics (Film "raw", docs/sensor.md) */
+#define LF_KEY_CFA                               "lensfield:cfa"
+#define LF_KEY_BLACKLEVEL                        "lensfield:blacklevel"
+#define LF_KEY_WHITELEVEL                        "lensfield:whitelevel"
+#define LF_KEY_COLOR_MATRIX                      "lensfield:color_matrix"
+#define LF_KEY_AS_SHOT_NEUTRAL                   "lensfield:as_shot_neutral"
+#define LF_KEY_DN_PER_UNIT                       "lensfield:dn_per_unit"
+#define LF_KEY_FILM                              "lensfield:film"
+#define LF_KEY_SENSOR_PREFIX                     "lensfield:sensor:" /* + each Film "raw" parameter */
+
 #endif

@@ -175,7 +175,7 @@ static int write_pixels(exr_context_t ctxt, const lf_image *img, const char *nam
 }
 
 int lf_exr_write(const char *file, const char *name, const lf_image *img, const lf_attrs *attrs, int half,
-                 lf_error *err)
+                 const char *mono_name, lf_error *err)
 {
     exr_last_msg[0] = '\0';
     exr_context_initializer_t init = exr_init();
@@ -193,6 +193,8 @@ int lf_exr_write(const char *file, const char *name, const lf_image *img, const 
     for (int k = 0; k < img->channels && !rv; k++) {
         char cname[16];
         channel_name(k, img->channels, cname, sizeof cname);
+        if (img->channels == 1 && mono_name)
+            snprintf(cname, sizeof cname, "%s", mono_name);
         rv = exr_add_channel(ctxt, part, cname, half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
                              EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     }

@@ -431,7 +431,7 @@ int lf_image_write(const char *path, const lf_image *img, const lf_attrs *attrs,
         return rc;
     }
     if (is_exr)
-        rc = lf_exr_write(tmp, path, img, attrs, opts->half, err);
+        rc = lf_exr_write(tmp, path, img, attrs, opts->half, opts->mono_channel, err);
     else if (is_pfm)
         rc = lf_pfm_write(tmp, path, img, err);
     else if (as_float)

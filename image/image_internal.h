@@ -31,6 +31,7 @@ int lf_png_write(const char *file, const char *name, int width, int height, int 
 /* EXR via OpenEXRCore.  `file` is the file actually opened or created (for
  * writes, the temporary file); `name` is the path shown in messages. */
 int lf_exr_write(const char *file, const char *name, const lf_image *img, const lf_attrs *attrs, int half,
+                 const char *mono_name /* 1-channel images: the channel's name, NULL: Y */,
                  lf_error *err);
 int lf_exr_read(const char *file, const char *name, lf_image *img, lf_attrs *attrs, lf_error *err);
 

@@ -97,6 +97,7 @@ typedef struct lf_write_opts {
     float exposure;      /* 8-bit outputs: multiply by 2^exposure before tonemapping */
     int allow_nonfinite; /* write NaN/Inf instead of failing */
     lf_tonemap tonemap;  /* 8-bit outputs: the tone curve (default clamp) */
+    const char *mono_channel; /* EXR, 1-channel images: the channel's name (NULL: "Y") */
 } lf_write_opts;
 
 /* The tone curve alone: linear scene value (after exposure) -> linear

@@ -13,6 +13,7 @@
 #ifndef LF_SOURCE_H
 #define LF_SOURCE_H
 
+#include "image/lf_raw.h"
 #include "lf_lightfield.h"
 
 #ifdef __cplusplus
@@ -48,6 +49,25 @@ typedef struct lf_lightfield_open_opts {
  * LF_ERR_NUMERIC on non-finite values unless allow_nonfinite; on failure
  * *src is left empty.  src->lf.nonfinite counts the excluded samples. */
 int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_lightfield_source *src, lf_error *err);
+
+/* Raw sensor mosaics (Film "raw" EXR, DNG): lf_lightfield_open develops them
+ * (black level, white balance, colour matrix) with demosaicing kept inside
+ * each microlens image, and, when the raw gives no layout and a white image
+ * is given, calibrates the microlens grid from the white image alone
+ * (lf_lightfield_calibrate on its grey version), as LFToolbox does with
+ * Lytro white images.  The pieces: */
+/* Per pixel, the index (j * lens_x + i) of the microlens whose cell holds
+ * its centre, or -1 outside the grid; malloc'ed. */
+int lf_lightfield_lens_labels(const lf_lightfield_layout *l, int w, int h, int **labels, lf_error *err);
+/* A mosaic as grey: each site minus black, divided by the mean of its CFA colour. */
+int lf_lightfield_mosaic_grey(const lf_image *raw, const lf_raw_info *ri, lf_image *grey, lf_error *err);
+/* The microlens grid from a white image alone: lf_lightfield_calibrate,
+ * then again on the white image with each microlens image flattened (its
+ * outline kept, its shading removed; lightfield/mosaic.c). */
+int lf_lightfield_calibrate_white(const lf_image *white, lf_lightfield_layout *lay, lf_error *err);
+/* A mosaic developed to RGB, demosaicing within microlens cells. */
+int lf_lightfield_develop_mosaic(const lf_image *raw, const lf_raw_info *ri, const lf_lightfield_layout *l,
+                                 lf_image *rgb, lf_error *err);
 void lf_lightfield_close(lf_lightfield_source *src); /* accepts a zeroed struct */
 
 /* What `lftool info` says about a source: its kind, size and layout. */

@@ -129,6 +129,54 @@ static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_lay
     return LF_OK;
 }
 
+/* A raw or white image as the tools take it: a mosaic (DNG, or one channel
+ * with lensfield:cfa) says so in *mosaic with its raw info. */
+static int read_any(const char *path, lf_image *img, lf_attrs *attrs, lf_raw_info *ri, int *mosaic, lf_error *err)
+{
+    *mosaic = 0;
+    if (lf_path_has_ext(path, ".dng")) {
+        *mosaic = 1;
+        return lf_raw_read(path, img, ri, NULL, err);
+    }
+    lf_attrs a = {0};
+    int rc = lf_image_read(path, img, &a, err);
+    if (!rc && img->channels == 1 && lf_raw_info_from_attrs(&a, ri, NULL) == 0)
+        *mosaic = 1;
+    if (attrs && !rc)
+        *attrs = a;
+    else
+        lf_attrs_free(&a);
+    return rc;
+}
+
+/* The layout: the raw's attributes and the flags; when they leave it
+ * incomplete and a white image is given, the microlens grid calibrated from
+ * the white image (a mosaic through its grey version). */
+static int resolve_layout(const lf_lightfield_open_opts *o, const lf_lightfield_layout *flags, const lf_image *white,
+                          const lf_raw_info *wri, int white_mosaic, lf_lightfield_source *src, lf_error *e)
+{
+    lf_lightfield_layout file;
+    if (lf_lightfield_layout_from_attrs(&src->attrs, &file, e))
+        return e->code;
+    lf_error first = {0};
+    if (!lf_lightfield_layout_resolve(&file, flags, src->raw.width, src->raw.height, &src->layout, &first))
+        return LF_OK;
+    if (!o->white || !white->data || (file.have & LF_LIGHTFIELD_HAVE_PITCH)) {
+        *e = first;
+        return first.code;
+    }
+    lf_image grey = {0};
+    int rc = white_mosaic ? lf_lightfield_mosaic_grey(white, wri, &grey, e) : 0;
+    lf_lightfield_layout cal;
+    lf_lightfield_layout_init(&cal);
+    if (!rc)
+        rc = lf_lightfield_calibrate_white(white_mosaic ? &grey : white, &cal, e);
+    lf_image_free(&grey);
+    if (!rc)
+        rc = lf_lightfield_layout_resolve(&cal, flags, src->raw.width, src->raw.height, &src->layout, e);
+    return rc;
+}
+
 int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_lightfield_source *src, lf_error *err)
 {
     memset(src, 0, sizeof *src);
@@ -141,31 +189,50 @@ int lf_lightfield_open(const char *path, const lf_lightfield_open_opts *o, lf_li
     /* The layout alone needs no pixels where the header gives the size (a
      * PNG: no attributes, no non-finite values); otherwise read it all. */
     lf_error he = {0};
-    int hrc = o->layout_only ? lf_image_read_size(path, &src->raw.width, &src->raw.height, &src->raw.channels, &he)
-                             : LF_ERR_UNSUPPORTED;
+    int hrc = o->layout_only && !o->white ? lf_image_read_size(path, &src->raw.width, &src->raw.height,
+                                                               &src->raw.channels, &he)
+                                          : LF_ERR_UNSUPPORTED;
     if (hrc && hrc != LF_ERR_UNSUPPORTED) {
         if (err)
             *err = he;
         return hrc;
     }
-    if (hrc && lf_image_read(path, &src->raw, &src->attrs, err))
+    lf_raw_info ri, wri;
+    int mosaic = 0, white_mosaic = 0;
+    if (hrc && read_any(path, &src->raw, &src->attrs, &ri, &mosaic, err))
         return err ? err->code : LF_ERR_IO;
-    lf_error e = {0};
-    lf_lightfield_layout file;
-    if (lf_lightfield_layout_from_attrs(&src->attrs, &file, &e) ||
-        lf_lightfield_layout_resolve(&file, flags, src->raw.width, src->raw.height, &src->layout, &e))
-        return fail_named(src, &e, err);
-    src->raw_nonfinite = lf_image_count_nonfinite(&src->raw);
-    if (o->layout_only)
-        return LF_OK;
-    if (src->raw_nonfinite && !o->allow_nonfinite)
-        return nonfinite_error(src, src->raw_nonfinite, err);
     lf_image white = {0};
-    if (o->white && lf_image_read(o->white, &white, NULL, err)) {
+    if (o->white && read_any(o->white, &white, NULL, &wri, &white_mosaic, err)) {
         lf_lightfield_close(src);
         return err ? err->code : LF_ERR_IO;
     }
-    int rc = lf_lightfield_decode(&src->raw, &src->layout, o->white ? &white : NULL, &src->lf, &e);
+    lf_error e = {0};
+    if (resolve_layout(o, flags, &white, &wri, white_mosaic, src, &e)) {
+        lf_image_free(&white);
+        return fail_named(src, &e, err);
+    }
+    src->raw_nonfinite = lf_image_count_nonfinite(&src->raw);
+    int rc = LF_OK;
+    if (o->layout_only)
+        goto done;
+    if (src->raw_nonfinite && !o->allow_nonfinite) {
+        lf_image_free(&white);
+        return nonfinite_error(src, src->raw_nonfinite, err);
+    }
+    /* mosaics: developed within microlens cells (white and raw alike), then
+     * decoded and devignetted as any RGB raw */
+    lf_image dev;
+    if (mosaic && !(rc = lf_lightfield_develop_mosaic(&src->raw, &ri, &src->layout, &dev, &e))) {
+        lf_image_free(&src->raw);
+        src->raw = dev;
+    }
+    if (!rc && white_mosaic && !(rc = lf_lightfield_develop_mosaic(&white, &wri, &src->layout, &dev, &e))) {
+        lf_image_free(&white);
+        white = dev;
+    }
+    if (!rc)
+        rc = lf_lightfield_decode(&src->raw, &src->layout, o->white ? &white : NULL, &src->lf, &e);
+done:
     lf_image_free(&white);
     return rc ? fail_named(src, &e, err) : LF_OK;
 }

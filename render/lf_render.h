@@ -97,6 +97,11 @@ int lf_render_write_disparity(lf_renderer *r, const char *path, lf_attrs *meta, 
 
 /* Output path requested by the Film's "filename" (pbrt default "pbrt.exr"). */
 const char *lf_renderer_film_filename(const lf_renderer *r);
+/* Film "raw": the sensor that turns the rendered film into a mosaic
+ * (render/lf_sensor.h; lfrender applies it after the render, and merge
+ * after summing the parts); NULL for Film "rgb". */
+struct lf_sensor;
+const struct lf_sensor *lf_renderer_sensor(const lf_renderer *r);
 /* Film "savefp16" (pbrt default true): store EXR channels as half floats. */
 int lf_renderer_film_half(const lf_renderer *r);
 

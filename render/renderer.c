@@ -24,6 +24,7 @@
 #include "base/lf_color.h"
 #include "render/film.h"
 #include "render/integrator_params.h"
+#include "render/lf_sensor.h"
 #include "render/render_internal.h"
 
 #define LF_VERSION_STRING "lensfield " LF_VERSION /* LF_VERSION: CMake's project version (lf_base) */
@@ -46,6 +47,10 @@ struct lf_renderer {
     int save_half;
     double max_component;
     char *film_filename;
+    int raw;                  /* Film "raw": the sensor turns the film into a mosaic (lf_sensor.h) */
+    lf_sensor sensor;
+    int has_wb;               /* Film "whitebalance" (pbrt-v4): von Kries in Bradford space, per sample */
+    float wb[3][3];
     char *camera_name;
     char *sampler_name;
     char *filter_name;
@@ -203,6 +208,119 @@ static int pixel_index(double v)
     return v < 1073741824.0 ? (int)v : 1073741824;
 }
 
+/* pbrt-v4's camera curves (measured data of Jiang et al., "What is the space
+ * of spectral sensitivity functions for digital color cameras?", WACV 2013,
+ * and others), named by the Film's "sensor"; lensfield does not ship them. */
+static const char *const pbrt_sensor_curves[] = {
+    "canon_eos_100d",  "canon_eos_1dx_mkii", "canon_eos_200d", "canon_eos_200d_mkii", "canon_eos_5d",
+    "canon_eos_5d_mkii", "canon_eos_5d_mkiii", "canon_eos_5d_mkiv", "canon_eos_5ds", "canon_eos_m",
+    "hasselblad_l1d_20c", "nikon_d810", "nikon_d850", "sony_ilce_6400", "sony_ilce_7m3", "sony_ilce_7rm3",
+    "sony_ilce_9"};
+
+/* The chromaticity of pbrt-v4's white-balance illuminant at T kelvin: CIE
+ * daylight (CIE 15:2004 eq. 3.3-3.4) from 4000 K, a black body below. */
+static void illuminant_xy(double t, double *x, double *y)
+{
+    double cct = t * 1.4388 / 1.4380; /* pbrt-v4: the old value of c2 */
+    if (cct < 4000) {
+        double X = 0, Y = 0, Z = 0;
+        for (double l = LF_CIE_LAMBDA_MIN; l <= LF_CIE_LAMBDA_MAX; l += 1) {
+            double b[3], p = lf_planck(l, cct);
+            lf_cie_xyz_bar(l, b);
+            X += p * b[0], Y += p * b[1], Z += p * b[2];
+        }
+        *x = X / (X + Y + Z), *y = Y / (X + Y + Z);
+        return;
+    }
+    double c3 = cct * cct * cct;
+    *x = cct <= 7000 ? -4.607e9 / c3 + 2.9678e6 / (cct * cct) + 0.09911e3 / cct + 0.244063
+                     : -2.0064e9 / c3 + 1.9018e6 / (cct * cct) + 0.24748e3 / cct + 0.23704;
+    *y = -3 * *x * *x + 2.870 * *x - 0.275;
+}
+
+/* White balance from the illuminant at T to sRGB's D65 (pbrt-v4's
+ * WhiteBalance: von Kries scaling in Bradford's cone space), as one matrix
+ * on linear sRGB. */
+static void white_balance_matrix(double t, float out[3][3])
+{
+    static const double B[3][3] = {{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}};
+    static const double Bi[3][3] = {{0.9869929, -0.1470543, 0.1599627},
+                                    {0.4323053, 0.5183603, 0.0492912},
+                                    {-0.0085287, 0.0400428, 0.9684867}};
+    static const double M[3][3] = {{0.4124564, 0.3575761, 0.1804375},
+                                   {0.2126729, 0.7151522, 0.0721750},
+                                   {0.0193339, 0.1191920, 0.9503041}};
+    static const double Mi[3][3] = {{3.2404542, -1.5371385, -0.4985314},
+                                    {-0.9692660, 1.8760108, 0.0415560},
+                                    {0.0556434, -0.2040259, 1.0572252}};
+    double x, y, src[3], dst[3], ws[3] = {0}, wd[3] = {0};
+    illuminant_xy(t, &x, &y);
+    src[0] = x / y, src[1] = 1, src[2] = (1 - x - y) / y;
+    dst[0] = 0.3127 / 0.3290, dst[1] = 1, dst[2] = (1 - 0.3127 - 0.3290) / 0.3290;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            ws[i] += B[i][k] * src[k], wd[i] += B[i][k] * dst[k];
+    double A[3][3], C[3][3];
+    for (int i = 0; i < 3; i++) /* diag(wd/ws) B M */
+        for (int j = 0; j < 3; j++) {
+            A[i][j] = 0;
+            for (int k = 0; k < 3; k++)
+                A[i][j] += B[i][k] * M[k][j];
+            A[i][j] *= wd[i] / ws[i];
+        }
+    for (int i = 0; i < 3; i++) /* Bi A */
+        for (int j = 0; j < 3; j++) {
+            C[i][j] = 0;
+            for (int k = 0; k < 3; k++)
+                C[i][j] += Bi[i][k] * A[k][j];
+        }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double v = 0;
+            for (int k = 0; k < 3; k++)
+                v += Mi[i][k] * C[k][j];
+            out[i][j] = (float)v;
+        }
+}
+
+/* Film "sensor" and "whitebalance" (pbrt-v4 meanings). */
+static int read_film_sensor(lf_renderer *r, option_entity *oe, lf_error *err)
+{
+    lf_paramset *ps = oe->ps;
+    const char *sensor = lf_params_string(ps, "sensor", "cie1931");
+    double wb = lf_params_float(ps, "whitebalance", 0.0);
+    int known = !strcmp(sensor, "cie1931") || !strcmp(sensor, "ideal"), pbrt_named = 0;
+    for (size_t i = 0; i < sizeof pbrt_sensor_curves / sizeof *pbrt_sensor_curves; i++)
+        pbrt_named |= !strcmp(sensor, pbrt_sensor_curves[i]);
+    if (!known && !pbrt_named)
+        return lf_error_set(err, LF_ERR_PARAM,
+                            "%s: unknown Film \"sensor\" \"%s\" (lensfield models \"cie1931\" and \"ideal\"; "
+                            "pbrt-v4's camera curves such as \"canon_eos_5d\" are not shipped)",
+                            oe->where, sensor);
+    if (pbrt_named)
+        lf_warn_at(&r->warnings, oe->loc,
+                   "Film \"sensor\" \"%s\": pbrt-v4's measured camera curves are not shipped with lensfield; "
+                   "using \"cie1931\"",
+                   sensor);
+    if (!(wb >= 0) || wb > 1e6)
+        return lf_error_set(err, LF_ERR_PARAM, "%s: Film \"whitebalance\" must be 0 (none) or a temperature in K",
+                            oe->where);
+    if (pbrt_named && wb == 0)
+        wb = 6500; /* pbrt-v4: a camera's curves are white balanced for 6500 K unless told */
+    if (r->raw) {
+        snprintf(r->sensor.curves, sizeof r->sensor.curves, "%s", known ? sensor : "cie1931");
+        if (wb != 0)
+            lf_warn_at(&r->warnings, oe->loc,
+                       "Film \"raw\": \"whitebalance\" %g is not applied to raw data (a developer white balances "
+                       "it with AsShotNeutral)",
+                       wb);
+    } else if (wb != 0) {
+        r->has_wb = 1;
+        white_balance_matrix(wb, r->wb);
+    }
+    return 0;
+}
+
 static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
 {
     lf_entity *f = &d->film;
@@ -210,7 +328,8 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     option_entity_init(&oe, f, "rgb");
     lf_paramset *ps = oe.ps;
     const char *where = oe.where;
-    if (f->type && strcmp(f->type, "rgb") != 0)
+    r->raw = f->type && !strcmp(f->type, "raw");
+    if (f->type && strcmp(f->type, "rgb") != 0 && !r->raw)
         lf_warn_at(&r->warnings, oe.loc, "Film \"%s\" is rendered as Film \"rgb\"", f->type);
     r->xres = lf_params_int(ps, "xresolution", 1280);
     r->yres = lf_params_int(ps, "yresolution", 720);
@@ -219,13 +338,12 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     double iso = lf_params_float(ps, "iso", 100.0);
     r->save_half = lf_params_bool(ps, "savefp16", 1);
     r->max_component = lf_params_float(ps, "maxcomponentvalue", INFINITY);
-    const char *sensor = lf_params_string(ps, "sensor", "cie1931");
-    double wb = lf_params_float(ps, "whitebalance", 0.0);
-    if (strcmp(sensor, "cie1931") != 0 || wb != 0.0)
-        lf_warn_at(&r->warnings, oe.loc,
-                   "Film sensor \"%s\"/whitebalance %g: only the CIE 1931 RGB sensor is "
-                   "modelled; no white balance applied",
-                   sensor, wb);
+    lf_sensor_defaults(&r->sensor);
+    if (read_film_sensor(r, &oe, err))
+        return err->code;
+    if (r->raw && lf_sensor_read_params(&r->sensor, ps, where, err))
+        return err->code;
+    r->sensor.iso = iso;
     if (r->xres <= 0 || r->yres <= 0 || r->xres > 65536 || r->yres > 65536)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Film resolution %dx%d is out of range (1..65536)", where, r->xres,
                             r->yres);
@@ -257,7 +375,7 @@ static int read_film(lf_renderer *r, lf_scene_desc *d, lf_error *err)
         r->px0 = pixel_index(pb[0]), r->px1 = pixel_index(pb[1]), r->py0 = pixel_index(pb[2]),
         r->py1 = pixel_index(pb[3]);
     }
-    if (lf_params_finish(ps, "Film \"rgb\"", err))
+    if (lf_params_finish(ps, r->raw ? "Film \"raw\"" : "Film \"rgb\"", err))
         return err->code;
     return 0;
 }
@@ -692,6 +810,38 @@ static int make_camera(lf_renderer *r, lf_scene_desc *d, lf_error *err)
     return option_entity_finish(&oe, "Camera", err);
 }
 
+static void sink_string(void *ctx, const char *name, const char *value);
+static void sink_int(void *ctx, const char *name, int value);
+static void sink_double(void *ctx, const char *name, double value);
+static void sink_doubles(void *ctx, const char *name, const double *v, int n);
+
+/* The sensor's share of the scene: exposure time, seed, and the pixel
+ * pitch - the camera's sensor width over the film's width where the camera
+ * has a physical sensor (thinlens, plenoptic), else the Film "diagonal". */
+static int prepare_sensor(lf_renderer *r, lf_error *err)
+{
+    lf_sensor *s = &r->sensor;
+    s->exposure_s = (r->shutter_close - r->shutter_open) * r->curve_mean;
+    s->seed = r->sampler.seed;
+    s->full_width = r->xres;
+    s->pixel_pitch_m = r->diagonal_mm * 1e-3 / hypot(r->xres, r->yres);
+    lf_attrs meta = {0};
+    if (r->camera_type->metadata) {
+        lf_camera_attr_sink sink = {&meta, sink_string, sink_int, sink_double, sink_doubles};
+        r->camera_type->metadata(r->camera, &sink);
+    }
+    const lf_attr *sz = lf_attrs_get(&meta, LF_KEY_SENSOR_SIZE_MM);
+    if (sz && sz->type == LF_ATTR_FLOATS && sz->n == 2 && sz->v[0] > 0)
+        s->pixel_pitch_m = sz->v[0] * 1e-3 / r->xres;
+    lf_attrs_free(&meta);
+    return lf_sensor_prepare(s, err);
+}
+
+const lf_sensor *lf_renderer_sensor(const lf_renderer *r)
+{
+    return r->raw ? &r->sensor : NULL;
+}
+
 int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer **out, lf_error *err)
 {
     *out = NULL;
@@ -779,6 +929,8 @@ int lf_renderer_create(lf_scene_desc *d, const lf_render_opts *opts, lf_renderer
     /* Time is sampled only when something moves: a static scene renders the
      * same bits whatever the shutter says, and pays nothing for it. */
     r->time_needed = (r->scene.moving_shapes > 0 || r->camera_moving) && r->shutter_close >= r->shutter_open;
+    if (r->raw && prepare_sensor(r, err))
+        goto fail;
     long nproc = sysconf(_SC_NPROCESSORS_ONLN);
     r->threads = opts->threads > 0 ? opts->threads : (nproc > 0 ? (int)nproc : 1);
     *out = r;
@@ -931,6 +1083,11 @@ char *lf_renderer_explain(const lf_renderer *r)
             lsm == LF_LIGHTS_ALL       ? "every light sampled at every vertex (one shadow ray each)"
             : lsm == LF_LIGHTS_UNIFORM ? "one light per vertex, chosen uniformly"
                                        : "one light per vertex, chosen by power");
+    if (r->raw)
+        lf_sensor_explain(&r->sensor, &b);
+    else
+        lf_strbuf_printf(&b, "sensor: none (Film \"rgb\": noiseless linear exposure%s)\n",
+                         r->has_wb ? ", white balanced" : "");
     lf_strbuf_printf(&b, "threads: %d\n", r->threads);
     if (b.failed) { /* out of memory: no half a plan */
         lf_strbuf_free(&b);
@@ -1026,6 +1183,10 @@ static void trace_camera_ray(const lf_renderer *r, pending *p, const lf_camera_r
                                     rays)
                     : lf_path_li(&r->scene, &r->integrator, of, df, (float)p->tau, &p->st, rays);
     L = lf_scale(L, (float)w * (float)r->imaging_ratio);
+    if (r->has_wb)
+        L = lf_v3(r->wb[0][0] * L.x + r->wb[0][1] * L.y + r->wb[0][2] * L.z,
+                  r->wb[1][0] * L.x + r->wb[1][1] * L.y + r->wb[1][2] * L.z,
+                  r->wb[2][0] * L.x + r->wb[2][1] * L.y + r->wb[2][2] * L.z);
     if ((r->camera_needs & LF_CAMERA_NEEDS_WAVELENGTH) && cr->wavelength_nm > 0)
         L = lf_mul(L, lf_wavelength_rgb_weight(cr->wavelength_nm));
     if (!isfinite(L.x) || !isfinite(L.y) || !isfinite(L.z)) {
@@ -1452,6 +1613,8 @@ static int render_attrs(const lf_renderer *r, lf_attrs *meta, lf_error *err)
     if (r->has_curve)
         lf_attrs_set_double(meta, LF_KEY_SHUTTER_EFFICIENCY, r->curve_mean, err);
     lf_attrs_set_int(meta, LF_KEY_MOTION_BLUR, r->time_needed, err);
+    if (r->raw)
+        lf_sensor_to_attrs(&r->sensor, meta, err);
     if (r->camera_type->metadata) {
         lf_camera_attr_sink sink = {meta, sink_string, sink_int, sink_double, sink_doubles};
         r->camera_type->metadata(r->camera, &sink);

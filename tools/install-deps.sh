@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config zlib1g-dev
   libembree-dev libopenexr-dev libimath-dev libopenimageio-dev openimageio-tools libpng-dev
   libcairo2-dev fonts-dejavu-core
-  libnanovdb-dev libblosc-dev
+  libnanovdb-dev libblosc-dev libraw-bin
   clang libclang-rt-14-dev
   python3-numpy python3-pytest python3-venv python3-setuptools python3-wheel python3-pip
   chromium nodejs

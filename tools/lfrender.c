@@ -23,7 +23,9 @@
 #include "camera/lf_camera.h"
 #include "cli.h"
 #include "image/lf_image.h"
+#include "image/lf_raw.h"
 #include "render/lf_render.h"
+#include "render/lf_sensor.h"
 #include "scenefile/lf_scene_desc.h"
 
 enum { MAX_PLUGINS = 16 };
@@ -34,6 +36,23 @@ typedef struct flags {
     long long seed;
     double checkpoint_every, exposure;
 } flags;
+
+/* Film "raw": the sensor turns the film (region from full-film pixel x0, y0)
+ * into a mosaic of DN, written as .exr or .dng. */
+static int write_raw(const char *out, const lf_sensor *s, const lf_image *film, int x0, int y0, const lf_attrs *meta,
+                     lf_error *err)
+{
+    lf_image raw;
+    int rc = lf_sensor_expose(s, film, x0, y0, &raw, err);
+    if (rc)
+        return rc;
+    lf_raw_info ri;
+    lf_sensor_raw_info(s, &ri);
+    ri.cfa = lf_cfa_shift(ri.cfa, x0, y0); /* a crop's pattern starts at its own first site */
+    rc = lf_raw_write(out, &raw, &ri, meta, err);
+    lf_image_free(&raw);
+    return rc;
+}
 
 static int run_merge(void *ctx, int n, char **parts)
 {
@@ -46,7 +65,16 @@ static int run_merge(void *ctx, int n, char **parts)
         return LF_EXIT_FAIL;
     }
     int rc = lf_render_merge((const char **)parts, n, &img, &meta, &err);
-    if (!rc) { /* write as the unsplit render would: Film "savefp16" travels in the parts */
+    lf_sensor sensor;
+    int raw = rc ? -1 : lf_sensor_from_attrs(&meta, &sensor, &err);
+    if (!rc && raw == 0) { /* Film "raw": the sensor sees the merged film, as an unsplit render's */
+        const lf_attr *pb = lf_attrs_get(&meta, LF_KEY_PIXEL_BOUNDS);
+        rc = write_raw(f->out, &sensor, &img, pb ? (int)pb->v[0] : 0, pb ? (int)pb->v[2] : 0, &meta, &err);
+        lf_image_free(&img);
+    } else if (!rc && raw > 0) {
+        rc = raw;
+        lf_image_free(&img);
+    } else if (!rc) { /* write as the unsplit render would: Film "savefp16" travels in the parts */
         const lf_attr *h = lf_attrs_get(&meta, LF_KEY_SAVEFP16);
         lf_write_opts wo = {.half = h && h->type == LF_ATTR_INT && h->i && lf_image_fits_half(&img)};
         rc = lf_image_write(f->out, &img, &meta, &wo, &err);
@@ -129,6 +157,9 @@ static int check_output(const flags *f, lf_renderer *r, const lf_render_opts *o,
     if (o->part && !lf_path_has_ext(*out, ".exr"))
         return lf_cli_usage_error("lfrender", NULL, "parts (--spp-range, --tile, --part) must be written as .exr, "
                                   "not %s", *out);
+    if (lf_renderer_sensor(r) && !o->part && !lf_path_has_ext(*out, ".exr") && !lf_path_has_ext(*out, ".dng"))
+        return lf_cli_usage_error("lfrender", NULL, "Film \"raw\" writes a mosaic as .exr or .dng, not %s "
+                                  "(develop it with lftool develop)", *out);
     if (f->aov && (o->part || !lf_path_has_ext(*out, ".exr")))
         return lf_cli_usage_error("lfrender", NULL, "--aov disparity needs an .exr output and an unsplit render (no "
                                   "--part, --tile, --spp-range)");
@@ -167,8 +198,13 @@ static int render_and_write(const flags *f, lf_renderer *r, const lf_render_opts
         float range[2];
         if (f->aov && !(rc = lf_render_write_disparity(r, out, &meta, aov, sizeof aov, range, &err)) && !f->quiet)
             fprintf(stderr, "lfrender: wrote %s (disparity %.6g .. %.6g px per view step)\n", aov, range[0], range[1]);
-        if (!rc)
+        const lf_sensor *sensor = lf_renderer_sensor(r);
+        if (!rc && sensor && !o->part) {
+            const lf_attr *pb = lf_attrs_get(&meta, LF_KEY_PIXEL_BOUNDS);
+            rc = write_raw(out, sensor, &img, pb ? (int)pb->v[0] : 0, pb ? (int)pb->v[2] : 0, &meta, &err);
+        } else if (!rc) {
             rc = lf_image_write(out, &img, &meta, &wo, &err);
+        }
         if (!rc && !f->quiet)
             fprintf(stderr, "lfrender: wrote %s\n", out);
         lf_image_free(&img);

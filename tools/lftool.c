@@ -17,6 +17,7 @@
 #include "base/lf_progress.h"
 #include "cli.h"
 #include "image/lf_image.h"
+#include "image/lf_raw.h"
 #include "lightfield/lf_depth.h"
 #include "lightfield/lf_lightfield.h"
 #include "lightfield/lf_source.h"
@@ -30,7 +31,7 @@ typedef struct opts {
     lf_lightfield_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
-    int views[4], steps, threads, allow_nonfinite, calibrate_views;
+    int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units;
     lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal; /* synth */
     int port, have_steps;                               /* export-web, serve */
@@ -221,6 +222,32 @@ static int cmd_info(void *ctx, int n, char **pos)
     fputs(buf, stdout);
     lf_lightfield_close(&s);
     return LF_EXIT_OK;
+}
+
+/* A raw mosaic (Film "raw" EXR or DNG) to a picture: black level,
+ * Malvar-He-Cutler demosaicing, white balance, colour matrix, tone curve. */
+static int cmd_develop(void *ctx, int n, char **pos)
+{
+    const opts *o = begin(ctx, "develop", n, pos);
+    if (refuse_overwrite(o))
+        return LF_EXIT_FAIL;
+    lf_image raw, rgb;
+    lf_raw_info ri;
+    lf_error err = {0};
+    if (lf_raw_read(o->input, &raw, &ri, NULL, &err))
+        return fail(&err, NULL);
+    lf_develop_opts d = {o->no_wb, o->film_units};
+    int rc = lf_raw_develop(&raw, &ri, &d, &rgb, &err);
+    lf_image_free(&raw);
+    if (rc)
+        return fail(&err, o->input);
+    rc = write_image(o, o->output, &rgb, NULL);
+    if (!rc)
+        printf("%s: %d x %d %s mosaic developed (Malvar-He-Cutler, white balance%s, %s) -> %s\n", o->input,
+               rgb.width, rgb.height, lf_cfa_name(ri.cfa), o->no_wb ? " off" : "",
+               o->film_units && ri.dn_per_unit > 0 ? "in the film's units" : "white level = 1", o->output);
+    lf_image_free(&rgb);
+    return rc;
 }
 
 /* The HCI benchmark layout, with the centre view's ground truth when known. */
@@ -580,7 +607,7 @@ static int cmd_calibrate(void *ctx, int n, char **pos)
     if (o->flags.have & LF_LIGHTFIELD_HAVE_GRID)
         lay.grid = o->flags.grid, lay.have |= LF_LIGHTFIELD_HAVE_GRID;
     int rc = LF_EXIT_FAIL;
-    if (lf_lightfield_calibrate(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
+    if (lf_lightfield_calibrate_white(&white, &lay, &err) || lf_lightfield_layout_to_attrs(&lay, &a, &err))
         fail(&err, o->input);
     else if (lf_attrs_set_int(&a, LF_KEY_WHITE, 1, &err))
         fail(&err, NULL);
@@ -736,6 +763,12 @@ int main(int argc, char **argv)
         {"--steps", NULL, LF_ARG_INT, &o.steps, "N", "focal-stack slices (default 9)", R_IN(2, 64),
          .given = &o.have_steps},
     };
+    const lf_arg develop_args[] = {
+        OUTPUT_FLAG("the picture (.exr linear sRGB, .png tone-mapped)"), PICTURE_FLAGS,
+        {"--no-white-balance", NULL, LF_ARG_FLAG, &o.no_wb, NULL, "keep the camera's white (no AsShotNeutral)"},
+        {"--film-units", NULL, LF_ARG_FLAG, &o.film_units, NULL,
+         "EXR raws from lfrender: values in the renderer's film units (lensfield:dn_per_unit), not white level = 1"},
+    };
     const lf_arg serve_args[] = {
         {"--port", NULL, LF_ARG_INT, &o.port, "P", "port on 127.0.0.1 (default 8000; 0: any free)", R_IN(0, 65535)},
     };
@@ -763,6 +796,10 @@ int main(int argc, char **argv)
          LF_ARRAY_LEN(synth_args), 2, 2, cmd_synth, NULL},
         CMD("export-web", "IN -o DIR [--format jpg|png] [--from D0 --to D1] [--steps N]",
             "a living picture for the web: click to focus, drag to move (docs/web.md)", web_args, cmd_export_web, NULL),
+        CMD("develop", "RAW -o OUT.png|exr", "develop a Film \"raw\" mosaic (EXR or DNG) into a picture",
+            develop_args, cmd_develop,
+            "Black level and white level from the raw, Malvar-He-Cutler (ICASSP 2004) demosaicing, white balance by "
+            "AsShotNeutral, colour matrix (DNG ColorMatrix1) to linear sRGB; PNG adds --exposure and --tonemap."),
         CMD("serve", "DIR [--port P]", "serve DIR on http://127.0.0.1:P/ until Ctrl-C", serve_args, cmd_serve, NULL),
     };
     const lf_tool tool = {

@@ -52,6 +52,8 @@ typedef struct lf_lightfield_depth_opts {
     int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
+    int sgm;             /* semi-global aggregation after the guided filter: 0 default (on), < 0 off */
+    double sgm_p1, sgm_p2, sgm_edge; /* its penalties and edge scale; <= 0: defaults (docs/depth.md) */
     int threads;         /* <= 0: 2 */
     /* Called now and then from the calling thread with the work done of
      * `total` (done == total once, at the end); NULL: none.  The library

@@ -7,7 +7,7 @@
  * the cubic (or bilinear) weights are constant along a row and the inner
  * loops are plain multiply-adds over contiguous floats (vectorised, AVX2
  * clone).  Then each cost slice is filtered (guided filter, threads take
- * slices), then per pixel the minimum, parabola refinement and confidence,
+ * slices), then aggregated semi-globally (depth_sgm.c), then per pixel the minimum, parabola refinement and confidence,
  * then the weighted median, then the thin-structure step (the unaggregated
  * full-aperture winner, tracked while the volume is built, tested per
  * pixel), then a Gauss-Newton refinement (views outer, rows in parallel). */

@@ -7,7 +7,7 @@
  * the cubic (or bilinear) weights are constant along a row and the inner
  * loops are plain multiply-adds over contiguous floats (vectorised, AVX2
  * clone).  Then each cost slice is filtered (guided filter, threads take
- * slices), then per pixel the minimum, parabola refinement and confidence,
+ * slices), then aggregated semi-globally (depth_sgm.c), then per pixel the minimum, parabola refinement and confidence,
  * then the weighted median, then the thin-structure step (the unaggregated
  * full-aperture winner, tracked while the volume is built, tested per
  * pixel), then a Gauss-Newton refinement (views outer, rows in parallel). */
@@ -19,6 +19,7 @@
 
 #include "lf_depth.h"
 #include "base/lf_parallel.h"
+#include "lightfield/depth_internal.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))
@@ -74,6 +75,11 @@ static const int REFINE_RADIUS = 2;
 static const double REFINE_MAX_STEP_LABELS = 2.0;
 /* threads when the options say none */
 static const int DEFAULT_THREADS = 2;
+/* semi-global aggregation: penalties in units of the cost's mean contrast,
+ * and the colour step (square-root encoded) that halves P2 */
+static const double DEFAULT_SGM_P1 = 0.05;
+static const double DEFAULT_SGM_P2 = 8.0;
+static const double DEFAULT_SGM_EDGE = 0.05;
 
 lf_lightfield_depth_opts lf_lightfield_depth_defaults(void)
 {
@@ -547,7 +553,8 @@ static void gf_slices(void *vctx, int l0, int l1, int tid)
 typedef struct wta_ctx {
     int w, h, nlabels;
     double d0, step;
-    const float *cost;
+    const float *cost; /* the filtered costs: the parabola */
+    const float *sel;  /* the volume the label is chosen on (cost, or the semi-global sum) */
     float *disp, *conf;
 } wta_ctx;
 
@@ -562,16 +569,21 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             size_t i = (size_t)y * c->w + x;
             int best = 0;
             float cb = FLT_MAX, sum = 0;
+            const float *cv = c->cost; /* the confidence: the data's own curve, not the propagated one */
             for (int l = 0; l < L; l++) {
-                float v = c->cost[(size_t)l * np + i];
-                sum += v;
+                float v = c->sel[(size_t)l * np + i];
                 if (v < cb)
                     cb = v, best = l;
             }
+            for (int l = 0; l < L; l++)
+                sum += cv[(size_t)l * np + i];
+            /* the sub-label offset from the filtered costs: the semi-global
+             * sum is piecewise linear in the label near its minimum (P1) */
             double off = 0;
             if (best > 0 && best < L - 1) {
+                double c0 = c->cost[(size_t)best * np + i];
                 double cm = c->cost[(size_t)(best - 1) * np + i], cp = c->cost[(size_t)(best + 1) * np + i];
-                double den = cm - 2.0 * cb + cp;
+                double den = cm - 2.0 * c0 + cp;
                 if (den > 1e-12)
                     off = 0.5 * (cm - cp) / den;
                 off = off < -0.5 ? -0.5 : (off > 0.5 ? 0.5 : off);
@@ -580,9 +592,10 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             /* confidence: the minimum against the best cost away from it
              * (more than 2 labels off), relative to the curve's mean */
             float c2 = FLT_MAX;
+            cb = cv[(size_t)best * np + i];
             for (int l = 0; l < L; l++)
-                if (abs(l - best) > CONFIDENCE_AWAY_LABELS && c->cost[(size_t)l * np + i] < c2)
-                    c2 = c->cost[(size_t)l * np + i];
+                if (abs(l - best) > CONFIDENCE_AWAY_LABELS && cv[(size_t)l * np + i] < c2)
+                    c2 = cv[(size_t)l * np + i];
             float mean = sum / L;
             float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
             conf = conf * CONFIDENCE_GAIN;
@@ -940,6 +953,7 @@ typedef struct depth_work {
     float scale;        /* colour scale: 1 / mean channel sum of the reference */
     dview *views;       /* the other views */
     float *cost;        /* [label][pixel]; scratch for the stages after the minimum */
+    float *sel;         /* NULL, or the semi-global sum the labels are chosen on (same layout) */
     float *scratch;     /* per thread: the larger of the cost rows' and the guided filter's needs */
     size_t per_thread;
     float *guide;       /* 14 planes: guide (3), its means (3), inverse covariances (6), 2 temporaries */
@@ -952,7 +966,8 @@ typedef struct depth_work {
 
 static void depth_work_free(depth_work *w)
 {
-    free(w->views), free(w->cost), free(w->scratch), free(w->guide), free(w->disp), free(w->refs), free(w->rawd);
+    free(w->views), free(w->cost), free(w->sel), free(w->scratch), free(w->guide), free(w->disp), free(w->refs);
+    free(w->rawd);
 }
 
 static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lightfield_depth_opts *o, int nl,
@@ -1124,7 +1139,7 @@ static void winner_take_all(depth_work *w)
 {
     wta_ctx wc = {
         .w = w->ns, .h = w->nt, .nlabels = w->nlabels, .d0 = w->d0, .step = w->step,
-        .cost = w->cost, .disp = w->disp, .conf = w->conf,
+        .cost = w->cost, .sel = w->sel ? w->sel : w->cost, .disp = w->disp, .conf = w->conf,
     };
     lf_parallel_for(w->nt, w->threads, 8, wta_rows, &wc);
 }
@@ -1230,6 +1245,32 @@ static void refine_disparity(depth_work *w, float *map)
     }
 }
 
+/* Stage 3b: semi-global aggregation over the filtered volume, its
+ * penalties in units of the volume's mean cost contrast (mean over pixels
+ * of the curve's mean minus its minimum), so they follow the cost's scale. */
+static int semi_global(depth_work *w, lf_error *err)
+{
+    const lf_lightfield_depth_opts *o = w->o;
+    if (o->sgm < 0)
+        return LF_OK;
+    double contrast = 0;
+    for (size_t i = 0; i < w->np; i++) {
+        float mn = FLT_MAX, sum = 0;
+        for (int l = 0; l < w->nlabels; l++) {
+            float v = w->cost[(size_t)l * w->np + i];
+            sum += v, mn = v < mn ? v : mn;
+        }
+        contrast += sum / w->nlabels - mn;
+    }
+    contrast /= (double)w->np;
+    double p1 = o->sgm_p1 > 0 ? o->sgm_p1 : DEFAULT_SGM_P1, p2 = o->sgm_p2 > 0 ? o->sgm_p2 : DEFAULT_SGM_P2;
+    double edge = o->sgm_edge > 0 ? o->sgm_edge : DEFAULT_SGM_EDGE;
+    if (!(w->sel = malloc(sizeof(float) * w->np * (size_t)w->nlabels)))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for semi-global aggregation (%d labels)", w->nlabels);
+    return lf_depth_sgm(w->cost, w->sel, w->ns, w->nt, w->nlabels, w->refs, (float)(p1 * contrast),
+                        (float)(p2 * contrast), (float)edge, w->threads, err);
+}
+
 /* Labels from d0 to d1 at about step apart: at least 3 (the parabola needs
  * neighbours). */
 static int label_count(double d0, double d1, double step)
@@ -1257,13 +1298,14 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     if ((rc = build_cost_volume(&w, err)))
         goto done;
     aggregate_cost_volume(&w);
+    encode_reference(&w);
+    if ((rc = semi_global(&w, err)))
+        goto done;
     winner_take_all(&w);
     if (lf_image_alloc(disparity, w.ns, w.nt, 1, err)) {
         rc = err ? err->code : LF_ERR_NOMEM;
         goto done;
     }
-    if (o->median_radius != 0 || o->refine >= 0)
-        encode_reference(&w);
     if ((rc = weighted_median(&w, disparity->data, err)) || (rc = recover_thin_structures(&w, disparity->data, err))) {
         lf_image_free(disparity);
         goto done;
@@ -1378,9 +1420,11 @@ static int shrink_lightfield(const lf_lightfield *lf, int f, lf_lightfield *out,
 
 /* One coarse sweep over [s0, s1] (px/view at the small views' scale): the
  * 1st..99th percentile of the confident pixels' disparities into *lo, *hi
- * (same scale). */
-static int range_pass(const lf_lightfield *small, int threads, double s0, double s1, double step, double *lo, double *hi,
-                      lf_error *err)
+ * (same scale).  interior: pixels whose minimum is an end label are left
+ * out (the wide sweep: at the views' limit nothing confirms a minimum, and
+ * periodic texture has false minima everywhere, including there). */
+static int range_pass(const lf_lightfield *small, int threads, double s0, double s1, double step, int interior,
+                      double *lo, double *hi, lf_error *err)
 {
     lf_lightfield_depth_opts o = lf_lightfield_depth_defaults();
     o.threads = threads;
@@ -1402,7 +1446,8 @@ static int range_pass(const lf_lightfield *small, int threads, double s0, double
         n = 0;
         float thr = pass == 0 ? 0.3f : 0.f;
         for (size_t i = 0; i < np; i++)
-            if (conf.data[i] > thr || pass == 1)
+            if ((conf.data[i] > thr || pass == 1) &&
+                (!interior || (disp.data[i] > s0 + 0.5 * step && disp.data[i] < s1 - 0.5 * step)))
                 vals[n++] = disp.data[i];
     }
     qsort(vals, n, sizeof(float), cmpf);
@@ -1440,7 +1485,7 @@ int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, doubl
     if (info)
         memset(info, 0, sizeof *info);
     for (int round = 0;; round++) {
-        if ((rc = range_pass(&small, threads, a / f, b / f, step, &lo, &hi, err)))
+        if ((rc = range_pass(&small, threads, a / f, b / f, step, 0, &lo, &hi, err)))
             break;
         lo *= f, hi *= f;
         double pad = 0.05 * (hi - lo) + step * f;
@@ -1462,7 +1507,7 @@ int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, doubl
          * whether more than 1% of the confident pixels lie beyond */
         if (round == 0 && view_lim > lim0) {
             double ws = fmax(step, 2 * view_lim / f / first_labels), wlo, whi;
-            if ((rc = range_pass(&small, threads, -view_lim / f, view_lim / f, ws, &wlo, &whi, err)))
+            if ((rc = range_pass(&small, threads, -view_lim / f, view_lim / f, ws, 1, &wlo, &whi, err)))
                 break;
             wlo *= f, whi *= f;
             double wpad = 0.05 * (whi - wlo) + ws * f;

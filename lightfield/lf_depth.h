@@ -17,10 +17,12 @@
  *      the 8 half apertures (views on one side of a line through the
  *      reference, 45 degree steps) and the full aperture (Wang et al. 2015);
  *   2. edge-aware aggregation: every cost slice filtered by a guided filter
- *      guided by the reference view (He et al. 2010; Hosni et al. 2013);
- *   3. winner-take-all, sub-label refinement by a parabola through the
- *      cost minimum and its neighbours;
- *   4. confidence from the aggregated cost curve, and a confidence- and
+ *      guided by the reference view (He et al. 2010; Hosni et al. 2013),
+ *      then semi-global aggregation along 4 paths (Hirschmueller 2008),
+ *      its jump penalty lowered at colour edges;
+ *   3. winner-take-all on the semi-global sum, sub-label refinement by a
+ *      parabola through the filtered costs at the minimum and its neighbours;
+ *   4. confidence from the filtered cost curve, and a confidence- and
  *      colour-weighted median filter guided by the reference view;
  *   4b. thin structures the aggregation erased (a wire, a wedge's tip: a
  *      pixel or two wide) come back where the pixel's own cost curve is
@@ -52,6 +54,8 @@ typedef struct lf_lightfield_depth_opts {
     int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
+    int sgm;             /* semi-global aggregation after the guided filter: 0 default (on), < 0 off */
+    double sgm_p1, sgm_p2, sgm_edge; /* its penalties and edge scale; <= 0: defaults (docs/depth.md) */
     int threads;         /* <= 0: 2 */
     /* Called now and then from the calling thread with the work done of
      * `total` (done == total once, at the end); NULL: none.  The library

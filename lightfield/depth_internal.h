@@ -1,0 +1,18 @@
+/* depth_internal.h - stages of lf_lightfield_depth split out of depth.c
+ * (not public; docs/depth.md has the method). */
+#ifndef LF_LIGHTFIELD_DEPTH_INTERNAL_H
+#define LF_LIGHTFIELD_DEPTH_INTERNAL_H
+
+#include "base/lf_error.h"
+
+/* Semi-global aggregation (Hirschmueller 2008) of cost[label][pixel]
+ * (w x h pixels, nlabels slices) along 4 paths (left, right, up, down):
+ * sum (same layout) receives the sum of the 4 path costs.  p1: the
+ * penalty of a one-label step between neighbours; p2: of a larger jump,
+ * divided by (1 + dI / edge) where dI is the largest channel difference of
+ * the neighbours' colours in refs (RGB interleaved, w x h), so depth jumps
+ * where the colour does.  threads as lf_parallel_for. */
+int lf_depth_sgm(const float *cost, float *sum, int w, int h, int nlabels, const float *refs, float p1, float p2,
+                 float edge, int threads, lf_error *err);
+
+#endif

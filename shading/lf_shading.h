@@ -334,6 +334,11 @@ lf_vec3 lf_subsurface_albedo_from_reflectance(lf_vec3 r);
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */
 float lf_named_glass_eta(const char *name, float lambda_nm);
 
+/* `filename` resolved against the directory of the scene file that named it
+ * (pbrt-v4's ResolveFilename; absolute names unchanged), malloc'ed; NULL
+ * when out of memory.  For the texture and material files shading reads. */
+char *lf_shading_resolve_path(const char *scene_file, const char *filename);
+
 #ifdef __cplusplus
 }
 #endif

@@ -285,32 +285,13 @@ static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_ma
     return LF_OK;
 }
 
-/* Resolves `filename` against the directory of the scene file that wrote
- * it (pbrt-v4 ResolveFilename). */
-static char *resolve_path(const char *scene_file, const char *filename)
-{
-    size_t dl = 0;
-    if (filename[0] != '/' && scene_file) {
-        const char *slash = strrchr(scene_file, '/');
-        if (slash)
-            dl = (size_t)(slash - scene_file) + 1;
-    }
-    size_t fl = strlen(filename);
-    char *out = malloc(dl + fl + 1);
-    if (!out)
-        return NULL;
-    memcpy(out, scene_file ? scene_file : "", dl);
-    memcpy(out + dl, filename, fl + 1);
-    return out;
-}
-
 static int read_measured(lf_paramset *ps, lf_material *m, const lf_loc *loc, lf_error *err)
 {
     const char *fn = lf_params_string(ps, "filename", "");
     const lf_param *p = lf_params_peek(ps, "filename");
     if (!fn || !*fn)
         return lf_error_at(err, LF_ERR_PARAM, loc, "measured material: \"string filename\" is required");
-    char *path = resolve_path(p->loc.file, fn);
+    char *path = lf_shading_resolve_path(p->loc.file, fn);
     if (!path)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     lf_error lerr = {0};

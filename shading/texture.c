@@ -204,9 +204,7 @@ static int is_8bit_format(const char *path)
            !strcasecmp(e, "bmp") || !strcasecmp(e, "gif");
 }
 
-/* Resolves `filename` against the directory of the scene file that wrote
- * the directive (pbrt-v4 ResolveFilename). */
-static char *resolve_path(const char *scene_file, const char *filename)
+char *lf_shading_resolve_path(const char *scene_file, const char *filename)
 {
     size_t dl = 0;
     if (filename[0] != '/' && scene_file) {
@@ -250,7 +248,7 @@ static int read_imagemap(lf_texture_desc *td, lf_texture *t, lf_warnings *warnin
     t->scale = (float)lf_params_float(ps, "scale", 1.0);
     t->invert = lf_params_bool(ps, "invert", 0);
 
-    char *path = resolve_path(l->file, filename);
+    char *path = lf_shading_resolve_path(l->file, filename);
     if (!path)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     /* pbrt-v4's default encoding: sRGB for 8-bit files, linear otherwise;

@@ -2,6 +2,7 @@
  * grids, rotated, non-integer pitch) decode to the views encoded in them;
  * camera-array tiles; white-image devignetting; missing and non-finite
  * samples; layouts from attributes, flags, contradictions, missing fields. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -228,6 +229,14 @@ static void test_white_and_nonfinite(void)
     double zf = 1.0 / (1.0 / 0.050 - 1.0 / 0.052);
     CHECK(lf_lightfield_depth_to_disparity(&lf, zf, &d, &err) == 0);
     CHECK_MSG(d == 0, "disparity %g at the focused depth: exactly 0, not rounding", d); /* issue 33 */
+    {   /* the README's plenoptic demo at its 0.5 m focus printed "disparity 2.9976e-15": its
+         * terms carry ~15 ulps of metadata arithmetic; 40 ulps still snap to 0 */
+        double keep = lf.disp_at_inf;
+        lf.disp_at_inf *= 1 + 40 * DBL_EPSILON;
+        CHECK(lf_lightfield_depth_to_disparity(&lf, zf, &d, &err) == 0);
+        CHECK_MSG(d == 0, "disparity %g at the focused depth with 40 ulps of rounding in the terms", d);
+        lf.disp_at_inf = keep;
+    }
     CHECK(lf_lightfield_depth_to_disparity(&lf, zf * (1 + 1e-9), &d, &err) == 0);
     CHECK(d < 0 && d > -1e-6); /* a plane just beyond it is not snapped */
     CHECK(lf_lightfield_depth_to_disparity(&lf, zf / 2, &d, &err) == 0);

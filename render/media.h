@@ -59,4 +59,9 @@ int lf_medium_track(const lf_medium *m, lf_vec3 o, lf_vec3 d, float t_s, uint64_
 /* Ratio-tracking transmittance from o along unit d over tmax. */
 lf_vec3 lf_medium_tr(const lf_medium *m, lf_vec3 o, lf_vec3 d, float tmax, uint64_t seed);
 
+/* A Henyey-Greenstein direction around the travel direction d (pbrt-v4's
+ * SampleHenyeyGreenstein, render/volpath.c); the phase function is its own
+ * pdf, so a walk that samples it carries weight 1. */
+lf_vec3 lf_hg_direction(float g, lf_vec3 d, float u0, float u1);
+
 #endif

@@ -21,6 +21,7 @@
 #include <math.h>
 
 #include "render/integrator.h"
+#include "render/media.h"
 
 /* Walks longer than this are cut (a bias below 1e-6 for albedo <= 0.999). */
 #define WALK_MAX_STEPS 8192
@@ -29,26 +30,6 @@ static lf_vec3 transmittance(lf_vec3 sigma, float t)
 {
     return lf_v3(sigma.x > 0 ? expf(-sigma.x * t) : 1.f, sigma.y > 0 ? expf(-sigma.y * t) : 1.f,
                  sigma.z > 0 ? expf(-sigma.z * t) : 1.f);
-}
-
-/* Henyey-Greenstein sample around the travel direction d (pbrt-v4's
- * SampleHenyeyGreenstein); the phase function is its own pdf, so the
- * weight is 1. */
-static lf_vec3 hg_direction(float g, lf_vec3 d, float u0, float u1)
-{
-    float cos_t;
-    if (fabsf(g) < 1e-3f) {
-        cos_t = 1 - 2 * u0;
-    } else {
-        float q = (1 - g * g) / (1 - g + 2 * g * u0);
-        cos_t = (1 + g * g - q * q) / (2 * g);
-    }
-    cos_t = lf_clampf(cos_t, -1.f, 1.f);
-    float sin_t = sqrtf(fmaxf(0.f, 1 - cos_t * cos_t)), phi = 2 * (float)LF_PI * u1;
-    lf_vec3 t1, t2;
-    lf_basis(d, &t1, &t2);
-    return lf_normalize(
-        lf_add(lf_scale(d, cos_t), lf_add(lf_scale(t1, sin_t * cosf(phi)), lf_scale(t2, sin_t * sinf(phi)))));
 }
 
 int lf_subsurface_enters(const lf_material *mat, const lf_hit *h, lf_vec3 wo, lf_vec3 d, lf_subsurface *out)
@@ -97,7 +78,7 @@ int lf_subsurface_walk(const lf_scene *s, const lf_subsurface *m, float tau, lf_
             float u0, u1;
             lf_sample_2d(st, &u0, &u1);
             o = lf_madd(o, dir, t);
-            dir = hg_direction(m->g, dir, u0, u1);
+            dir = lf_hg_direction(m->g, dir, u0, u1); /* its own pdf: weight 1 */
             /* roulette on the throughput: absorbed walkers end unbiasedly */
             float q = lf_maxc(ps->beta);
             if (q < 1.f && step > 4) {

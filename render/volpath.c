@@ -40,9 +40,7 @@ static float hg_phase(float g, lf_vec3 wo, lf_vec3 wi)
     return (1 - g * g) / (4 * (float)LF_PI * denom * sqrtf(fmaxf(denom, 1e-12f)));
 }
 
-/* Samples wi around the forward direction d = -wo by the HG lobe; the
- * weight is 1 and the pdf the phase value. */
-static lf_vec3 hg_sample(float g, lf_vec3 wo, float u0, float u1, float *pdf)
+lf_vec3 lf_hg_direction(float g, lf_vec3 d, float u0, float u1)
 {
     float cos_t;
     if (fabsf(g) < 1e-3f) {
@@ -54,10 +52,17 @@ static lf_vec3 hg_sample(float g, lf_vec3 wo, float u0, float u1, float *pdf)
     cos_t = fminf(1.f, fmaxf(-1.f, cos_t));
     float sin_t = sqrtf(fmaxf(0.f, 1 - cos_t * cos_t));
     float phi = 2 * (float)LF_PI * u1;
-    lf_vec3 d = lf_neg(wo), t1, t2;
+    lf_vec3 t1, t2;
     lf_basis(d, &t1, &t2);
     lf_vec3 wi = lf_add(lf_scale(d, cos_t), lf_add(lf_scale(t1, sin_t * cosf(phi)), lf_scale(t2, sin_t * sinf(phi))));
-    wi = lf_normalize(wi);
+    return lf_normalize(wi);
+}
+
+/* Samples wi around the forward direction d = -wo by the HG lobe; the
+ * weight is 1 and the pdf the phase value. */
+static lf_vec3 hg_sample(float g, lf_vec3 wo, float u0, float u1, float *pdf)
+{
+    lf_vec3 wi = lf_hg_direction(g, lf_neg(wo), u0, u1);
     *pdf = hg_phase(g, wo, wi);
     return wi;
 }

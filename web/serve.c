@@ -34,6 +34,7 @@ typedef struct conn {
     size_t got;      /* request bytes read */
     size_t len, off; /* bytes in out[], bytes of them sent */
     int64_t accepted_ms, progress_ms;
+    uint64_t order; /* accept order: times tie within one poll round */
     char req[REQ_MAX];
     char out[CHUNK];
 } conn;
@@ -43,7 +44,8 @@ struct lf_web_server {
     int port;
     char root[PATH_MAX];
     conn *conns[LF_WEB_MAX_CONNECTIONS];
-    long answered; /* requests answered so far */
+    long answered;     /* requests answered so far */
+    uint64_t accepted; /* connections accepted so far */
 };
 
 int lf_web_server_open(const char *root, int port, lf_web_server **server, lf_error *err)
@@ -292,7 +294,7 @@ static int free_slot(lf_web_server *s)
     for (int i = 0; i < LF_WEB_MAX_CONNECTIONS; i++) {
         if (!s->conns[i])
             return i;
-        if (!s->conns[i]->writing && (oldest < 0 || s->conns[i]->accepted_ms < s->conns[oldest]->accepted_ms))
+        if (!s->conns[i]->writing && (oldest < 0 || s->conns[i]->order < s->conns[oldest]->order))
             oldest = i;
     }
     if (oldest >= 0)
@@ -320,7 +322,7 @@ static int accept_all(lf_web_server *s, int64_t t, lf_error *err)
             close(fd);
             continue;
         }
-        *c = (conn){.fd = fd, .file = -1, .accepted_ms = t, .progress_ms = t};
+        *c = (conn){.fd = fd, .file = -1, .accepted_ms = t, .progress_ms = t, .order = s->accepted++};
         c->req[0] = '\0';
         s->conns[i] = c;
     }

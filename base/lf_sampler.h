@@ -136,6 +136,17 @@ static inline uint32_t lf_hash_u32(uint32_t x)
     x ^= x >> 16;
     return x;
 }
+/* 64-bit integer hash (MurmurHash3's fmix64 finaliser): every input bit
+ * reaches every output bit. */
+static inline uint64_t lf_hash_u64(uint64_t h)
+{
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdULL;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ULL;
+    h ^= h >> 33;
+    return h;
+}
 static inline uint32_t lf_hash_combine(uint32_t a, uint32_t b)
 {
     return lf_hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2)));

@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "base/lf_sampler.h"
 #include "render/scene_build.h"
 
 int lf_read_shape_alpha(lf_scene_builder *b, lf_shape_desc *sh)
@@ -37,17 +38,6 @@ int lf_read_shape_alpha(lf_scene_builder *b, lf_shape_desc *sh)
     return 0;
 }
 
-static uint64_t mix64(uint64_t h)
-{
-    /* MurmurHash3's 64-bit finaliser: every input bit reaches every output bit. */
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdULL;
-    h ^= h >> 33;
-    h *= 0xc4ceb9fe1a85ec53ULL;
-    h ^= h >> 33;
-    return h;
-}
-
 /* A uniform number in [0,1) from a point and a direction (pbrt-v4's
  * HashFloat(o, d) in spirit: a pure function, so renders are repeatable). */
 static float hash_float(const float p[3], const float d[3])
@@ -57,7 +47,7 @@ static float hash_float(const float p[3], const float d[3])
         uint32_t a, c;
         memcpy(&a, &p[i], 4);
         memcpy(&c, &d[i], 4);
-        h = mix64(h ^ (((uint64_t)a << 32) | c));
+        h = lf_hash_u64(h ^ (((uint64_t)a << 32) | c));
     }
     return (float)(h >> 40) * 0x1p-24f;
 }

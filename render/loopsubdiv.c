@@ -5,6 +5,7 @@
  * of its edges.  Child triangles and new vertices are numbered as pbrt-v4
  * numbers them (four children per parent in order, then the old vertices,
  * then one new vertex per edge in order of first use). */
+#include "base/lf_sampler.h"
 #include "lf_subdiv.h"
 
 #include <limits.h>
@@ -45,15 +46,6 @@ static int prev_face(const topo *t, int f, int v) { return t->fn[3 * (size_t)f +
 static int next_vert(const topo *t, int f, int v) { return t->fv[3 * (size_t)f + NEXT(vnum(t, f, v))]; }
 static int prev_vert(const topo *t, int f, int v) { return t->fv[3 * (size_t)f + PREV(vnum(t, f, v))]; }
 
-static uint64_t mix64(uint64_t x)
-{
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    x *= 0xc4ceb9fe1a85ec53ull;
-    return x ^ (x >> 33);
-}
-
 /* Face adjacency, edge numbering and boundary flags. */
 static int topo_build(topo *t, size_t nv, size_t nf, const int *fv, lf_error *err)
 {
@@ -85,7 +77,7 @@ static int topo_build(topo *t, size_t nv, size_t nf, const int *fv, lf_error *er
             t->vstart[a] = (int)f;
             uint64_t lo = (uint64_t)(a < b ? a : b), hi = (uint64_t)(a < b ? b : a);
             uint64_t key = lo << 32 | hi;
-            size_t i = mix64(key) & (cap - 1);
+            size_t i = lf_hash_u64(key) & (cap - 1);
             while (keys[i] != UINT64_MAX && keys[i] != key)
                 i = (i + 1) & (cap - 1);
             if (keys[i] == UINT64_MAX) {

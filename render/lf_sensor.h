@@ -42,7 +42,7 @@ extern "C" {
 
 typedef struct lf_sensor {
     /* Film "raw" parameters (docs/scene-format.md) */
-    char curves[32];      /* "sensor": cie1931 or ideal */
+    char curves[32];      /* "sensor": cie1931, ideal or a camera of render/sensor_curves.h */
     lf_cfa cfa;
     double qe;            /* peak quantum efficiency */
     double fullwell;      /* electrons */
@@ -84,6 +84,12 @@ double lf_sensor_white_level(const lf_sensor *s);
  * when a has no sensor (Film "rgb"), 0 when read, or an LF_ERR_* status. */
 int lf_sensor_to_attrs(const lf_sensor *s, lf_attrs *a, lf_error *err);
 int lf_sensor_from_attrs(const lf_attrs *a, lf_sensor *s, lf_error *err);
+/* Film "rgb" with a named camera's curves (pbrt-v4's PixelSensor): the
+ * matrix taking the film's linear sRGB (as a spectrum in the fixed basis)
+ * through the camera's curves and the least-squares XYZ-from-camera fit for
+ * the white illuminant at white_k (lf_camera_xyz_fit) back to linear sRGB.
+ * LF_ERR_PARAM for a name that is not a camera of the table. */
+int lf_sensor_film_matrix(const char *curves, double white_k, float out[3][3], lf_error *err);
 /* The stages the scene asked for, one line each (lfrender --explain). */
 void lf_sensor_explain(const lf_sensor *s, lf_strbuf *b);
 

@@ -25,6 +25,7 @@
 #include "render/film.h"
 #include "render/integrator_params.h"
 #include "render/lf_sensor.h"
+#include "render/sensor_curves.h"
 #include "render/render_internal.h"
 
 #define LF_VERSION_STRING "lensfield " LF_VERSION /* LF_VERSION: CMake's project version (lf_base) */
@@ -208,15 +209,6 @@ static int pixel_index(double v)
     return v < 1073741824.0 ? (int)v : 1073741824;
 }
 
-/* pbrt-v4's camera curves (measured data of Jiang et al., "What is the space
- * of spectral sensitivity functions for digital color cameras?", WACV 2013,
- * and others), named by the Film's "sensor"; lensfield does not ship them. */
-static const char *const pbrt_sensor_curves[] = {
-    "canon_eos_100d",  "canon_eos_1dx_mkii", "canon_eos_200d", "canon_eos_200d_mkii", "canon_eos_5d",
-    "canon_eos_5d_mkii", "canon_eos_5d_mkiii", "canon_eos_5d_mkiv", "canon_eos_5ds", "canon_eos_m",
-    "hasselblad_l1d_20c", "nikon_d810", "nikon_d850", "sony_ilce_6400", "sony_ilce_7m3", "sony_ilce_7rm3",
-    "sony_ilce_9"};
-
 /* The chromaticity of pbrt-v4's white-balance illuminant at T kelvin: CIE
  * daylight (CIE 15:2004 eq. 3.3-3.4) from 4000 K, a black body below. */
 static void illuminant_xy(double t, double *x, double *y)
@@ -283,37 +275,43 @@ static void white_balance_matrix(double t, float out[3][3])
         }
 }
 
-/* Film "sensor" and "whitebalance" (pbrt-v4 meanings). */
+/* Film "sensor" and "whitebalance" (pbrt-v4 meanings): cie1931 is white
+ * balanced by von Kries scaling when asked; a named camera's curves go
+ * through its XYZ fit for the white illuminant (6500 K unless told), which
+ * is pbrt-v4's white balance for such a sensor. */
 static int read_film_sensor(lf_renderer *r, option_entity *oe, lf_error *err)
 {
     lf_paramset *ps = oe->ps;
     const char *sensor = lf_params_string(ps, "sensor", "cie1931");
     double wb = lf_params_float(ps, "whitebalance", 0.0);
-    int known = !strcmp(sensor, "cie1931") || !strcmp(sensor, "ideal"), pbrt_named = 0;
-    for (size_t i = 0; i < sizeof pbrt_sensor_curves / sizeof *pbrt_sensor_curves; i++)
-        pbrt_named |= !strcmp(sensor, pbrt_sensor_curves[i]);
-    if (!known && !pbrt_named)
-        return lf_error_set(err, LF_ERR_PARAM,
-                            "%s: unknown Film \"sensor\" \"%s\" (lensfield models \"cie1931\" and \"ideal\"; "
-                            "pbrt-v4's camera curves such as \"canon_eos_5d\" are not shipped)",
-                            oe->where, sensor);
-    if (pbrt_named)
-        lf_warn_at(&r->warnings, oe->loc,
-                   "Film \"sensor\" \"%s\": pbrt-v4's measured camera curves are not shipped with lensfield; "
-                   "using \"cie1931\"",
-                   sensor);
+    int named = lf_camera_curves_find(sensor) != NULL;
+    if (strcmp(sensor, "cie1931") && strcmp(sensor, "ideal") && !named) {
+        lf_strbuf names = {0};
+        for (int i = 0; i < LF_CAMERA_CURVE_COUNT; i++)
+            lf_strbuf_printf(&names, "%s\"%s\"", i ? ", " : "", lf_camera_curve_table[i].name);
+        lf_error_set(err, LF_ERR_PARAM,
+                     "%s: unknown Film \"sensor\" \"%s\" (\"cie1931\", \"ideal\" or one of pbrt-v4's cameras: %s)",
+                     oe->where, sensor, names.s ? names.s : "");
+        lf_strbuf_free(&names);
+        return err->code;
+    }
     if (!(wb >= 0) || wb > 1e6)
         return lf_error_set(err, LF_ERR_PARAM, "%s: Film \"whitebalance\" must be 0 (none) or a temperature in K",
                             oe->where);
-    if (pbrt_named && wb == 0)
+    if (named && wb == 0)
         wb = 6500; /* pbrt-v4: a camera's curves are white balanced for 6500 K unless told */
     if (r->raw) {
-        snprintf(r->sensor.curves, sizeof r->sensor.curves, "%s", known ? sensor : "cie1931");
-        if (wb != 0)
+        snprintf(r->sensor.curves, sizeof r->sensor.curves, "%s", sensor);
+        if (lf_params_peek(ps, "whitebalance") && wb != 0)
             lf_warn_at(&r->warnings, oe->loc,
                        "Film \"raw\": \"whitebalance\" %g is not applied to raw data (a developer white balances "
                        "it with AsShotNeutral)",
                        wb);
+    } else if (named) {
+        snprintf(r->sensor.curves, sizeof r->sensor.curves, "%s", sensor); /* for --explain */
+        r->has_wb = 1;
+        if (lf_sensor_film_matrix(sensor, wb, r->wb, err))
+            return err->code;
     } else if (wb != 0) {
         r->has_wb = 1;
         white_balance_matrix(wb, r->wb);
@@ -1085,6 +1083,11 @@ char *lf_renderer_explain(const lf_renderer *r)
                                        : "one light per vertex, chosen by power");
     if (r->raw)
         lf_sensor_explain(&r->sensor, &b);
+    else if (lf_camera_curves_find(r->sensor.curves))
+        lf_strbuf_printf(&b,
+                         "sensor: none (Film \"rgb\": noiseless linear exposure through the %s curves and their XYZ "
+                         "fit)\n",
+                         r->sensor.curves);
     else
         lf_strbuf_printf(&b, "sensor: none (Film \"rgb\": noiseless linear exposure%s)\n",
                          r->has_wb ? ", white balanced" : "");

@@ -9,6 +9,7 @@
 #include "base/lf_color.h"
 #include "base/lf_parallel.h"
 #include "render/lf_sensor.h"
+#include "render/sensor_curves.h"
 
 /* ---- radiometry ---- */
 
@@ -49,21 +50,39 @@ static int invert3(const double a[3][3], double o[3][3])
 }
 
 /* The filter curve of colour c (0 R, 1 G, 2 B; 3 the monochrome sensor),
- * peak 1: "cie1931" uses the CIE 1931 matching functions xbar, ybar, zbar
- * (each divided by its peak; ybar for monochrome); "ideal" is handled by
- * the caller (its channels are the film's own). */
-static double curve(int c, double l)
+ * a quantum-efficiency shape: "cie1931" uses the CIE 1931 matching
+ * functions xbar, ybar, zbar (each divided by its peak; ybar for
+ * monochrome); a named camera's curves (render/sensor_curves.h) are
+ * responses per unit energy, as pbrt-v4 uses them, so the QE shape is
+ * rbar(lambda) / lambda over the largest such value of the three (the
+ * channels keep the camera's balance; monochrome: green).  With it,
+ * electrons are proportional to pbrt-v4's sensor RGB, int L rbar.
+ * "ideal" is handled by the caller (its channels are the film's own). */
+static double curve(const lf_camera_curves *cc, double peak, int c, double l)
 {
+    if (cc)
+        return lf_camera_curve(cc, c == 3 ? 1 : c, l) / l / peak;
     double xyz[3];
     lf_cie_xyz_bar(l, xyz);
-    static const double peak[3] = {1.0622, 1.0, 1.7826}; /* the fit's maxima near 599, 556 and 446 nm */
-    return c == 3 ? xyz[1] : xyz[c] / peak[c];
+    static const double peak_cie[3] = {1.0622, 1.0, 1.7826}; /* the fit's maxima near 599, 556 and 446 nm */
+    return c == 3 ? xyz[1] : xyz[c] / peak_cie[c];
+}
+
+/* The largest rbar / lambda of a camera's three curves, at 1 nm. */
+static double curve_peak(const lf_camera_curves *cc)
+{
+    double m = 0;
+    for (double l = LF_CIE_LAMBDA_MIN; cc && l <= LF_CIE_LAMBDA_MAX; l += 1.0)
+        for (int c = 0; c < 3; c++)
+            m = fmax(m, lf_camera_curve(cc, c, l) / l);
+    return m;
 }
 
 /* Band weights per film RGB (T), photons of each band and the filters'
  * responses to each band, integrated at 1 nm. */
-static int spectral_tables(double T[3][3], double band_photons[3], double resp[4][3])
+static int spectral_tables(const lf_camera_curves *cc, double T[3][3], double band_photons[3], double resp[4][3])
 {
+    double pk = curve_peak(cc);
     double norm = 0, P[3][3] = {{0}};
     for (double l = LF_CIE_LAMBDA_MIN; l <= LF_CIE_LAMBDA_MAX; l += 1.0) {
         double xyz[3];
@@ -82,7 +101,7 @@ static int spectral_tables(double T[3][3], double band_photons[3], double resp[4
         double photons = s * (l * 1e-9) / (LF_PLANCK_H * LF_LIGHT_C); /* per nm step */
         band_photons[k] += photons;
         for (int c = 0; c < 4; c++)
-            resp[c][k] += photons * curve(c, l);
+            resp[c][k] += photons * curve(cc, pk, c, l);
     }
     double Pi[3][3];
     if (invert3(P, Pi))
@@ -119,7 +138,8 @@ void lf_sensor_defaults(lf_sensor *s)
 
 int lf_sensor_prepare(lf_sensor *s, lf_error *err)
 {
-    if (strcmp(s->curves, "cie1931") && strcmp(s->curves, "ideal"))
+    const lf_camera_curves *cc = lf_camera_curves_find(s->curves);
+    if (strcmp(s->curves, "cie1931") && strcmp(s->curves, "ideal") && !cc)
         return lf_error_set(err, LF_ERR_PARAM, "Film \"raw\": unknown \"sensor\" \"%s\"", s->curves);
     if (!(s->qe > 0 && s->qe <= 1) || !(s->fullwell > 0) || !(s->gain > 0) || !(s->readnoise >= 0) ||
         !(s->darkcurrent >= 0) || !(s->dsnu >= 0) || !(s->prnu >= 0 && s->prnu < 1) || !(s->blacklevel >= 0) ||
@@ -135,7 +155,7 @@ int lf_sensor_prepare(lf_sensor *s, lf_error *err)
         return lf_error_set(err, LF_ERR_PARAM, "Film \"raw\": \"blacklevel\" %g leaves no room in %d bits",
                             s->blacklevel, s->bits);
     double T[3][3], bp[3], resp[4][3];
-    if (spectral_tables(T, bp, resp))
+    if (spectral_tables(cc, T, bp, resp))
         return lf_error_set(err, LF_ERR_INTERNAL, "sensor: singular spectral basis");
     /* electrons per film unit: pixel area x qe x photons / (ISO/100), the
      * film holding exposure x ISO/100 */
@@ -155,6 +175,40 @@ int lf_sensor_prepare(lf_sensor *s, lf_error *err)
             if (ideal) /* the film's own channel, or all of them for a monochrome sensor */
                 r = (s->cfa == LF_CFA_NONE || c == k) ? s->photons_per_unit[k] : 0.0;
             s->e_per_unit[c][k] = f * r;
+        }
+    return 0;
+}
+
+int lf_sensor_film_matrix(const char *curves, double white_k, float out[3][3], lf_error *err)
+{
+    const lf_camera_curves *cc = lf_camera_curves_find(curves);
+    double T[3][3], bp[3], resp[4][3], F[3][3], Mi[3][3];
+    if (!cc)
+        return lf_error_set(err, LF_ERR_PARAM, "unknown camera curves \"%s\"", curves ? curves : "");
+    if (spectral_tables(cc, T, bp, resp) || lf_camera_xyz_fit(cc, white_k, F) || invert3(srgb_to_xyz, Mi))
+        return lf_error_set(err, LF_ERR_INTERNAL, "sensor \"%s\": singular colour fit", curves);
+    /* the photon-weighted responses back to energy: pbrt-v4's sensor RGB,
+     * int L rbar dlambda / CIE_Y_integral, per unit band weight */
+    double to_energy = LF_PLANCK_H * LF_LIGHT_C * curve_peak(cc) / 1e-9 / LF_CIE_Y_INTEGRAL;
+    double cam[3][3], xyz[3][3];
+    for (int c = 0; c < 3; c++) /* sensor RGB per film RGB */
+        for (int k = 0; k < 3; k++) {
+            cam[c][k] = 0;
+            for (int j = 0; j < 3; j++)
+                cam[c][k] += resp[c][j] * to_energy * T[j][k];
+        }
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            xyz[i][k] = 0;
+            for (int c = 0; c < 3; c++)
+                xyz[i][k] += F[i][c] * cam[c][k];
+        }
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double v = 0;
+            for (int j = 0; j < 3; j++)
+                v += Mi[i][j] * xyz[j][k];
+            out[i][k] = (float)v;
         }
     return 0;
 }
@@ -308,6 +362,29 @@ int lf_sensor_expose(const lf_sensor *s, const lf_image *film, int x0, int y0, l
     return 0;
 }
 
+/* A named camera's ColorMatrix1 (XYZ -> camera, CalibrationIlluminant1
+ * D65): the inverse of the least-squares fit under D65
+ * (lf_camera_xyz_fit), scaled so that D65 white (Y = 1) gives a camera
+ * neutral whose largest component is 1.  Electrons are proportional to the
+ * fit's camera RGB (curve() above), so the scale is the only freedom. */
+static void named_color_matrix(const lf_sensor *s, lf_raw_info *ri)
+{
+    const lf_camera_curves *cc = lf_camera_curves_find(s->curves);
+    double F[3][3], Fi[3][3], w[3] = {0}, wmax = 0;
+    if (!cc || lf_camera_xyz_fit(cc, 6500.0, F) || invert3(F, Fi))
+        return;
+    for (int c = 0; c < 3; c++) {
+        for (int k = 0; k < 3; k++)
+            w[c] += Fi[c][k] * (srgb_to_xyz[k][0] + srgb_to_xyz[k][1] + srgb_to_xyz[k][2]);
+        wmax = fmax(wmax, w[c]);
+    }
+    if (!(wmax > 0))
+        return;
+    for (int c = 0; c < 3; c++)
+        for (int j = 0; j < 3; j++)
+            ri->color_matrix[3 * c + j] = Fi[c][j] / wmax;
+}
+
 void lf_sensor_raw_info(const lf_sensor *s, lf_raw_info *ri)
 {
     memset(ri, 0, sizeof *ri);
@@ -335,6 +412,7 @@ void lf_sensor_raw_info(const lf_sensor *s, lf_raw_info *ri)
             ri->color_matrix[3 * c + j] = v / nmax;
         }
     }
+    named_color_matrix(s, ri);
     ri->dn_per_unit = nmax * s->gain * s->iso / 100.0;
     ri->iso = s->iso, ri->exposure_s = s->exposure_s;
 }

@@ -371,7 +371,7 @@ static void named_color_matrix(const lf_sensor *s, lf_raw_info *ri)
 {
     const lf_camera_curves *cc = lf_camera_curves_find(s->curves);
     double F[3][3], Fi[3][3], w[3] = {0}, wmax = 0;
-    if (!cc || lf_camera_xyz_fit(cc, 6500.0, F) || invert3(F, Fi))
+    if (!cc || s->cfa == LF_CFA_NONE || lf_camera_xyz_fit(cc, 6500.0, F) || invert3(F, Fi))
         return;
     for (int c = 0; c < 3; c++) {
         for (int k = 0; k < 3; k++)

@@ -278,6 +278,30 @@ static void test_refused(void)
         }
     }
 
+    /* parameters pbrt-v4 dropped (zero-day's Film "scale", transparent-
+     * machines' "rrthreshold", explosion's "LeScale", renamed "Lescale"):
+     * refused as pbrt-v4 refuses them, even with --allow-unsupported, with
+     * what to do instead */
+    const char *dropped[] = {
+        "Film \"rgb\" \"float scale\" 3\nWorldBegin\n",
+        "Integrator \"volpath\" \"float rrthreshold\" 0\nWorldBegin\n",
+        "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float LeScale\" 2\n",
+    };
+    const char *said[] = {
+        "dropped.pbrt:1:12: unused parameter \"float scale\" in Film \"rgb\" (early pbrt-v4's film scale factor; "
+        "pbrt-v4 no longer reads it",
+        "dropped.pbrt:1:22: unused parameter \"float rrthreshold\" in Integrator \"volpath\" (pbrt-v3's and early "
+        "pbrt-v4's",
+        "dropped.pbrt:2:49: unused parameter \"float LeScale\" in MakeNamedMedium \"m\" (did you mean \"float "
+        "Lescale\"?)",
+    };
+    for (size_t i = 0; i < sizeof dropped / sizeof dropped[0]; i++) {
+        write_file("dropped.pbrt", dropped[i]);
+        int rc = run("%s dropped.pbrt -o dropped.exr --quiet --allow-unsupported", LF_LFRENDER);
+        CHECK_MSG(rc == 1 && strstr(out_text, said[i]), "%s: exit %d: %s", dropped[i], rc, out_text);
+        CHECK(!exists("dropped.exr"));
+    }
+
     /* three problems, three messages, one run */
     char text[2048];
     snprintf(text, sizeof text,

@@ -409,6 +409,27 @@ int lf_params_rgb(lf_paramset *ps, const char *name, lf_spectrum_kind kind, lf_v
 
 const lf_error *lf_params_error(const lf_paramset *ps) { return &ps->error; }
 
+/* Parameters that pbrt-v4 once read and has since dropped: today's pbrt-v4
+ * refuses them as unused too (ParameterDictionary::ReportUnused), and some
+ * of pbrt-v4-scenes' files still carry them; the message says so. */
+static const char *dropped_note(const char *context, const char *name)
+{
+    static const struct {
+        const char *context, *name, *note;
+    } dropped[] = {
+        {"Film", "scale",
+         "early pbrt-v4's film scale factor; pbrt-v4 no longer reads it and refuses it as well: delete it, or "
+         "use \"float iso\""},
+        {"Integrator", "rrthreshold",
+         "pbrt-v3's and early pbrt-v4's Russian-roulette threshold; pbrt-v4 no longer reads it and refuses it as "
+         "well: delete it"},
+    };
+    for (size_t i = 0; context && i < sizeof dropped / sizeof dropped[0]; i++)
+        if (!strncmp(context, dropped[i].context, strlen(dropped[i].context)) && !strcmp(name, dropped[i].name))
+            return dropped[i].note;
+    return NULL;
+}
+
 int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err)
 {
     const lf_error *parked = lf_params_error(ps);
@@ -423,6 +444,10 @@ int lf_params_finish(const lf_paramset *ps, const char *context, lf_error *err)
             lf_suggest_consider(&s, ps->absent + k + 1);
         const char *best = lf_suggest_best(&s);
         int type = best && best[-1] ? best[-1] - 1 : (int)p->type; /* the type byte before the name; 0: as written */
+        const char *note = best ? NULL : dropped_note(context, p->name);
+        if (note)
+            return lf_error_at(err, LF_ERR_PARAM, &p->loc, "unused parameter \"%s %s\" in %s (%s)",
+                               lf_param_type_name(p->type), p->name, context, note);
         return lf_error_at(err, LF_ERR_PARAM, &p->loc, "unused parameter \"%s %s\" in %s%s%s%s%s%s",
                            lf_param_type_name(p->type), p->name, context ? context : "directive",
                            best ? " (did you mean \"" : "", best ? lf_param_type_name((lf_param_type)type) : "",

@@ -10,15 +10,20 @@
 # links under a temporary folder, where the files a scene names and the
 # copy lacks (meshes, textures, spectra, volumes: the repository keeps the
 # big ones in Git LFS) are stubbed: a one-triangle PLY, a 2x2 image, a flat
-# spectrum, an empty Include or .nvdb (a scene with a nanovdb medium then
-# fails with "has no grid": its volume is data).  So a row judges the scene's text, not its
-# data.  RENDER=1 also renders a 32x32 crop at 1 spp to check the build
+# spectrum, lensfield's own measured BSDF (scenes/pbrt-v4/rough-gold.bsdf)
+# for a .bsdf, the lens of that name from scenes/lenses (else dgauss.50mm)
+# for a .dat lens file, a 2x2x2 "density" grid of 0.5 for a .nvdb (written
+# by bin/pbrt_v4_stub_nvdb next to LFRENDER; without it an empty file, on
+# which a nanovdb medium fails with "has no grid"), an empty Include (a
+# scene whose parameters continue after an emptied Include fails to
+# parse).  So a row judges the scene's text, not its data.  RENDER=1 also renders a 32x32 crop at 1 spp to check the build
 # through to pixels.  Example:
 #   bench/pbrt_v4_scenes.sh ~/pbrt-v4-scenes build/bin/lfrender > rows.md
 set -u
 src=${1:?usage: pbrt_v4_scenes.sh DIR [LFRENDER]}
 lfrender=${2:-$(dirname "$0")/../build/bin/lfrender}
 src=$(cd "$src" && pwd)
+repo=$(cd "$(dirname "$0")/.." && pwd)
 lfrender=$(cd "$(dirname "$lfrender")" && pwd)/$(basename "$lfrender")
 work=$(mktemp -d "${TMPDIR:-/tmp}/pbrt_v4_scenes.XXXXXX")
 [ "${KEEP:-0}" = 1 ] || trap 'rm -rf "$work"' EXIT
@@ -33,6 +38,8 @@ printf 'Film "rgb" "integer xresolution" 2 "integer yresolution" 2\nWorldBegin\n
 for ext in exr png pfm; do
     "$lfrender" "$work/stub/img.pbrt" -o "$work/stub/stub.$ext" --quiet >/dev/null 2>&1
 done
+nvdb_stub=/dev/null
+if "$(dirname "$lfrender")/pbrt_v4_stub_nvdb" "$work/stub/stub.nvdb" 2>/dev/null; then nvdb_stub=$work/stub/stub.nvdb; fi
 python3 - "$work/stub/stub.tga" <<'PY' 2>/dev/null
 import sys
 hdr = bytes([0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 0, 24, 0])
@@ -48,14 +55,17 @@ stub_for() { # path -> the stub to link there, or nothing
     *.png | *.jpg | *.jpeg) echo "$work/stub/stub.png" ;;
     *.pfm) echo "$work/stub/stub.pfm" ;;
     *.tga) echo "$work/stub/stub.tga" ;;
-    *.pbrt | *.pbrt.gz | *.nvdb | *.bsdf) echo /dev/null ;;
+    *.bsdf) echo "$repo/scenes/pbrt-v4/rough-gold.bsdf" ;;
+    *.dat) if [ -f "$repo/scenes/lenses/$(basename "$1")" ]; then echo "$repo/scenes/lenses/$(basename "$1")"; else echo "$repo/scenes/lenses/dgauss.50mm.dat"; fi ;;
+    *.nvdb) echo "$nvdb_stub" ;;
+    *.pbrt | *.pbrt.gz) echo /dev/null ;;
     esac
 }
 
 # every file name the scene folders mention, stubbed where missing (names
 # are looked up next to the top-level scene, as pbrt-v4 resolves them)
 cd "$work/tree" || exit 1
-grep -RhoE '"(string filename|string mapname|spectrum [A-Za-z_]+)"[[:space:]]*\[?[[:space:]]*"[^"]+"|^[[:space:]]*(Include|Import)[[:space:]]+"[^"]+"' \
+grep -RhoE '"(string filename|string mapname|string lensfile|spectrum [A-Za-z_]+)"[[:space:]]*\[?[[:space:]]*"[^"]+"|^[[:space:]]*(Include|Import)[[:space:]]+"[^"]+"' \
     --include='*.pbrt' . 2>/dev/null | sed -E 's/.*"([^"]+)"$/\1/' | sort -u >"$work/names"
 for d in */; do
     while read -r name; do

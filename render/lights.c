@@ -454,9 +454,10 @@ static double envmap_upper_illuminance(const lf_envmap *env)
 }
 
 /* An infinite light: uniform radiance "L", or an environment map
- * "filename" (relative to the scene file that names it). */
-static int read_infinite_light(lf_scene *s, lf_light_desc *ld, const lf_transform *xf, double scale, const char *where,
-                               lf_light *l, lf_error *err)
+ * "filename" (relative to the scene file that names it, else to the
+ * top-level scene's directory, as pbrt-v4 resolves it). */
+static int read_infinite_light(lf_scene *s, lf_light_desc *ld, const char *scene_dir, const lf_transform *xf,
+                               double scale, const char *where, lf_light *l, lf_error *err)
 {
     lf_paramset *ps = &ld->e.params;
     const char *fn = lf_params_string(ps, "filename", NULL);
@@ -470,18 +471,18 @@ static int read_infinite_light(lf_scene *s, lf_light_desc *ld, const lf_transfor
         return lf_error_set(err, LF_ERR_PARAM, "%s: infinite light: give either \"L\" or \"filename\", not both",
                             where);
     if (fn) {
-        char path[4096];
-        const char *file = ld->e.loc.file;
-        const char *slash = file ? strrchr(file, '/') : NULL;
-        if (fn[0] == '/' || !slash)
-            snprintf(path, sizeof path, "%s", fn);
-        else
-            snprintf(path, sizeof path, "%.*s/%s", (int)(slash - file), file, fn);
-        l->env = calloc(1, sizeof *l->env);
-        if (!l->env)
+        char *path = lf_shading_resolve_path(ld->e.loc.file, scene_dir, fn);
+        if (!path)
             return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        l->env = calloc(1, sizeof *l->env);
+        if (!l->env) {
+            free(path);
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+        }
         lf_error lerr = {0};
-        if (lf_envmap_load(path, l->env, &lerr)) {
+        int lrc = lf_envmap_load(path, l->env, &lerr);
+        free(path);
+        if (lrc) {
             free(l->env);
             l->env = NULL;
             return lf_error_set(err, lerr.code, "%s: infinite light: %s", where, lerr.msg);
@@ -503,7 +504,7 @@ static int read_infinite_light(lf_scene *s, lf_light_desc *ld, const lf_transfor
     return 0;
 }
 
-static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *skip, int allow_unsupported,
+static int light_from_desc(lf_scene *s, const lf_scene_desc *d, lf_light_desc *ld, lf_light *l, int *skip,
                            lf_error *err)
 {
     lf_paramset *ps = &ld->e.params;
@@ -520,11 +521,11 @@ static int light_from_desc(lf_scene *s, lf_light_desc *ld, lf_light *l, int *ski
     } else if (!strcmp(type, "distant")) {
         read_distant_light(ps, xf, scale, l);
     } else if (!strcmp(type, "infinite")) {
-        int rc = read_infinite_light(s, ld, xf, scale, where, l, err);
+        int rc = read_infinite_light(s, ld, d->scene_dir, xf, scale, where, l, err);
         if (rc)
             return rc;
     } else {
-        if (!allow_unsupported)
+        if (!d->allow_unsupported)
             return lf_error_set(err, LF_ERR_UNSUPPORTED,
                                 "%s: LightSource \"%s\" is not supported (--allow-unsupported renders the scene "
                                 "without it)",
@@ -563,7 +564,7 @@ int lf_scene_build_lights(lf_scene_desc *d, lf_scene *s, lf_error *err)
     for (size_t i = 0; i < d->n_lights; i++) {
         lf_light l;
         int skip;
-        if (light_from_desc(s, &d->lights[i], &l, &skip, d->allow_unsupported, err))
+        if (light_from_desc(s, d, &d->lights[i], &l, &skip, err))
             return err ? err->code : LF_ERR_PARAM;
         if (skip)
             continue;

@@ -239,6 +239,7 @@ typedef struct lf_tex_input {
 typedef struct lf_texture_list {
     lf_texture **items;
     size_t count;
+    const char *scene_dir; /* top-level scene's directory, for file names (may be NULL) */
 } lf_texture_list;
 
 /* Reads parameter `name` of ps: "texture name" -> that texture (which must
@@ -334,10 +335,12 @@ lf_vec3 lf_subsurface_albedo_from_reflectance(lf_vec3 r);
  * lambda_nm, from Schott's Sellmeier coefficients; 0 if the name is unknown. */
 float lf_named_glass_eta(const char *name, float lambda_nm);
 
-/* `filename` resolved against the directory of the scene file that named it
- * (pbrt-v4's ResolveFilename; absolute names unchanged), malloc'ed; NULL
- * when out of memory.  For the texture and material files shading reads. */
-char *lf_shading_resolve_path(const char *scene_file, const char *filename);
+/* `filename` resolved against the directory of the scene file that named it;
+ * if nothing is there, against scene_dir (the top-level scene's directory,
+ * where pbrt-v4's ResolveFilename looks; NULL: none); absolute names
+ * unchanged.  Malloc'ed; NULL when out of memory.  For the texture,
+ * material and environment-map files. */
+char *lf_shading_resolve_path(const char *scene_file, const char *scene_dir, const char *filename);
 
 #ifdef __cplusplus
 }

@@ -285,13 +285,13 @@ static int read_layer_extras(lf_paramset *ps, const lf_texture_list *texs, lf_ma
     return LF_OK;
 }
 
-static int read_measured(lf_paramset *ps, lf_material *m, const lf_loc *loc, lf_error *err)
+static int read_measured(lf_paramset *ps, const char *scene_dir, lf_material *m, const lf_loc *loc, lf_error *err)
 {
     const char *fn = lf_params_string(ps, "filename", "");
     const lf_param *p = lf_params_peek(ps, "filename");
     if (!fn || !*fn)
         return lf_error_at(err, LF_ERR_PARAM, loc, "measured material: \"string filename\" is required");
-    char *path = lf_shading_resolve_path(p->loc.file, fn);
+    char *path = lf_shading_resolve_path(p->loc.file, scene_dir, fn);
     if (!path)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     lf_error lerr = {0};
@@ -439,7 +439,7 @@ static int read_measured_or_hair(lf_paramset *ps, const char *type, const lf_tex
     if (!strcmp(type, "measured")) {
         m->kind = MAT_MEASURED;
         m->type = "measured";
-        return read_measured(ps, m, loc, err);
+        return read_measured(ps, texs ? texs->scene_dir : NULL, m, loc, err);
     }
     m->kind = MAT_HAIR;
     m->type = "hair";
@@ -629,6 +629,7 @@ int lf_materials_build(lf_scene_desc *d, lf_materials **out, lf_error *err)
     ms->def.type = "diffuse";
     ms->def.reflectance.value = lf_v3(0.5f, 0.5f, 0.5f);
     ms->def.mix_index[0] = ms->def.mix_index[1] = -1;
+    ms->texs.scene_dir = d->scene_dir;
     int rc = LF_OK;
     if (d->n_textures) {
         ms->texs.items = calloc(d->n_textures, sizeof *ms->texs.items);

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 typedef enum tex_class {
     TEX_CONSTANT,
@@ -204,7 +205,20 @@ static int is_8bit_format(const char *path)
            !strcasecmp(e, "bmp") || !strcasecmp(e, "gif");
 }
 
-char *lf_shading_resolve_path(const char *scene_file, const char *filename)
+static char *join_dir(const char *dir, size_t dl, const char *filename)
+{
+    size_t fl = strlen(filename);
+    char *out = malloc(dl + fl + 2);
+    if (!out)
+        return NULL;
+    memcpy(out, dir ? dir : "", dl);
+    if (dl && out[dl - 1] != '/')
+        out[dl++] = '/';
+    memcpy(out + dl, filename, fl + 1);
+    return out;
+}
+
+char *lf_shading_resolve_path(const char *scene_file, const char *scene_dir, const char *filename)
 {
     size_t dl = 0;
     if (filename[0] != '/' && scene_file) {
@@ -212,16 +226,24 @@ char *lf_shading_resolve_path(const char *scene_file, const char *filename)
         if (slash)
             dl = (size_t)(slash - scene_file) + 1;
     }
-    size_t fl = strlen(filename);
-    char *out = malloc(dl + fl + 1);
-    if (!out)
-        return NULL;
-    memcpy(out, scene_file ? scene_file : "", dl);
-    memcpy(out + dl, filename, fl + 1);
+    char *out = join_dir(scene_file, dl, filename);
+    /* Not next to the naming file (a nested materials include naming
+     * "textures/x.png"): the top-level scene's directory, where pbrt-v4
+     * resolves every relative name.  The first candidate stays when neither
+     * exists, so the message names it. */
+    if (!out || filename[0] == '/' || !scene_dir || !scene_dir[0] || access(out, F_OK) == 0)
+        return out;
+    char *alt = join_dir(scene_dir, strlen(scene_dir), filename);
+    if (alt && access(alt, F_OK) == 0) {
+        free(out);
+        return alt;
+    }
+    free(alt);
     return out;
 }
 
-static int read_imagemap(lf_texture_desc *td, lf_texture *t, lf_warnings *warnings, lf_error *err)
+static int read_imagemap(lf_texture_desc *td, const char *scene_dir, lf_texture *t, lf_warnings *warnings,
+                         lf_error *err)
 {
     lf_paramset *ps = &td->e.params;
     const lf_loc *l = &td->e.loc;
@@ -248,7 +270,7 @@ static int read_imagemap(lf_texture_desc *td, lf_texture *t, lf_warnings *warnin
     t->scale = (float)lf_params_float(ps, "scale", 1.0);
     t->invert = lf_params_bool(ps, "invert", 0);
 
-    char *path = lf_shading_resolve_path(l->file, filename);
+    char *path = lf_shading_resolve_path(l->file, scene_dir, filename);
     if (!path)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     /* pbrt-v4's default encoding: sRGB for 8-bit files, linear otherwise;
@@ -661,7 +683,7 @@ int lf_texture_new(lf_texture_desc *td, const lf_texture_list *texs, lf_warnings
         t->cls = TEX_IMAGE;
         rc = read_mapping(td, &t->map, err);
         if (!rc)
-            rc = read_imagemap(td, t, warnings, err);
+            rc = read_imagemap(td, texs ? texs->scene_dir : NULL, t, warnings, err);
     } else {
         rc = lf_error_at(err, LF_ERR_UNSUPPORTED, l,
                          "texture \"%s\": %s texture class \"%s\" not supported (constant, scale, mix, "

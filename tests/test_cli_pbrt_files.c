@@ -159,6 +159,51 @@ static void test_gzip_bit_identical(void)
     CHECK(!exists("bad.exr"));
 }
 
+/* An image texture and an environment map named in a nested include
+ * relative to the top-level scene (pbrt-v4 resolves every relative name
+ * there; sanmiguel's geometry/ *-mat.pbrt files name "textures/..." that way)
+ * render like the same files named next to the including file; a name
+ * found in neither place is reported with the path tried first. */
+static void test_nested_image_files(void)
+{
+    CHECK(run("mkdir -p flat/textures nested/geometry nested/textures") == 0);
+    /* a 2x2 PFM, rows of different colours */
+    char pfm[512];
+    snprintf(pfm, sizeof pfm, "%s/flat/textures/t.pfm", dir);
+    FILE *f = fopen(pfm, "wb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    float px[12] = {0.2f, 0.4f, 0.6f, 0.2f, 0.4f, 0.6f, 0.7f, 0.3f, 0.1f, 0.7f, 0.3f, 0.1f};
+    fprintf(f, "PF\n2 2\n-1.0\n");
+    CHECK(fwrite(px, sizeof px, 1, f) == 1);
+    fclose(f);
+    CHECK(run("cp flat/textures/t.pfm nested/textures/") == 0);
+    const char *main_fmt = "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n"
+                           "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
+                           "Sampler \"sobol\" \"integer pixelsamples\" 4\nWorldBegin\nInclude \"%s\"\n"
+                           "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0 1 -1 0 1 1 0 -1 1 0] "
+                           "\"integer indices\" [0 1 2 0 2 3] \"point2 uv\" [0 0 1 0 1 1 0 1]\n";
+    const char *inc = "LightSource \"infinite\" \"string filename\" \"textures/t.pfm\"\n"
+                      "Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/t.pfm\"\n"
+                      "Material \"diffuse\" \"texture reflectance\" \"t\"\n";
+    char text[2048];
+    snprintf(text, sizeof text, main_fmt, "inc.pbrt");
+    write_file("flat/main.pbrt", text);
+    write_file("flat/inc.pbrt", inc);
+    snprintf(text, sizeof text, main_fmt, "geometry/inc.pbrt");
+    write_file("nested/main.pbrt", text);
+    write_file("nested/geometry/inc.pbrt", inc);
+    CHECK_MSG(run("%s flat/main.pbrt -o flat.exr --quiet --seed 5", LF_LFRENDER) == 0, "%s", out_text);
+    CHECK_MSG(run("%s nested/main.pbrt -o nested.exr --quiet --seed 5", LF_LFRENDER) == 0, "%s", out_text);
+    CHECK_MSG(same_pixels("flat.exr", "nested.exr"), "nested image files render differently");
+    /* in neither place: exit 1, the first candidate named */
+    CHECK(run("rm nested/textures/t.pfm") == 0);
+    CHECK(run("%s nested/main.pbrt -o gone.exr --quiet", LF_LFRENDER) == 1);
+    CHECK_MSG(strstr(out_text, "nested/geometry/textures/t.pfm"), "%s", out_text);
+    CHECK(!exists("gone.exr"));
+}
+
 /* Shape "loopsubdiv" renders bit-identical to the trianglemesh holding its
  * limit positions and normals: the subdivision reaches the mesh path intact. */
 static void test_loopsubdiv_as_trianglemesh(void)
@@ -233,6 +278,30 @@ static void test_refused(void)
         }
     }
 
+    /* parameters pbrt-v4 dropped (zero-day's Film "scale", transparent-
+     * machines' "rrthreshold", explosion's "LeScale", renamed "Lescale"):
+     * refused as pbrt-v4 refuses them, even with --allow-unsupported, with
+     * what to do instead */
+    const char *dropped[] = {
+        "Film \"rgb\" \"float scale\" 3\nWorldBegin\n",
+        "Integrator \"volpath\" \"float rrthreshold\" 0\nWorldBegin\n",
+        "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float LeScale\" 2\n",
+    };
+    const char *said[] = {
+        "dropped.pbrt:1:12: unused parameter \"float scale\" in Film \"rgb\" (early pbrt-v4's film scale factor; "
+        "pbrt-v4 no longer reads it",
+        "dropped.pbrt:1:22: unused parameter \"float rrthreshold\" in Integrator \"volpath\" (pbrt-v3's and early "
+        "pbrt-v4's",
+        "dropped.pbrt:2:49: unused parameter \"float LeScale\" in MakeNamedMedium \"m\" (did you mean \"float "
+        "Lescale\"?)",
+    };
+    for (size_t i = 0; i < sizeof dropped / sizeof dropped[0]; i++) {
+        write_file("dropped.pbrt", dropped[i]);
+        int rc = run("%s dropped.pbrt -o dropped.exr --quiet --allow-unsupported", LF_LFRENDER);
+        CHECK_MSG(rc == 1 && strstr(out_text, said[i]), "%s: exit %d: %s", dropped[i], rc, out_text);
+        CHECK(!exists("dropped.exr"));
+    }
+
     /* three problems, three messages, one run */
     char text[2048];
     snprintf(text, sizeof text,
@@ -259,6 +328,7 @@ int main(void)
     }
     test_gzip_bit_identical();
     test_loopsubdiv_as_trianglemesh();
+    test_nested_image_files();
     test_refused();
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

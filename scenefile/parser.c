@@ -45,6 +45,12 @@
  * took 6 GB.  Real scenes nest a few levels (exporters: tens); 10,000 keeps
  * the stack under 60 MB. */
 #define MAX_BLOCK_DEPTH 10000
+/* Values in one parameter: 2^28 numbers are 2 GiB as doubles and at least
+ * 512 MB of text (89 million triangles' indices); the file is read as a
+ * stream, so this is what bounds memory for a run of numbers (a 14 MB
+ * .pbrt.gz can hold 3 GB of "0 ", 12 GB as doubles).  Meshes that large
+ * belong in PLY files, whose counts are checked against the file. */
+#define MAX_PARAM_VALUES ((size_t)1 << 28)
 
 /* ------------------------------------------------------------------------ */
 /* Small utilities                                                          */
@@ -381,6 +387,8 @@ static void lx_free(lexer *X)
 
 static int is_space(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
+static int is_bare_end(int c) { return is_space(c) || c == '"' || c == '[' || c == ']' || c == '#'; }
+
 static int is_escape_char(int c) { return c && strchr("bfnrt\\'\"", c) != NULL; }
 
 /* A stream that failed (corrupt gzip data half-way, a read error): named as
@@ -414,7 +422,20 @@ static int lex_skip(parser *P, lexer *X, lx_frame **out)
             lx_pop(X); /* end of an included file: continue in the includer */
             L = &X->fr[X->n_fr - 1];
         } else if (is_space(c)) {
-            lx_getc(L);
+            const char *q = L->p, *newline = NULL; /* the blanks in the window at once */
+            for (; q < L->end; q++) {
+                char b = *q;
+                if (b == ' ' || b == '\t')
+                    continue;
+                if (b == '\n') {
+                    L->line++;
+                    newline = q;
+                } else if (!is_space((unsigned char)b)) {
+                    break;
+                }
+            }
+            L->col = newline ? q - newline : L->col + (q - L->p);
+            L->p = q;
         } else if (c == '#') {
             lx_skip_line(L);
         } else {
@@ -476,14 +497,17 @@ static int lex_string(parser *P, lexer *X, lx_frame *L, token *t, char *text)
 static int lex_bare(parser *P, lexer *X, lx_frame *L, token *t, char *text)
 {
     long long n = 1;
-    for (;;) {
-        int c = lx_peekc(L);
-        if (c == EOF || is_space(c) || c == '"' || c == '[' || c == ']' || c == '#')
+    for (;;) { /* a window at a time; a bare token never holds a newline */
+        if (L->p == L->end && !lx_fill(L))
             break;
-        lx_getc(L);
-        if (n < LX_MAX_BARE)
-            text[n] = (char)c;
-        n++;
+        const char *q = L->p;
+        for (; q < L->end && !is_bare_end((unsigned char)*q); q++, n++)
+            if (n < LX_MAX_BARE)
+                text[n] = *q;
+        L->col += q - L->p;
+        L->p = q;
+        if (q < L->end)
+            break;
     }
     char first = text[0];
     int numeric = isdigit((unsigned char)first) || first == '-' || first == '+' || first == '.';
@@ -916,6 +940,11 @@ static int add_value(parser *P, const token *t, lf_param_type type, const char *
 {
     char b[200];
     value_class vc = class_of(type);
+    if (a->n_nums + a->n_strs + a->n_bools >= MAX_PARAM_VALUES)
+        return perr(P, LF_ERR_PARSE, &t->loc,
+                    "parameter \"%s\" has more than %zu values: expected ']' (a mesh this large belongs in a PLY "
+                    "file)",
+                    decl, MAX_PARAM_VALUES);
     if (t->kind == TK_WORD && is_nonfinite_word(t))
         return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%.*s\" in parameter \"%s\"", (int)t->n, t->s,
                     decl);

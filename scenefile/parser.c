@@ -171,7 +171,10 @@ typedef struct token {
  * follows the tokens kept, not the file: a 3 GB comment or run of blanks
  * costs nothing, and a value list (a mesh of millions of numbers) keeps only
  * its parsed numbers.  A token is bounded instead: */
-#define LX_WINDOW ((size_t)1 << 16)
+#ifndef LF_LEX_WINDOW
+#define LF_LEX_WINDOW 65536 /* the fuzz build makes it tiny (CMakeLists.txt) */
+#endif
+#define LX_WINDOW ((size_t)LF_LEX_WINDOW)
 /* a quoted string: file names, types and names are far shorter, and a
  * string array is a list of such strings */
 #define LX_MAX_STRING 65536
@@ -189,8 +192,10 @@ typedef struct token {
  * end, so the token stream runs on into the including file as in pbrt-v4:
  * a parameter list may start in one file and continue in the other. */
 typedef struct lx_frame {
-    lf_file_stream *in; /* NULL: the text was given whole (lf_scene_parse_string) */
-    char *window;       /* LX_WINDOW bytes of a stream */
+    lf_file_stream *in; /* the file; NULL for a text given whole (lf_scene_parse_string) */
+    const char *text;   /* ... which goes through the window too, so both read alike */
+    size_t text_left;
+    char *window;       /* LX_WINDOW bytes */
     const char *p, *end; /* what is left to read of the window (or the text) */
     int at_end;         /* nothing follows end */
     lf_error read_error; /* a stream that failed: reported once, at its end */
@@ -226,7 +231,15 @@ static int lx_fill(lx_frame *L)
     if (L->at_end)
         return 0;
     size_t got = 0;
-    if (!L->in || lf_file_stream_read(L->in, L->window, LX_WINDOW, &got, &L->read_error) || got == 0) {
+    if (!L->in) {
+        got = L->text_left < LX_WINDOW ? L->text_left : LX_WINDOW;
+        memcpy(L->window, L->text, got);
+        L->text += got;
+        L->text_left -= got;
+    } else if (lf_file_stream_read(L->in, L->window, LX_WINDOW, &got, &L->read_error)) {
+        got = 0;
+    }
+    if (got == 0) {
         L->at_end = 1;
         return 0;
     }
@@ -350,12 +363,12 @@ static int lx_push(lexer *X, lf_file_stream *in, const char *text, size_t len, c
     }
     lx_frame *L = &X->fr[X->n_fr];
     memset(L, 0, sizeof *L);
-    if (in && !(L->window = malloc(LX_WINDOW)))
+    if (!(L->window = malloc(LX_WINDOW)))
         return -1;
     L->in = in;
-    L->p = text;
-    L->end = text + len;
-    L->at_end = !in;
+    L->text = text;
+    L->text_left = len;
+    L->p = L->end = L->window;
     L->line = L->col = 1;
     L->file = file;
     L->dir = dir;
@@ -1737,7 +1750,7 @@ static int push_file(parser *P, lexer *X, const char *path, const lf_loc *from)
     const char *kept_file = keep_string(P, path);
     const char *kept_dir = dir ? keep_string(P, dir) : NULL;
     free(dir);
-    if (!kept_file || !kept_dir || lx_push(X, in, NULL, 0, kept_file, kept_dir, from)) {
+    if (!kept_file || !kept_dir || lx_push(X, in, "", 0, kept_file, kept_dir, from)) {
         lf_file_stream_close(in);
         return nomem(P);
     }

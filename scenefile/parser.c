@@ -7,11 +7,14 @@
  * after one, the parser skips to the next directive name and goes on, up to
  * max_errors; if there was any, everything built is freed at the end.
  *
- * Files are read whole through lf_file_read (gzip detected by its magic
- * bytes).  Include and Import push the file onto the lexer's stack of
- * frames, so the token stream continues into the included file and back
- * out of it, as pbrt-v4's tokenizer does: a parameter list may span the
- * end of an included file.
+ * Files are read as streams (lf_file_stream: gzip detected by its magic
+ * bytes) through a window of 64 KiB, so memory follows the tokens kept,
+ * not the file's size: pbrt-v4 maps plain files and inflates .gz files
+ * whole, where one 3 GB comment line costs 3 GB.  Tokens are bounded
+ * instead (LX_MAX_STRING, LX_MAX_BARE).  Include and Import push the file
+ * onto the lexer's stack of frames, so the token stream continues into the
+ * included file and back out of it, as pbrt-v4's tokenizer does: a
+ * parameter list may span the end of an included file.
  *
  * Where lensfield deliberately differs from pbrt-v4 (all documented at the
  * handler): Include paths are relative to the including file; TransformBegin

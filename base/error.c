@@ -31,8 +31,8 @@ int lf_loc_format(char *buf, size_t n, const lf_loc *loc)
     if (!loc || loc->line <= 0)
         return snprintf(buf, n, "%s", file);
     if (loc->col <= 0)
-        return snprintf(buf, n, "%s:%d", file, loc->line);
-    return snprintf(buf, n, "%s:%d:%d", file, loc->line, loc->col);
+        return snprintf(buf, n, "%s:%lld", file, loc->line);
+    return snprintf(buf, n, "%s:%lld:%lld", file, loc->line, loc->col);
 }
 
 int lf_error_at(lf_error *err, int code, const lf_loc *loc, const char *fmt, ...)

@@ -60,10 +60,11 @@ void lf_error_clear(lf_error *err);
 /* Where something was written in a file.  `file` points into storage owned
  * by whoever read the file (a scene description, or a string literal); it
  * stays valid as long as the owner does.  line 0: the file as a whole; col 0:
- * the line as a whole. */
+ * the line as a whole.  64-bit: a 3 GB line is read (as a stream) and its
+ * columns must be told exactly. */
 typedef struct lf_loc {
     const char *file;
-    int line, col;
+    long long line, col;
 } lf_loc;
 
 /* The one location formatter: "file:line:col", "file:line" (col 0), "file"

@@ -1,4 +1,4 @@
-/* lf_file.h - whole-file reads that transparently gunzip.
+/* lf_file.h - file reads that transparently gunzip, whole or as a stream.
  *
  * Every file a scene names (the scene itself, Include/Import, PLY meshes,
  * spectrum files, lens prescriptions) may be gzip-compressed, as pbrt-v4
@@ -45,6 +45,25 @@ int lf_file_read_head(const char *path, size_t max_bytes, char **data, size_t *l
  * malloc'ed, NUL-terminated buffer.  `name` is used in messages. */
 int lf_gunzip(const unsigned char *in, size_t in_len, const char *name, size_t max_bytes, char **data, size_t *len,
               lf_error *err);
+
+/* A stream of the same content, a chunk at a time, for readers whose memory
+ * should follow what they keep rather than the file's size (the scene
+ * parser: a 3 GB comment line costs it nothing).  Opening reads ahead
+ * 64 KiB to see the gzip magic; open errors are lf_file_read's; reads fail
+ * with its messages for corrupt, truncated or trailing gzip data.
+ *
+ *   lf_file_stream *s; char buf[4096]; size_t got;
+ *   if (lf_file_stream_open(path, &s, &err)) ...
+ *   while (!(rc = lf_file_stream_read(s, buf, sizeof buf, &got, &err)) && got) ...
+ *   lf_file_stream_close(s);
+ */
+typedef struct lf_file_stream lf_file_stream;
+int lf_file_stream_open(const char *path, lf_file_stream **out, lf_error *err);
+/* Up to n bytes of content; *got < n only at the end (0: nothing left). */
+int lf_file_stream_read(lf_file_stream *s, char *buf, size_t n, size_t *got, lf_error *err);
+int lf_file_stream_was_gzip(const lf_file_stream *s);
+/* Accepts NULL. */
+void lf_file_stream_close(lf_file_stream *s);
 
 /* 1 if the buffer starts with the gzip magic bytes 1f 8b. */
 int lf_is_gzip(const void *buf, size_t len);

@@ -7,11 +7,14 @@
  * after one, the parser skips to the next directive name and goes on, up to
  * max_errors; if there was any, everything built is freed at the end.
  *
- * Files are read whole through lf_file_read (gzip detected by its magic
- * bytes).  Include and Import push the file onto the lexer's stack of
- * frames, so the token stream continues into the included file and back
- * out of it, as pbrt-v4's tokenizer does: a parameter list may span the
- * end of an included file.
+ * Files are read as streams (lf_file_stream: gzip detected by its magic
+ * bytes) through a window of 64 KiB, so memory follows the tokens kept,
+ * not the file's size: pbrt-v4 maps plain files and inflates .gz files
+ * whole, where one 3 GB comment line costs 3 GB.  Tokens are bounded
+ * instead (LX_MAX_STRING, LX_MAX_BARE).  Include and Import push the file
+ * onto the lexer's stack of frames, so the token stream continues into the
+ * included file and back out of it, as pbrt-v4's tokenizer does: a
+ * parameter list may span the end of an included file.
  *
  * Where lensfield deliberately differs from pbrt-v4 (all documented at the
  * handler): Include paths are relative to the including file; TransformBegin
@@ -45,6 +48,12 @@
  * took 6 GB.  Real scenes nest a few levels (exporters: tens); 10,000 keeps
  * the stack under 60 MB. */
 #define MAX_BLOCK_DEPTH 10000
+/* Values in one parameter: 2^28 numbers are 2 GiB as doubles and at least
+ * 512 MB of text (89 million triangles' indices); the file is read as a
+ * stream, so this is what bounds memory for a run of numbers (a 14 MB
+ * .pbrt.gz can hold 3 GB of "0 ", 12 GB as doubles).  Meshes that large
+ * belong in PLY files, whose counts are checked against the file. */
+#define MAX_PARAM_VALUES ((size_t)1 << 28)
 
 /* ------------------------------------------------------------------------ */
 /* Small utilities                                                          */
@@ -152,7 +161,7 @@ typedef enum tok_kind { TK_EOF, TK_STRING, TK_NUMBER, TK_WORD, TK_LBRACK, TK_RBR
 
 typedef struct token {
     tok_kind kind;
-    const char *s; /* raw text; for strings, between the quotes, escapes undecoded */
+    const char *s; /* text (in the lexer's token store); for strings, between the quotes, escapes undecoded */
     size_t n;
     double num;    /* TK_NUMBER */
     int escaped;   /* TK_STRING contains a backslash */
@@ -160,27 +169,52 @@ typedef struct token {
     const char *dir; /* directory of the file it was read from (Include, plymesh paths) */
 } token;
 
+/* Files are read as streams through a window (LX_WINDOW bytes a frame),
+ * and each token's text is copied out of it into the token store, so memory
+ * follows the tokens kept, not the file: a 3 GB comment or run of blanks
+ * costs nothing, and a value list (a mesh of millions of numbers) keeps only
+ * its parsed numbers.  A token is bounded instead: */
+#ifndef LF_LEX_WINDOW
+#define LF_LEX_WINDOW 65536 /* the fuzz build makes it tiny (CMakeLists.txt) */
+#endif
+#define LX_WINDOW ((size_t)LF_LEX_WINDOW)
+/* a quoted string: file names, types and names are far shorter, and a
+ * string array is a list of such strings */
+#define LX_MAX_STRING 65536
+/* a number or a bare word (directive names, true/false): numbers were
+ * already refused from 128 characters (17 significant digits and an
+ * exponent need 25) and the longest directive name has 22 */
+#define LX_MAX_BARE 128
+/* The token store: blocks that never move (tokens point into them); a token
+ * starts a new block when the longest string might not fit.  Text is
+ * released at each directive, after each parameter and after each value of
+ * a list (lx_mark/lx_release), so a few tokens live at a time. */
+#define LX_BLOCK ((size_t)1 << 20)
+
 /* One file being read.  Include pushes a frame and the lexer pops it at its
  * end, so the token stream runs on into the including file as in pbrt-v4:
  * a parameter list may start in one file and continue in the other. */
 typedef struct lx_frame {
-    char *owned;      /* malloc'ed text (NULL for lf_scene_parse_string) */
-    const char *text;
-    size_t len, pos;
-    int line, col;
-    const char *file; /* kept in the description's strings */
-    const char *dir;  /* directory of file */
-    int included;     /* read by Include/Import: refused whole if it does not start as a scene */
-    int directives;   /* directives read from it so far */
+    lf_file_stream *in; /* the file; NULL for a text given whole (lf_scene_parse_string) */
+    const char *text;   /* ... which goes through the window too, so both read alike */
+    size_t text_left;
+    char *window;       /* LX_WINDOW bytes */
+    const char *p, *end; /* what is left to read of the window (or the text) */
+    int at_end;         /* nothing follows end */
+    lf_error read_error; /* a stream that failed: reported once, at its end */
+    long long line, col; /* 64-bit: a line over 2 GiB was undefined behaviour in an int */
+    const char *file;   /* kept in the description's strings */
+    const char *dir;    /* directory of file */
+    lf_loc from;        /* the Include that opened it (line 0 for the top-level file) */
+    int included;       /* read by Include/Import: refused whole if it does not start as a scene */
+    int directives;     /* directives read from it so far */
 } lx_frame;
 
 typedef struct lexer {
     lx_frame *fr;
     int n_fr, cap_fr;
-    /* Texts of files already finished: tokens of the directive being read
-     * may still point into them, so they are freed between directives. */
-    char **done;
-    int n_done, cap_done;
+    char **blocks;      /* the token store */
+    size_t n_blocks, cur_block, used; /* text is appended at blocks[cur_block] + used */
     token peeked;
     int has_peek;
 } lexer;
@@ -193,25 +227,134 @@ static int perr(parser *P, int code, const lf_loc *loc, const char *fmt, ...)
 #endif
     ;
 
-static int lx_getc(lx_frame *L)
+/* Refills an empty window from the stream.  0 at the end (or when reading
+ * failed: the error is kept for lex_scan to report). */
+static int lx_fill(lx_frame *L)
 {
-    if (L->pos >= L->len)
+    if (L->at_end)
+        return 0;
+    size_t got = 0;
+    if (!L->in) {
+        got = L->text_left < LX_WINDOW ? L->text_left : LX_WINDOW;
+        memcpy(L->window, L->text, got);
+        L->text += got;
+        L->text_left -= got;
+    } else if (lf_file_stream_read(L->in, L->window, LX_WINDOW, &got, &L->read_error)) {
+        got = 0;
+    }
+    if (got == 0) {
+        L->at_end = 1;
+        return 0;
+    }
+    L->p = L->window;
+    L->end = L->window + got;
+    return 1;
+}
+
+static inline int lx_peekc(lx_frame *L)
+{
+    if (L->p == L->end && !lx_fill(L))
         return EOF;
-    int c = (unsigned char)L->text[L->pos++];
-    /* saturating: a line over 2 GiB (or a file of 2^31 lines) must not
-     * overflow the int; its locations then say INT_MAX */
+    return (unsigned char)*L->p;
+}
+
+static inline int lx_getc(lx_frame *L)
+{
+    if (L->p == L->end && !lx_fill(L))
+        return EOF;
+    int c = (unsigned char)*L->p++;
     if (c == '\n') {
-        L->line += L->line < INT_MAX;
+        L->line++;
         L->col = 1;
     } else {
-        L->col += L->col < INT_MAX;
+        L->col++;
     }
     return c;
 }
 
-static int lx_peekc(const lx_frame *L) { return L->pos < L->len ? (unsigned char)L->text[L->pos] : EOF; }
+/* Skips to the end of the line (a comment), a window at a time. */
+static void lx_skip_line(lx_frame *L)
+{
+    for (;;) {
+        if (L->p == L->end && !lx_fill(L))
+            return;
+        const char *q = L->p;
+        while (q < L->end && *q != '\n' && *q != '\r')
+            q++;
+        L->col += q - L->p;
+        L->p = q;
+        if (q < L->end)
+            return;
+    }
+}
 
-static int lx_push(lexer *X, char *owned, const char *text, size_t len, const char *file, const char *dir)
+/* Where the token store will write next, to give back with lx_release. */
+static size_t lx_mark(const lexer *X) { return X->cur_block * LX_BLOCK + X->used; }
+
+static int lx_text_begin(lexer *X, char **start);
+
+/* Where p is in the store (as lx_mark counts), or SIZE_MAX outside it. */
+static size_t lx_pos(const lexer *X, const char *p)
+{
+    for (size_t b = 0; p && b < X->n_blocks; b++)
+        if (p >= X->blocks[b] && p < X->blocks[b] + LX_BLOCK)
+            return b * LX_BLOCK + (size_t)(p - X->blocks[b]);
+    return SIZE_MAX;
+}
+
+/* Gives back the text of the tokens read since mark, which must no longer
+ * be needed; a peeked token read since then is kept (moved down to mark). */
+static void lx_release(lexer *X, size_t mark)
+{
+    if (mark >= lx_mark(X))
+        return;
+    size_t at = X->has_peek ? lx_pos(X, X->peeked.s) : SIZE_MAX;
+    size_t cur = X->cur_block, used = X->used;
+    X->cur_block = mark / LX_BLOCK;
+    X->used = mark % LX_BLOCK;
+    if (at == SIZE_MAX || at < mark)
+        return;
+    char *start;
+    if (lx_text_begin(X, &start)) { /* no memory for a block: keep everything */
+        X->cur_block = cur, X->used = used;
+        return;
+    }
+    memmove(start, X->peeked.s, X->peeked.n + 1);
+    X->peeked.s = start;
+    X->used += X->peeked.n + 1;
+}
+
+/* Starts a token's text in the store: *start receives where it begins (a
+ * token is kept whole in one block).  -1: no memory. */
+static int lx_text_begin(lexer *X, char **start)
+{
+    if (X->n_blocks == 0 || X->used + LX_MAX_STRING + 2 > LX_BLOCK) {
+        if (X->n_blocks && X->cur_block + 1 < X->n_blocks) {
+            X->cur_block++;
+        } else {
+            char **nb = realloc(X->blocks, (X->n_blocks + 1) * sizeof *nb);
+            if (!nb)
+                return -1;
+            X->blocks = nb;
+            if (!(nb[X->n_blocks] = malloc(LX_BLOCK)))
+                return -1;
+            X->cur_block = X->n_blocks++;
+        }
+        X->used = 0;
+    }
+    *start = X->blocks[X->cur_block] + X->used;
+    return 0;
+}
+
+/* Ends a token of n bytes begun at start (NUL-terminated, not counted). */
+static void lx_text_end(lexer *X, char *start, size_t n)
+{
+    start[n] = '\0';
+    X->used += n + 1;
+}
+
+static int lx_push(lexer *X, lf_file_stream *in, const char *text, size_t len, const char *file, const char *dir,
+                   const lf_loc *from)
 {
     if (X->n_fr == X->cap_fr) {
         int nc = X->cap_fr ? 2 * X->cap_fr : 8;
@@ -221,140 +364,225 @@ static int lx_push(lexer *X, char *owned, const char *text, size_t len, const ch
         X->fr = n;
         X->cap_fr = nc;
     }
-    /* Room in `done` for every open frame, so popping never allocates
-     * (and never has to free a text that tokens may still point into). */
-    if (X->cap_done < X->n_done + X->n_fr + 1) {
-        int nc = 2 * (X->n_done + X->n_fr + 1);
-        char **n = realloc(X->done, (size_t)nc * sizeof *n);
-        if (!n)
-            return -1;
-        X->done = n;
-        X->cap_done = nc;
-    }
-    X->fr[X->n_fr] = (lx_frame){owned, text, len, 0, 1, 1, file, dir, X->n_fr > 0, 0};
+    lx_frame *L = &X->fr[X->n_fr];
+    memset(L, 0, sizeof *L);
+    if (!(L->window = malloc(LX_WINDOW)))
+        return -1;
+    L->in = in;
+    L->text = text;
+    L->text_left = len;
+    L->p = L->end = L->window;
+    L->line = L->col = 1;
+    L->file = file;
+    L->dir = dir;
+    L->from = from ? *from : (lf_loc){0};
+    L->included = X->n_fr > 0;
     X->n_fr++;
     return 0;
 }
 
-/* Ends the innermost file; its text is freed at the next directive (lx_push
- * reserved the slot). */
-static int lx_pop(lexer *X)
+/* Ends the innermost file.  Token text lives in the store, so the stream
+ * and its window go at once. */
+static void lx_pop(lexer *X)
 {
     lx_frame *F = &X->fr[--X->n_fr];
-    if (F->owned)
-        X->done[X->n_done++] = F->owned;
-    return 0;
-}
-
-static void lx_release_done(lexer *X)
-{
-    for (int i = 0; i < X->n_done; i++)
-        free(X->done[i]);
-    X->n_done = 0;
+    lf_file_stream_close(F->in);
+    free(F->window);
 }
 
 static void lx_free(lexer *X)
 {
     while (X->n_fr)
         lx_pop(X);
-    lx_release_done(X);
-    free(X->done);
+    for (size_t b = 0; b < X->n_blocks; b++)
+        free(X->blocks[b]);
+    free(X->blocks);
     free(X->fr);
     memset(X, 0, sizeof *X);
 }
 
 static int is_space(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
+static int is_bare_end(int c) { return is_space(c) || c == '"' || c == '[' || c == ']' || c == '#'; }
+
 static int is_escape_char(int c) { return c && strchr("bfnrt\\'\"", c) != NULL; }
 
-static int lex_scan(parser *P, lexer *X, token *t)
+/* A stream that failed (corrupt gzip data half-way, a read error): named as
+ * push_file names a file it cannot read. */
+static int lx_report_read_error(parser *P, lx_frame *L)
+{
+    const char *what = L->read_error.msg;
+    size_t pl = strlen(L->file);
+    if (strncmp(what, L->file, pl) == 0 && what[pl] == ':' && what[pl + 1] == ' ')
+        what += pl + 2;
+    int code = L->read_error.code;
+    lf_error_clear(&L->read_error);
+    if (L->from.line)
+        return perr(P, code, &L->from, "cannot read included file \"%s\": %s", L->file, what);
+    return perr(P, code, NULL, "cannot read scene file \"%s\": %s", L->file, what);
+}
+
+/* Skips blanks and comments, leaving included files at their end.  0 with
+ * *L the frame of the next token (or of the end of everything); an error
+ * when a file could not be read to its end. */
+static int lex_skip(parser *P, lexer *X, lx_frame **out)
 {
     lx_frame *L = &X->fr[X->n_fr - 1];
     for (;;) {
         int c = lx_peekc(L);
         if (c == EOF) {
-            if (X->n_fr > 1) { /* end of an included file: continue in the includer */
-                if (lx_pop(X))
-                    return nomem(P);
-                L = &X->fr[X->n_fr - 1];
-                continue;
+            if (L->read_error.code)
+                return lx_report_read_error(P, L);
+            if (X->n_fr == 1)
+                break;
+            lx_pop(X); /* end of an included file: continue in the includer */
+            L = &X->fr[X->n_fr - 1];
+        } else if (is_space(c)) {
+            const char *q = L->p, *newline = NULL; /* the blanks in the window at once */
+            for (; q < L->end; q++) {
+                char b = *q;
+                if (b == ' ' || b == '\t')
+                    continue;
+                if (b == '\n') {
+                    L->line++;
+                    newline = q;
+                } else if (!is_space((unsigned char)b)) {
+                    break;
+                }
             }
-            memset(t, 0, sizeof *t);
-            t->kind = TK_EOF;
-            t->loc = (lf_loc){L->file, L->line, L->col};
-            t->dir = L->dir;
-            return LF_OK;
+            L->col = newline ? q - newline : L->col + (q - L->p);
+            L->p = q;
+        } else if (c == '#') {
+            lx_skip_line(L);
+        } else {
+            break;
         }
-        if (is_space(c)) {
-            lx_getc(L);
-            continue;
-        }
-        if (c == '#') {
-            while ((c = lx_peekc(L)) != EOF && c != '\n' && c != '\r')
-                lx_getc(L);
-            continue;
-        }
-        break;
     }
+    *out = L;
+    return LF_OK;
+}
+
+/* Past the rest of a string too long to keep: to its closing quote, the
+ * end of the line or of the file, as its scan would have stopped. */
+static void lx_skip_string(lx_frame *L)
+{
+    int c;
+    while ((c = lx_getc(L)) != EOF && c != '"' && c != '\n')
+        if (c == '\\' && lx_getc(L) == EOF)
+            return;
+}
+
+static int lex_string(parser *P, lexer *X, lx_frame *L, token *t, char *text)
+{
+    size_t n = 0;
+    t->kind = TK_STRING;
+    for (;;) {
+        int c = lx_getc(L);
+        if (c == EOF)
+            return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: end of file before the closing '\"'");
+        if (c == '\n')
+            return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: newline before the closing '\"'");
+        if (c == '"')
+            break;
+        if (n >= LX_MAX_STRING) {
+            lx_skip_string(L);
+            return perr(P, LF_ERR_PARSE, &t->loc,
+                        "string longer than %d bytes: expected its closing '\"' within that (file names, types and "
+                        "names are far shorter)",
+                        LX_MAX_STRING);
+        }
+        text[n++] = (char)c;
+        if (c == '\\') {
+            int e = lx_getc(L);
+            if (!is_escape_char(e))
+                return perr(P, LF_ERR_PARSE, &t->loc,
+                            e == EOF ? "unterminated string: end of file after '\\'"
+                                     : "unknown escape sequence in string");
+            text[n++] = (char)e; /* the store has room for one more than LX_MAX_STRING */
+            t->escaped = 1;
+        }
+    }
+    lx_text_end(X, text, n);
+    t->s = text;
+    t->n = n;
+    return LF_OK;
+}
+
+/* A bare token: a directive, a number, or true/false.  text[0] holds its
+ * first character. */
+static int lex_bare(parser *P, lexer *X, lx_frame *L, token *t, char *text)
+{
+    long long n = 1;
+    for (;;) { /* a window at a time; a bare token never holds a newline */
+        if (L->p == L->end && !lx_fill(L))
+            break;
+        const char *q = L->p;
+        for (; q < L->end && !is_bare_end((unsigned char)*q); q++, n++)
+            if (n < LX_MAX_BARE)
+                text[n] = *q;
+        L->col += q - L->p;
+        L->p = q;
+        if (q < L->end)
+            break;
+    }
+    char first = text[0];
+    int numeric = isdigit((unsigned char)first) || first == '-' || first == '+' || first == '.';
+    if (n >= LX_MAX_BARE) {
+        if (numeric) {
+            text[40] = '\0';
+            return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%s...\"", text);
+        }
+        /* not echoed: it may be the first token of a file that is no scene */
+        return perr(P, LF_ERR_PARSE, &t->loc,
+                    "a word of %lld characters: expected a directive, a number, true or false (at most %d "
+                    "characters)",
+                    n, LX_MAX_BARE - 1);
+    }
+    lx_text_end(X, text, (size_t)n);
+    t->s = text;
+    t->n = (size_t)n;
+    if (!numeric) {
+        t->kind = TK_WORD;
+        return LF_OK;
+    }
+    char *end;
+    double v = strtod(text, &end);
+    if (end != text + n)
+        return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%s\"", text);
+    if (!isfinite(v))
+        return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%s\"", text);
+    t->kind = TK_NUMBER;
+    t->num = v;
+    return LF_OK;
+}
+
+static int lex_scan(parser *P, lexer *X, token *t)
+{
     memset(t, 0, sizeof *t);
+    lx_frame *L = NULL;
+    int rc = lex_skip(P, X, &L);
+    if (rc)
+        return rc;
     t->loc = (lf_loc){L->file, L->line, L->col};
     t->dir = L->dir;
-    size_t start = L->pos;
     int c = lx_getc(L);
+    if (c == EOF) {
+        t->kind = TK_EOF;
+        return LF_OK;
+    }
     if (c == '[' || c == ']') {
         t->kind = c == '[' ? TK_LBRACK : TK_RBRACK;
-        t->s = L->text + start;
+        t->s = c == '[' ? "[" : "]";
         t->n = 1;
         return LF_OK;
     }
-    if (c == '"') {
-        t->kind = TK_STRING;
-        t->s = L->text + L->pos;
-        for (;;) {
-            c = lx_getc(L);
-            if (c == EOF)
-                return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: end of file before the closing '\"'");
-            if (c == '\n')
-                return perr(P, LF_ERR_PARSE, &t->loc, "unterminated string: newline before the closing '\"'");
-            if (c == '"')
-                break;
-            if (c == '\\') {
-                int e = lx_getc(L);
-                if (!is_escape_char(e))
-                    return perr(P, LF_ERR_PARSE, &t->loc,
-                                e == EOF ? "unterminated string: end of file after '\\'"
-                                         : "unknown escape sequence in string");
-                t->escaped = 1;
-            }
-        }
-        t->n = (size_t)(L->text + L->pos - 1 - t->s);
-        return LF_OK;
-    }
-    /* Bare token: a directive, a number, or true/false. */
-    while ((c = lx_peekc(L)) != EOF && !is_space(c) && c != '"' && c != '[' && c != ']' && c != '#')
-        lx_getc(L);
-    t->s = L->text + start;
-    t->n = L->pos - start;
-    char first = t->s[0];
-    if (isdigit((unsigned char)first) || first == '-' || first == '+' || first == '.') {
-        char buf[128];
-        if (t->n >= sizeof buf)
-            return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%.40s...\"", t->s);
-        memcpy(buf, t->s, t->n);
-        buf[t->n] = '\0';
-        char *end;
-        errno = 0;
-        double v = strtod(buf, &end);
-        if (end == buf || *end)
-            return perr(P, LF_ERR_PARSE, &t->loc, "invalid number \"%s\"", buf);
-        if (!isfinite(v))
-            return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%s\"", buf);
-        t->kind = TK_NUMBER;
-        t->num = v;
-        return LF_OK;
-    }
-    t->kind = TK_WORD;
-    return LF_OK;
+    char *text;
+    if (lx_text_begin(X, &text))
+        return nomem(P);
+    if (c == '"')
+        return lex_string(P, X, L, t, text);
+    text[0] = (char)c;
+    return lex_bare(P, X, L, t, text);
 }
 
 static int lex_next(parser *P, lexer *L, token *t)
@@ -728,6 +956,11 @@ static int add_value(parser *P, const token *t, lf_param_type type, const char *
 {
     char b[200];
     value_class vc = class_of(type);
+    if (a->n_nums + a->n_strs + a->n_bools >= MAX_PARAM_VALUES)
+        return perr(P, LF_ERR_PARSE, &t->loc,
+                    "parameter \"%s\" has more than %zu values: expected ']' (a mesh this large belongs in a PLY "
+                    "file)",
+                    decl, MAX_PARAM_VALUES);
     if (t->kind == TK_WORD && is_nonfinite_word(t))
         return perr(P, LF_ERR_NUMERIC, &t->loc, "non-finite number \"%.*s\" in parameter \"%s\"", (int)t->n, t->s,
                     decl);
@@ -946,6 +1179,7 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
 {
     for (;;) {
         token t;
+        size_t param_mark = lx_mark(L); /* a parameter's own copies are kept, not its tokens */
         int rc = lex_peek(P, L, &t);
         if (rc)
             return rc;
@@ -968,6 +1202,7 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
         if (v.kind == TK_LBRACK) {
             token open = v;
             for (;;) {
+                size_t value_mark = lx_mark(L); /* each value is kept parsed, its text released */
                 if ((rc = lex_next(P, L, &v)))
                     goto fail;
                 if (v.kind == TK_RBRACK)
@@ -981,12 +1216,13 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
                                             !is_nonfinite_word(&v))) {
                     unget_directive(L, &v); /* the parse goes on there */
                     char b[200];
-                    rc = perr(P, LF_ERR_PARSE, &v.loc, "expected a value or ']' to close the '[' at %d:%d, got %s",
+                    rc = perr(P, LF_ERR_PARSE, &v.loc, "expected a value or ']' to close the '[' at %lld:%lld, got %s",
                               open.loc.line, open.loc.col, describe(&v, b, sizeof b));
                     goto fail;
                 }
                 if ((rc = add_value(P, &v, type, decl, &a)))
                     goto fail;
+                lx_release(L, value_mark);
             }
         } else if (v.kind == TK_NUMBER || v.kind == TK_STRING ||
                    (v.kind == TK_WORD && (tok_is(&v, "true") || tok_is(&v, "false") || is_nonfinite_word(&v)))) {
@@ -1013,15 +1249,12 @@ static int parse_params(parser *P, lexer *L, lf_paramset *out)
         p.bools = a.bools;
         p.n_bools = a.n_bools;
         p.loc = t.loc;
-        if (replace_duplicate(out, &p)) {
-            free(decl);
-            continue;
-        }
-        if (lf_params_add(out, &p)) {
+        if (!replace_duplicate(out, &p) && lf_params_add(out, &p)) {
             rc = nomem(P);
             goto fail;
         }
         free(decl);
+        lx_release(L, param_mark);
         continue;
     fail:
         acc_free(&a);
@@ -1497,10 +1730,9 @@ static char *dir_of(const char *path)
  * for the top-level file). */
 static int push_file(parser *P, lexer *X, const char *path, const lf_loc *from)
 {
-    char *text;
-    size_t len;
+    lf_file_stream *in;
     lf_error fe = {0};
-    if (lf_file_read(path, LF_FILE_MAX_DEFAULT, &text, &len, NULL, &fe)) {
+    if (lf_file_stream_open(path, &in, &fe)) {
         if (fe.code == LF_ERR_NOMEM)
             return nomem(P);
         /* fe.msg is "path: what"; say which kind of file it was. */
@@ -1521,8 +1753,8 @@ static int push_file(parser *P, lexer *X, const char *path, const lf_loc *from)
     const char *kept_file = keep_string(P, path);
     const char *kept_dir = dir ? keep_string(P, dir) : NULL;
     free(dir);
-    if (!kept_file || !kept_dir || lx_push(X, text, text, len, kept_file, kept_dir)) {
-        free(text);
+    if (!kept_file || !kept_dir || lx_push(X, in, "", 0, kept_file, kept_dir, from)) {
+        lf_file_stream_close(in);
         return nomem(P);
     }
     return LF_OK;
@@ -2176,6 +2408,7 @@ static void recover(parser *P, lexer *L)
 {
     for (;;) {
         token t;
+        size_t mark = lx_mark(L); /* skipped tokens keep no text */
         int rc = lex_peek(P, L, &t);
         if (rc == LF_ERR_NOMEM || P->n_errors >= P->max_errors)
             return;
@@ -2184,6 +2417,7 @@ static void recover(parser *P, lexer *L)
         if (t.kind == TK_EOF || is_directive_like(&t))
             return;
         lex_next(P, L, &t);
+        lx_release(L, mark);
     }
 }
 
@@ -2192,7 +2426,7 @@ static void recover(parser *P, lexer *L)
 static int parse_run(parser *P, lexer *L, lf_loc *eof)
 {
     for (;;) {
-        lx_release_done(L);
+        lx_release(L, 0); /* the tokens of the directive before */
         if (P->n_errors >= P->max_errors) {
             char line[64];
             snprintf(line, sizeof line, "(stopped after %d errors)\n", P->n_errors);
@@ -2228,7 +2462,8 @@ static int parse_run(parser *P, lexer *L, lf_loc *eof)
              * echoed in messages. */
             perr(P, LF_ERR_PARSE, &t.loc, "\"%s\" is not a scene file (it does not begin with a directive): not "
                  "read further", top->file);
-            top->pos = top->len; /* its end: the lexer returns to the including file */
+            top->p = top->end; /* its end: the lexer returns to the including file */
+            top->at_end = 1;
             continue;
         }
         if (fn && from_top)
@@ -2408,7 +2643,7 @@ int lf_scene_parse_string_ex(const char *text, const char *name, const lf_parse_
             rc = nomem(&P);
     }
     lf_loc eof = {name, 1, 1};
-    if (!rc && lx_push(&L, NULL, text ? text : "", text ? strlen(text) : 0, file, dir))
+    if (!rc && lx_push(&L, NULL, text ? text : "", text ? strlen(text) : 0, file, dir, NULL))
         rc = nomem(&P);
     if (!rc)
         P.main_dir = out->scene_dir = dir;

@@ -189,6 +189,58 @@ Camera \"perspective\"" ''; yes AttributeBegin | head -n 1000000; } | gzip -9 > 
 run "3. a million nested AttributeBegin refused at the depth limit (1 GB limit)" 1 'nested more than 10000 deep' \
   limited "$bin/lfrender" deep.pbrt.gz -o deep.exr --quiet
 
+# Scene files are read as streams, so a long line costs no memory: 1 GiB of
+# comment on one line of a 1 MB .pbrt.gz renders under the 1 GB limit (the
+# whole-file reader needed the line's size), and 2.1 GB of blanks on one line,
+# written into a FIFO, ends in a misspelt directive named at its exact
+# column, past 2^31 (the old int column overflowed), with the suggestion.
+scene "$look
+Camera \"perspective\"" 'LightSource "infinite" "rgb L" [0.5 0.5 0.5]' > head.pbrt
+python3 - <<'PY'
+import struct, zlib
+head = open('head.pbrt', 'rb').read()
+c = zlib.compressobj(9, zlib.DEFLATED, -15)
+parts, crc, size = [b'\x1f\x8b\x08\x00\0\0\0\0\x00\xff'], 0, 0
+for data, times in ((head + b'#', 1), (b' ' * (1 << 20), 1024), (b'\nShape "sphere"\n', 1)):
+    block = c.compress(data) + c.flush(zlib.Z_FULL_FLUSH)
+    for _ in range(times):
+        parts.append(block); crc = zlib.crc32(data, crc); size += len(data)
+parts.append(c.flush() + struct.pack('<II', crc & 0xffffffff, size & 0xffffffff))
+open('line.pbrt.gz', 'wb').write(b''.join(parts))
+PY
+run "3. a 1 GiB comment line in a 1 MB .pbrt.gz renders (1 GB limit)" 0 '' \
+  limited "$bin/lfrender" line.pbrt.gz -o line.exr --quiet
+[ -s line.exr ] || bad "3. the 1 GiB comment line rendered no image"
+mkfifo blanks.pbrt
+timeout 300 python3 -c '
+import sys
+out = sys.stdout.buffer
+out.write(open("head.pbrt", "rb").read())
+block = b" " * (1 << 20)
+for _ in range(2100):
+    out.write(block)
+out.write(b"Shap \"sphere\"\n")' > blanks.pbrt 2>/dev/null &
+writer=$!
+run "3. 2.1 GB of blanks on one line: the error after them at its exact column (1 GB limit)" 1 \
+  "blanks.pbrt:7:$((2100 * 1048576 + 1)): unknown directive \"Shap\" \(did you mean Shape\?\)" \
+  limited "$bin/lfrender" blanks.pbrt -o blanks.exr --quiet
+kill "$writer" 2>/dev/null; wait "$writer" 2>/dev/null
+# Tokens are bounded instead: a 70,000-byte string, a 200-letter word and a
+# 200-digit number are each refused at their place, with what was expected.
+scene "$look
+Camera \"perspective\"" "LightSource \"infinite\"
+Shape \"sphere\" \"string name\" \"$(head -c 70000 /dev/zero | tr '\0' a)\"
+$(head -c 200 /dev/zero | tr '\0' W)
+Shape \"sphere\" \"float radius\" [ 1$(head -c 199 /dev/zero | tr '\0' 0) ]" > long.pbrt
+run "3. a 70,000-byte string refused at its place" 1 \
+  "long.pbrt:7:30: string longer than 65536 bytes: expected its closing '\"' within that" \
+  "$bin/lfrender" long.pbrt -o long.exr --quiet
+grep -q 'long.pbrt:8:1: a word of 200 characters: expected a directive, a number, true or false' err.txt ||
+  bad "3. a 200-letter word not refused at 8:1: $(head -c 400 err.txt)"
+grep -q 'long.pbrt:9:33: invalid number "1000000000' err.txt ||
+  bad "3. a 200-digit number not refused at 9:33: $(head -c 400 err.txt)"
+if grep -q WWWWWWWWWW err.txt; then bad "3. the long word was echoed"; fi
+
 # .ply.gz bombs: the header is read first and bounds what is inflated.  One
 # declares a triangle and hides 1.5 GB of zeros after it (4 MB on disk);
 # the other declares 10^12 vertices in a few bytes.

@@ -213,6 +213,66 @@ static void test_include_tokens(void)
     CHECK_MSG(strstr(err.msg, "\\x01\\x02garbage"), "%s", err.msg);
 }
 
+/* Files are read through a 64 KiB window: every token must read the same
+ * when the window ends inside it.  The Shape line is pushed across the
+ * boundary a byte at a time, plain and gzipped (stored blocks of 4000
+ * bytes, so inflate's output ends elsewhere too); the values, the decoded
+ * string and the column must equal those of the text given whole. */
+static void test_window_boundaries(void)
+{
+    const char *body = "Shape \"sphere\" \"float radius\" 2.5 # a comment\n"
+                       "  \"string name\" \"ab\\\"cd\" \"float zmin\" [ -1.25e0 ]\nShape \"disk\"\n";
+    size_t nh = strlen(HEAD), nb = strlen(body), bad = 0;
+    char *text = malloc(nh + 100000 + nb + 1);
+    CHECK(text != NULL);
+    if (!text)
+        return;
+    for (size_t pad = 65536 - nh - 80; pad <= 65536 - nh + 8; pad++) {
+        memcpy(text, HEAD, nh);
+        memset(text + nh, ' ', pad);
+        memcpy(text + nh + pad, body, nb + 1);
+        write_text("window.pbrt", text);
+        write_gz("window.pbrt.gz", text, 4000);
+        for (int k = 0; k < 3; k++) {
+            lf_scene_desc d;
+            lf_error err = {0};
+            int rc = k == 2 ? lf_scene_parse_string(text, "window.pbrt", &d, &err)
+                            : lf_scene_parse_file(path_of(k ? "window.pbrt.gz" : "window.pbrt"), &d, &err);
+            if (rc) {
+                if (bad++ < 3)
+                    CHECK_MSG(0, "pad %zu, %s: %s", pad, k == 2 ? "text" : k ? "gzip" : "file", err.msg);
+                continue;
+            }
+            const lf_param *r = lf_params_peek(&d.shapes[0].e.params, "radius");
+            const lf_param *n = lf_params_peek(&d.shapes[0].e.params, "name");
+            const lf_param *z = lf_params_peek(&d.shapes[0].e.params, "zmin");
+            int same = d.n_shapes == 2 && r && r->nums[0] == 2.5 && n && n->n_strs == 1 &&
+                       !strcmp(n->strs[0], "ab\"cd") && z && z->n_nums == 1 && z->nums[0] == -1.25 &&
+                       d.shapes[0].e.loc.line == 3 && d.shapes[0].e.loc.col == (long long)pad + 1 &&
+                       z->loc.line == 4 && z->loc.col == 26 && d.shapes[1].e.loc.line == 5;
+            if (!same && bad++ < 3)
+                CHECK_MSG(0, "pad %zu (%s): values or places differ", pad, k == 2 ? "text" : k ? "gzip" : "file");
+            lf_scene_desc_free(&d);
+        }
+    }
+    CHECK_MSG(bad == 0, "%zu parses differed", bad);
+    /* a gzipped scene cut short after 100 KB: the parse reads up to the
+     * damage, then names the file and what is wrong with it */
+    memset(text + nh, ' ', 100000);
+    memcpy(text + nh + 100000, body, nb + 1);
+    size_t ng;
+    unsigned char *g = gzip_stored(text, strlen(text), 4000, &ng);
+    write_bytes("cut.pbrt.gz", g, ng - 10);
+    free(g);
+    lf_scene_desc d;
+    lf_error err = {0};
+    CHECK(lf_scene_parse_file(path_of("cut.pbrt.gz"), &d, &err) == LF_ERR_PARSE);
+    CHECK_MSG(strstr(err.msg, "cannot read scene file") && strstr(err.msg, "cut.pbrt.gz") &&
+                  strstr(err.msg, "truncated"),
+              "%s", err.msg);
+    free(text);
+}
+
 /* pbrt-v4 resolves names against the main file's directory; lensfield tries
  * the naming file's directory first, then the main one. */
 static void test_nested_paths(void)
@@ -480,6 +540,7 @@ int main(void)
     mkdir(sub, 0755);
     test_file_read();
     test_include_tokens();
+    test_window_boundaries();
     test_spectrum_files();
     test_nested_paths();
     test_metal_spectrum_rgb();

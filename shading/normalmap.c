@@ -37,8 +37,9 @@ void lf_normal_maps_free(lf_normal_maps *c)
     free(c);
 }
 
-/* Undoes lf_image_read's sRGB decoding of 8-bit files: pbrt-v4 reads
- * normal maps with ColorEncoding::Linear. */
+/* Undoes lf_image_read's sRGB decoding of 8-bit formats: pbrt-v4 reads
+ * normal maps with ColorEncoding::Linear.  The continuous inverse of the
+ * sRGB curve, so 16-bit PNGs keep their precision. */
 static void undo_srgb(lf_image *img)
 {
     size_t n = (size_t)img->width * (size_t)img->height;
@@ -46,7 +47,8 @@ static void undo_srgb(lf_image *img)
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < nc && c < 3; c++) {
             float *v = &img->data[i * (size_t)nc + (size_t)c];
-            *v = (float)lf_srgb_encode(*v) / 255.f;
+            double x = *v > 0.f ? (*v < 1.f ? *v : 1.0) : 0.0;
+            *v = (float)(x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055);
         }
 }
 

@@ -65,7 +65,7 @@ stub_for() { # path -> the stub to link there, or nothing
 # every file name the scene folders mention, stubbed where missing (names
 # are looked up next to the top-level scene, as pbrt-v4 resolves them)
 cd "$work/tree" || exit 1
-grep -RhoE '"(string filename|string mapname|string lensfile|spectrum [A-Za-z_]+)"[[:space:]]*\[?[[:space:]]*"[^"]+"|^[[:space:]]*(Include|Import)[[:space:]]+"[^"]+"' \
+grep -RhoE '"(string filename|string mapname|string normalmap|string lensfile|spectrum [A-Za-z_]+)"[[:space:]]*\[?[[:space:]]*"[^"]+"|^[[:space:]]*(Include|Import)[[:space:]]+"[^"]+"' \
     --include='*.pbrt' . 2>/dev/null | sed -E 's/.*"([^"]+)"$/\1/' | sort -u >"$work/names"
 for d in */; do
     while read -r name; do

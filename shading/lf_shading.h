@@ -341,6 +341,23 @@ float lf_named_glass_eta(const char *name, float lambda_nm);
  * unchanged.  Malloc'ed; NULL when out of memory.  For the texture,
  * material and environment-map files. */
 char *lf_shading_resolve_path(const char *scene_file, const char *scene_dir, const char *filename);
+/* Is the file an 8-bit format (PNG, JPEG, ...), which lf_image_read decodes
+ * from sRGB? */
+int lf_shading_is_8bit_image(const char *path);
+
+/* Normal maps ("string normalmap"), read once per resolved path: the cache
+ * owns the images (lf_normal_map_get creates it on first use). */
+typedef struct lf_normal_maps lf_normal_maps;
+struct lf_image;
+/* The map at path, read with a linear encoding as pbrt-v4 does; an error
+ * (no file, fewer than three channels) without a location: callers add it. */
+int lf_normal_map_get(lf_normal_maps **cache, const char *path, const struct lf_image **out, lf_error *err);
+void lf_normal_maps_free(lf_normal_maps *c); /* accepts NULL */
+/* pbrt-v4's NormalMap: the map's rgb at (u, 1 - v) (bilinear, repeat) as
+ * 2 rgb - 1, normalised, in the frame x = dp/du orthogonalised against ns,
+ * y = ns x x, z = ns, becomes the shading normal (on ng's side); dp/du is
+ * re-orthogonalised around it.  Writes the new context to out. */
+void lf_normal_map_shading(const struct lf_image *map, const lf_shading_ctx *ctx, lf_shading_ctx *out);
 
 #ifdef __cplusplus
 }

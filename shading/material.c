@@ -7,13 +7,14 @@
  * measured (RGL .bsdf files, measured.c), hair (hair.c), subsurface (a
  * random walk in the renderer, render/subsurface.c) and interface ("",
  * "none").  "displacement" bump-maps the shading normal (lf_bump_shading);
- * "normalmap" is read and ignored with a
- * warning.
+ * "normalmap" replaces it from a tangent-space image (normalmap.c), and
+ * wins over "displacement" as in pbrt-v4.
  */
 #include "lf_shading.h"
 
 #include "base/lf_color.h"
 #include "base/lf_params.h"
+#include "image/lf_image.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -70,6 +71,7 @@ struct lf_material {
     float ss_g, ss_exit_c;
     lf_tex_input displacement; /* bump map (pbrt-v4 "float displacement"), when bump */
     int bump;
+    const lf_image *normal_map; /* "normalmap", owned by lf_materials' cache; NULL if none */
     lf_loc loc;
 };
 
@@ -79,6 +81,7 @@ struct lf_materials {
     lf_material def; /* index -1 */
     lf_texture_list texs;
     lf_warnings warnings;
+    lf_normal_maps *nmaps; /* one image per normal map file */
 };
 
 /* --------------------------------------------------------- named glasses */
@@ -446,6 +449,20 @@ static int read_measured_or_hair(lf_paramset *ps, const char *type, const lf_tex
     return read_hair(ps, texs, m, warnings, loc, err);
 }
 
+/* pbrt-v4 resolves the name as other files and reads each file once. */
+static int read_normal_map(lf_materials *ms, const char *fn, const lf_loc *loc, lf_material *m, lf_error *err)
+{
+    char *path = lf_shading_resolve_path(loc->file, ms->texs.scene_dir, fn);
+    if (!path)
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    lf_error ierr = {0};
+    int rc = lf_normal_map_get(&ms->nmaps, path, &m->normal_map, &ierr);
+    free(path);
+    if (rc)
+        return lf_error_at(err, rc, loc, "%s: \"normalmap\": %s", m->type, ierr.msg);
+    return LF_OK;
+}
+
 static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_error *err)
 {
     lf_paramset *ps = &md->e.params;
@@ -546,10 +563,11 @@ static int build_one(lf_material_desc *md, lf_materials *ms, lf_material *m, lf_
             m->bump = 1;
         }
         const lf_param *np = lf_params_peek(ps, "normalmap");
-        if (np) {
-            const char *fn = lf_params_string(ps, "normalmap", "");
-            if (fn && *fn)
-                lf_warn_at(&ms->warnings, &np->loc, "%s: \"normalmap\" \"%s\" is not supported; ignored", m->type, fn);
+        const char *fn = np ? lf_params_string(ps, "normalmap", "") : NULL;
+        if (fn && *fn) {
+            rc = read_normal_map(ms, fn, &np->loc, m, err);
+            if (rc)
+                return rc;
         }
     }
     if (m->kind == MAT_COATED_DIFFUSE || m->kind == MAT_COATED_CONDUCTOR) {
@@ -673,6 +691,7 @@ void lf_materials_free(lf_materials *ms)
         lf_texture_free(ms->texs.items[i]);
     free(ms->texs.items);
     lf_warnings_free(&ms->warnings);
+    lf_normal_maps_free(ms->nmaps);
     free(ms);
 }
 
@@ -708,7 +727,7 @@ int lf_material_uses_textures(const lf_material *mat)
         for (size_t i = 0; i < sizeof in / sizeof in[0]; i++)
             if (in[i]->tex)
                 return 1;
-        if (mat->kind == MAT_HAIR) /* h across the fibre is the hit's v */
+        if (mat->kind == MAT_HAIR || mat->normal_map) /* h across the fibre is the hit's v; maps read (u,v) */
             return 1;
         if (mat->kind != MAT_MIX)
             return 0;
@@ -832,7 +851,10 @@ void lf_material_bsdf(const lf_material *mat, const lf_shading_ctx *ctx, lf_bsdf
     if (mat->kind == MAT_MIX)
         mat = lf_material_resolve(mat, ctx, hash_position(ctx->p));
     lf_shading_ctx bumped;
-    if (mat->bump && ctx->has_derivs) {
+    if (mat->normal_map) {
+        lf_normal_map_shading(mat->normal_map, ctx, &bumped);
+        ctx = &bumped;
+    } else if (mat->bump && ctx->has_derivs) {
         lf_bump_shading(&mat->displacement, ctx, &bumped);
         ctx = &bumped;
     }

@@ -205,6 +205,8 @@ static int is_8bit_format(const char *path)
            !strcasecmp(e, "bmp") || !strcasecmp(e, "gif");
 }
 
+int lf_shading_is_8bit_image(const char *path) { return is_8bit_format(path); }
+
 static char *join_dir(const char *dir, size_t dl, const char *filename)
 {
     size_t fl = strlen(filename);

@@ -1,5 +1,5 @@
 /* test_render_material_scenes.c - the example scenes of issue 30's materials
- * and textures (scenes/pbrt-v4/{textures,measured,hair,subsurface}.pbrt)
+ * and textures (scenes/pbrt-v4/{textures,measured,hair,subsurface,normalmap}.pbrt)
  * parse, build with every parameter used and nothing refused or warned
  * about, and render to finite, lit images.  Each scene's subject is checked
  * by a number the scene predicts: see the per-scene comments. */
@@ -136,8 +136,59 @@ static void test_subsurface_scene(void)
     lf_image_free(&img);
 }
 
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* normalmap.pbrt: under a distant light of irradiance pi at angle theta
+ * (cos = 2.2 / |(-2, 2.2, 1)|) a plain diffuse square (albedo 0.5) has
+ * radiance 0.5 cos theta everywhere.  The normal-mapped square's domes
+ * (caps tilting up to asin(1 / 1.4) = 45.6 deg, about theta) reach close to
+ * 0.5 facing the light and 0 facing away; the flat ground between them
+ * (56 % of the area) stays at the plain value, so the median does.  Which
+ * image half holds which square is found from the spread (the plain one
+ * has none), not assumed. */
+static void test_normalmap_scene(void)
+{
+    lf_image img;
+    if (render_file(LF_SOURCE_DIR "/scenes/pbrt-v4/normalmap.pbrt", 4, &img))
+        return;
+    const double plain = 0.5 * 2.2 / sqrt(4 + 2.2 * 2.2 + 1);
+    float *v[2];
+    int n = 130 * 130, bad = 0;
+    double lo[2], hi[2], med[2];
+    for (int h = 0; h < 2; h++) {
+        v[h] = malloc(sizeof(float) * (size_t)n);
+        if (!v[h])
+            return;
+        int k = 0;
+        for (int y = 15; y < 145; y++)
+            for (int x = 0; x < 130; x++) {
+                float g = lf_image_px(&img, (h ? 175 : 15) + x, y)[1];
+                bad += !isfinite(g);
+                v[h][k++] = g;
+            }
+        qsort(v[h], (size_t)n, sizeof(float), cmp_float);
+        lo[h] = v[h][0], hi[h] = v[h][n - 1], med[h] = v[h][n / 2];
+        free(v[h]);
+    }
+    int m = hi[1] - lo[1] > hi[0] - lo[0]; /* the mapped half */
+    printf("normalmap: plain %g..%g, mapped %g..%g median %g, want plain %g\n", lo[1 - m], hi[1 - m], lo[m], hi[m],
+           med[m], plain);
+    CHECK_MSG(bad == 0, "%d non-finite pixels", bad);
+    CHECK_MSG(fabs(lo[1 - m] / plain - 1) < 0.01 && fabs(hi[1 - m] / plain - 1) < 0.01, "plain square %g..%g, want %g",
+              lo[1 - m], hi[1 - m], plain);
+    CHECK_MSG(fabs(med[m] / plain - 1) < 0.02, "mapped square's median %g, want %g", med[m], plain);
+    CHECK_MSG(hi[m] > 1.3 * plain && lo[m] < 0.3 * plain, "mapped square %g..%g, want beyond %g..%g", lo[m], hi[m],
+              0.3 * plain, 1.3 * plain);
+    lf_image_free(&img);
+}
+
 int main(void)
 {
+    test_normalmap_scene();
     test_subsurface_scene();
     test_textures_scene();
     test_measured_scene();

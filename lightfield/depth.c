@@ -134,7 +134,7 @@ typedef struct cost_ctx {
     float alpha;         /* defocus weight */
     int occlusion;
     int cubic;           /* 1: views looked up by Keys cubic convolution, 0: bilinear */
-    int line_gate;       /* 1: a line subset competes only where its contrast is the best (select_subsets) */
+    int half_gate;       /* 1: a half aperture competes only where its contrast is the best (select_subsets) */
     float *cost;         /* [label][pixel] */
     float *rawd;         /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     float *scratch;      /* per thread: (NGROUPS * NFIELDS + 13) * ns + 12 floats */
@@ -344,15 +344,17 @@ LF_HOT_LOOP static void track_full(const float *restrict acc, float *restrict w,
     }
 }
 
-/* Per pixel of a row, which line subsets compete (occlusion 2, the line
- * gate on).  A line holds the 8 views along one direction: where the
- * texture runs along it (stripes, an edge) its curve is flat and low at
- * every label, and where the texture repeats along it its curve has a
- * false minimum a period away; a per-label minimum over the subsets takes
- * every such label.  So a line competes only where its contrast (mean
- * minus minimum over the labels) is the largest of all 12 subsets' (a gap
- * between two occluders, seen only along it); the 8 half apertures always
- * compete.  sub[s][l][x], s < 8 the halves; the least into cost. */
+/* Per pixel of a row, which half apertures compete (occlusion 2, the
+ * gate on).  Each half's curve has false minima of its own where the
+ * texture repeats or runs along some of its views (stripes, checks, the
+ * grout of a floor seen at a grazing angle), and a per-label minimum over
+ * the 8 halves takes every one of them: the curve handed on is their
+ * union.  Wang et al. (ICCV 2015) take one half per pixel, the one the
+ * occluding edge's orientation picks; here it is the half whose curve has
+ * the largest contrast (mean minus minimum over the labels), and a half
+ * competes only where its contrast is the largest of all 12 subsets'.  The
+ * 4 lines always compete: a gap between two occluders is seen only along
+ * one of them.  sub[s][l][x], s < 8 the halves; the least into cost. */
 static void select_subsets(const float *sub, int L, int ns, float *cost, size_t np)
 {
     for (int x = 0; x < ns; x++) {
@@ -371,7 +373,7 @@ static void select_subsets(const float *sub, int L, int ns, float *cost, size_t 
         for (int l = 0; l < L; l++) {
             float v = FLT_MAX;
             for (int s = 0; s < 12; s++)
-                if (s < 8 || con[s] >= best) {
+                if (s >= 8 || con[s] >= best) {
                     float q = sub[((size_t)s * L + l) * ns + x];
                     v = q < v ? q : v;
                 }
@@ -390,7 +392,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
     float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
     float *rt = vt + 3 * (size_t)ns + 12; /* 5 * ns: the full aperture's winner (track_full) */
-    float *sub = c->line_gate && c->occlusion >= 2 ? rt + 5 * (size_t)ns : NULL; /* [subset][label][x] */
+    float *sub = c->half_gate && c->occlusion >= 2 ? rt + 5 * (size_t)ns : NULL; /* [subset][label][x] */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
         const float *cref = c->ref + (size_t)y * ns * 3;
@@ -1021,7 +1023,7 @@ static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lig
 {
     int ns = lf->ns, nt = lf->nt;
     size_t np = (size_t)ns * nt;
-    /* the row's per-subset curves (the line gate): 12 x labels x ns */
+    /* the row's per-subset curves (the half gate): 12 x labels x ns */
     size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12 + (size_t)12 * nl * ns;
     size_t gf_scratch = 10 * np;
     *w = (depth_work){
@@ -1106,7 +1108,7 @@ static int build_cost_volume(depth_work *w, lf_error *err)
         .alpha = o->defocus_weight >= 0 ? (float)o->defocus_weight : DEFAULT_DEFOCUS_WEIGHT,
         .occlusion = o->occlusion,
         .cubic = o->interp != 1,
-        .line_gate = o->line_gate >= 0,
+        .half_gate = o->half_gate >= 0,
         .cost = w->cost,
         .rawd = w->rawd,
         .scratch = w->scratch,

@@ -16,7 +16,8 @@
  * from the depth and score the depth again; the views from the 5x5 views
  * calibrated the same way.
  * Diagnostics (environment): LFD_VERBOSE=1 per-view and per-disparity
- * breakdowns; LFD_GTVIEW=1 the views from the ground-truth map; LFD_THIN=-1
+ * breakdowns; LFD_GTVIEW=1 the views from the ground-truth map; LFD_HALF_GATE=-1
+ * without the half gate of the occlusion subsets; LFD_THIN=-1
  * without the thin-structure step (LFD_THIN_RATIO its ratio); LFD_DUMP=DIR
  * writes the 5x5 map (disp5.f32, conf5.f32: 512 x 512 floats) and each
  * synthesised view (syn_R_C.f32: RGB floats, linear) for offline analysis;
@@ -242,6 +243,8 @@ int main(int argc, char **argv)
                 o.thin = atoi(getenv("LFD_THIN"));
             if (getenv("LFD_THIN_RATIO"))
                 o.thin_ratio = atof(getenv("LFD_THIN_RATIO"));
+            if (getenv("LFD_HALF_GATE"))
+                o.half_gate = atoi(getenv("LFD_HALF_GATE"));
             double s = lf_seconds(), sc = bench_cpu_seconds();
             if (lf_lightfield_depth(&lf, &o, &disp, &conf, &err)) {
                 fprintf(stderr, "bench_lf_backgammon: %s\n", err.msg);

@@ -134,6 +134,7 @@ typedef struct cost_ctx {
     float alpha;         /* defocus weight */
     int occlusion;
     int cubic;           /* 1: views looked up by Keys cubic convolution, 0: bilinear */
+    int half_gate;       /* 1: a half aperture competes only where its contrast is the best (select_subsets) */
     float *cost;         /* [label][pixel] */
     float *rawd;         /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     float *scratch;      /* per thread: (NGROUPS * NFIELDS + 13) * ns + 12 floats */
@@ -244,7 +245,7 @@ LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float 
  * half being 9 consecutive groups (rays h-2..h+2 and the octants between);
  * w: 5 * ns scratch. */
 LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w, float *restrict out, int ns,
-                                    float alpha, float worst, int occlusion)
+                                    float alpha, float worst, int occlusion, float *restrict sub, size_t sstride)
 {
     float *restrict w0 = w, *restrict w1 = w + ns, *restrict w2 = w + 2 * ns, *restrict w3 = w + 3 * ns,
                     *restrict w4 = w + 4 * ns;
@@ -273,11 +274,14 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
         }
     }
     for (int h = 0; h < 8; h++) {
+        float *so = sub ? sub + (size_t)h * sstride : NULL;
         for (int x = 0; x < ns; x++) {
             float n = w4[x] > 0.f ? w4[x] : 1.f;
             float c = (w0[x] + alpha * (fabsf(w1[x]) + fabsf(w2[x]) + fabsf(w3[x]))) / n;
             c = w4[x] > 0.f ? c : worst;
             out[x] = c < out[x] ? c : out[x];
+            if (so)
+                so[x] = c;
         }
         if (h == 7) {
             if (occlusion < 2)
@@ -294,6 +298,8 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
                                         fabsf(a[3 * ns + x] + b[3 * ns + x]))) / n;
                     c = nn > 0.f ? c : worst;
                     out[x] = c < out[x] ? c : out[x];
+                    if (sub)
+                        sub[(size_t)(8 + k) * sstride + x] = c;
                 }
             }
             break;
@@ -338,6 +344,44 @@ LF_HOT_LOOP static void track_full(const float *restrict acc, float *restrict w,
     }
 }
 
+/* Per pixel of a row, which half apertures compete (occlusion 2, the
+ * gate on).  Each half's curve has false minima of its own where the
+ * texture repeats or runs along some of its views (stripes, checks, the
+ * grout of a floor seen at a grazing angle), and a per-label minimum over
+ * the 8 halves takes every one of them: the curve handed on is their
+ * union.  Wang et al. (ICCV 2015) take one half per pixel, the one the
+ * occluding edge's orientation picks; here it is the half whose curve has
+ * the largest contrast (mean minus minimum over the labels), and a half
+ * competes only where its contrast is the largest of all 12 subsets'.  The
+ * 4 lines always compete: a gap between two occluders is seen only along
+ * one of them.  sub[s][l][x], s < 8 the halves; the least into cost. */
+static void select_subsets(const float *sub, int L, int ns, float *cost, size_t np)
+{
+    for (int x = 0; x < ns; x++) {
+        float con[12], best = 0;
+        for (int s = 0; s < 12; s++) {
+            const float *c = sub + (size_t)s * L * ns + x;
+            double m = 0;
+            float mn = FLT_MAX;
+            for (int l = 0; l < L; l++) {
+                float v = c[(size_t)l * ns];
+                m += v, mn = v < mn ? v : mn;
+            }
+            con[s] = (float)(m / L) - mn;
+            best = con[s] > best ? con[s] : best;
+        }
+        for (int l = 0; l < L; l++) {
+            float v = FLT_MAX;
+            for (int s = 0; s < 12; s++)
+                if (s >= 8 || con[s] >= best) {
+                    float q = sub[((size_t)s * L + l) * ns + x];
+                    v = q < v ? q : v;
+                }
+            cost[(size_t)l * np + x] = v;
+        }
+    }
+}
+
 static void cost_rows(void *vctx, int y0, int y1, int tid)
 {
     cost_ctx *c = vctx;
@@ -348,6 +392,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
     float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
     float *rt = vt + 3 * (size_t)ns + 12; /* 5 * ns: the full aperture's winner (track_full) */
+    float *sub = c->half_gate && c->occlusion >= 2 ? rt + 5 * (size_t)ns : NULL; /* [subset][label][x] */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
         const float *cref = c->ref + (size_t)y * ns * 3;
@@ -404,10 +449,13 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
                              xb);
                 }
             }
-            combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion);
+            combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion,
+                        sub ? sub + (size_t)l * ns : NULL, (size_t)c->nlabels * ns);
             if (c->rawd)
                 track_full(acc, w, rt, ns, l);
         }
+        if (sub)
+            select_subsets(sub, c->nlabels, ns, c->cost + (size_t)y * ns, np);
         if (c->rawd)
             for (int x = 0; x < ns; x++) {
                 double off = 0, cm = rt[2 * ns + x], cp = rt[3 * ns + x], cb = rt[x];
@@ -975,7 +1023,8 @@ static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lig
 {
     int ns = lf->ns, nt = lf->nt;
     size_t np = (size_t)ns * nt;
-    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12;
+    /* the row's per-subset curves (the half gate): 12 x labels x ns */
+    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12 + (size_t)12 * nl * ns;
     size_t gf_scratch = 10 * np;
     *w = (depth_work){
         .lf = lf,
@@ -1059,6 +1108,7 @@ static int build_cost_volume(depth_work *w, lf_error *err)
         .alpha = o->defocus_weight >= 0 ? (float)o->defocus_weight : DEFAULT_DEFOCUS_WEIGHT,
         .occlusion = o->occlusion,
         .cubic = o->interp != 1,
+        .half_gate = o->half_gate >= 0,
         .cost = w->cost,
         .rawd = w->rawd,
         .scratch = w->scratch,

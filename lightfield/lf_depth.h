@@ -47,6 +47,8 @@ typedef struct lf_lightfield_depth_opts {
     double eps;          /* guided-filter regulariser (colour guide in [0,1]); <= 0: 1e-3 */
     int occlusion;       /* 0: full aperture only; 1: best of 8 half apertures too; 2 (default): and of
                           * the 4 lines through the reference */
+    int half_gate;       /* occlusion 2: a half aperture competes only where its cost contrast is the
+                          * largest of the 12 subsets' (stripes, repetitive texture); 0 default (on), < 0 off */
     double defocus_weight; /* weight of the defocus cue against correspondence; < 0: default (docs/depth.md) */
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
     int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */

@@ -270,6 +270,36 @@ float lf_srgb_decode(unsigned char v)
     return (float)srgb_to_linear(v / 255.0);
 }
 
+/* Every channel but alpha from sRGB to linear, in place.  An 8-bit file
+ * arrives as floats k / 255, so the curve is tabulated for the 256 codes,
+ * in both ways the float can have been formed (k / 255 rounded once, or
+ * k times 1/255f): the result is bit for bit what srgb_to_linear gives
+ * (one pow per sample took 8 % of `lftool depth` on a 9 x 9 x 512^2 PNG
+ * folder); other values (16-bit files) take the curve itself. */
+static void srgb_decode_image(lf_image *img, int alpha_channel)
+{
+    float fa[256], fb[256], ta[256], tb[256];
+    for (int k = 0; k < 256; k++) {
+        fa[k] = (float)(k / 255.0), fb[k] = (float)k * (1.0f / 255.0f);
+        ta[k] = (float)srgb_to_linear(fa[k]), tb[k] = (float)srgb_to_linear(fb[k]);
+    }
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t p = 0; p < n; p++)
+        for (int c = 0; c < img->channels; c++) {
+            if (c == alpha_channel)
+                continue;
+            float *v = &img->data[p * (size_t)img->channels + (size_t)c];
+            float q = *v * 255.f + 0.5f;
+            int k = q >= 0.f && q < 256.f ? (int)q : -1;
+            if (k >= 0 && *v == fa[k])
+                *v = ta[k];
+            else if (k >= 0 && *v == fb[k])
+                *v = tb[k];
+            else
+                *v = (float)srgb_to_linear(*v);
+        }
+}
+
 /* ------------------------------------------------------------ comparison */
 
 int lf_image_mse(const lf_image *a, const lf_image *b, double *mse, lf_error *err)
@@ -592,15 +622,8 @@ int lf_image_read(const char *path, lf_image *img, lf_attrs *attrs, lf_error *er
         lf_oiio_read_info info = {0, -1};
         if (!rc)
             rc = lf_oiio_read(path, path, &tmp, &info, err);
-        if (!rc && info.srgb_encoded) {
-            size_t n = (size_t)tmp.width * (size_t)tmp.height;
-            for (size_t p = 0; p < n; p++)
-                for (int c = 0; c < tmp.channels; c++)
-                    if (c != info.alpha_channel) {
-                        float *v = &tmp.data[p * (size_t)tmp.channels + (size_t)c];
-                        *v = (float)srgb_to_linear(*v);
-                    }
-        }
+        if (!rc && info.srgb_encoded)
+            srgb_decode_image(&tmp, info.alpha_channel);
     }
     if (!rc && attrs && (rc = attrs_move(attrs, &tmp_attrs)) != 0)
         rc = lf_error_set(err, rc, "cannot read '%s': out of memory for header attributes", path);

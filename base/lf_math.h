@@ -98,6 +98,10 @@ lf_transform lf_transform_rotate(double angle_deg, double ax, double ay, double 
 int lf_transform_look_at(const double eye[3], const double look[3], const double up[3], lf_transform *out);
 lf_transform lf_transform_compose(const lf_transform *a, const lf_transform *b); /* a * b */
 lf_transform lf_transform_inverse(const lf_transform *t);
+
+/* o = a^-1 for a 3 x 3 matrix (cofactors over the determinant); -1 when
+ * the determinant is 0 or not finite (o untouched). */
+int lf_mat3_inverse(const double a[3][3], double o[3][3]);
 int lf_transform_is_identity(const lf_transform *t);
 /* True if the transform swaps handedness (negative determinant of 3x3). */
 int lf_transform_swaps_handedness(const lf_transform *t);

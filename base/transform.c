@@ -502,3 +502,12 @@ lf_transform lf_decomposed_interpolate(const lf_decomposed *a, const lf_decompos
         t = lf_transform_identity();
     return t;
 }
+
+int lf_mat3_inverse(const double a[3][3], double o[3][3])
+{
+    double d = det3(a);
+    if (!(fabs(d) > 1e-300) || !isfinite(d))
+        return -1;
+    inv3(a, o, d);
+    return 0;
+}

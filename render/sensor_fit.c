@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "base/lf_color.h"
+#include "base/lf_math.h"
 #include "render/lf_sensor.h"
 #include "render/sensor_curves.h"
 
@@ -73,21 +74,6 @@ double lf_camera_fit_reflectance(int i, double l)
     return 0.05 + 0.85 / (1 + exp((l - (450.0 + 50.0 * (i - 20))) / 15.0));
 }
 
-static int invert3(const double a[3][3], double o[3][3])
-{
-    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    if (!(fabs(det) > 1e-300))
-        return -1;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            /* cofactor of a[j][i] over det */
-            int r0 = (j + 1) % 3, r1 = (j + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
-            o[i][j] = (a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]) / det;
-        }
-    return 0;
-}
-
 int lf_camera_xyz_fit(const lf_camera_curves *cc, double white_k, double F[3][3])
 {
     enum { N = LF_CAMERA_FIT_COUNT };
@@ -116,7 +102,7 @@ int lf_camera_xyz_fit(const lf_camera_curves *cc, double white_k, double F[3][3]
                 A[j][k] += cj * ck;
                 B[j][k] += xyz[i][j] / y_d * (y_i / g_i) * ck;
             }
-    if (invert3(A, Ai))
+    if (lf_mat3_inverse(A, Ai))
         return -1;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "base/lf_color.h"
+#include "base/lf_math.h"
 #include "base/lf_parallel.h"
 #include "render/lf_sensor.h"
 #include "render/sensor_curves.h"
@@ -30,24 +31,6 @@ static int band_of(double l)
 
 static const double srgb_to_xyz[3][3] = {
     {0.4124564, 0.3575761, 0.1804375}, {0.2126729, 0.7151522, 0.0721750}, {0.0193339, 0.1191920, 0.9503041}};
-
-static int invert3(const double a[3][3], double o[3][3])
-{
-    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    if (!(fabs(det) > 1e-300))
-        return -1;
-    o[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) / det;
-    o[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) / det;
-    o[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) / det;
-    o[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) / det;
-    o[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) / det;
-    o[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) / det;
-    o[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
-    o[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
-    o[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
-    return 0;
-}
 
 /* The filter curve of colour c (0 R, 1 G, 2 B; 3 the monochrome sensor),
  * a quantum-efficiency shape: "cie1931" uses the CIE 1931 matching
@@ -104,7 +87,7 @@ static int spectral_tables(const lf_camera_curves *cc, double T[3][3], double ba
             resp[c][k] += photons * curve(cc, pk, c, l);
     }
     double Pi[3][3];
-    if (invert3(P, Pi))
+    if (lf_mat3_inverse(P, Pi))
         return -1;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
@@ -185,7 +168,7 @@ int lf_sensor_film_matrix(const char *curves, double white_k, float out[3][3], l
     double T[3][3], bp[3], resp[4][3], F[3][3], Mi[3][3];
     if (!cc)
         return lf_error_set(err, LF_ERR_PARAM, "unknown camera curves \"%s\"", curves ? curves : "");
-    if (spectral_tables(cc, T, bp, resp) || lf_camera_xyz_fit(cc, white_k, F) || invert3(srgb_to_xyz, Mi))
+    if (spectral_tables(cc, T, bp, resp) || lf_camera_xyz_fit(cc, white_k, F) || lf_mat3_inverse(srgb_to_xyz, Mi))
         return lf_error_set(err, LF_ERR_INTERNAL, "sensor \"%s\": singular colour fit", curves);
     /* the photon-weighted responses back to energy: pbrt-v4's sensor RGB,
      * int L rbar dlambda / CIE_Y_integral, per unit band weight */
@@ -371,7 +354,7 @@ static void named_color_matrix(const lf_sensor *s, lf_raw_info *ri)
 {
     const lf_camera_curves *cc = lf_camera_curves_find(s->curves);
     double F[3][3], Fi[3][3], w[3] = {0}, wmax = 0;
-    if (!cc || s->cfa == LF_CFA_NONE || lf_camera_xyz_fit(cc, 6500.0, F) || invert3(F, Fi))
+    if (!cc || s->cfa == LF_CFA_NONE || lf_camera_xyz_fit(cc, 6500.0, F) || lf_mat3_inverse(F, Fi))
         return;
     for (int c = 0; c < 3; c++) {
         for (int k = 0; k < 3; k++)
@@ -398,7 +381,7 @@ void lf_sensor_raw_info(const lf_sensor *s, lf_raw_info *ri)
     if (s->cfa == LF_CFA_NONE)
         for (int c = 0; c < 3; c++)
             memcpy(C[c], s->e_per_unit[1], sizeof C[c]);
-    invert3(srgb_to_xyz, Mi);
+    lf_mat3_inverse(srgb_to_xyz, Mi);
     for (int c = 0; c < 3; c++) {
         n[c] = C[c][0] + C[c][1] + C[c][2];
         nmax = fmax(nmax, n[c]);

@@ -136,6 +136,9 @@ int lf_lightfield_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_er
  * missing (lf->valid), a view dark everywhere is missing whole.  Sets
  * views_rescaled, views_dark, gain_lo/hi; adds to missing. */
 int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err);
+/* The same on `threads` threads (<= 0: every core): views measured in
+ * parallel, applied in view order (the same result). */
+int lf_lightfield_equalize_threads(lf_lightfield *lf, int threads, lf_error *err);
 void lf_lightfield_free(lf_lightfield *lf); /* accepts a zeroed struct */
 
 /* Decodes a raw image (any channel count: 1 is grey, RGB(A) used as RGB).

@@ -124,7 +124,7 @@ static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_lay
     lf_error e = {0};
     if (check_grid(o, src, &e))
         return fail_named(src, &e, err);
-    if (!o->no_equalize && lf_lightfield_equalize(&src->lf, &e))
+    if (!o->no_equalize && lf_lightfield_equalize_threads(&src->lf, o->threads, &e))
         return fail_named(src, &e, err);
     return LF_OK;
 }

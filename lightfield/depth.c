@@ -22,18 +22,22 @@
 #include "lightfield/depth_internal.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))
+#define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx512f", "avx2", "default")))
 #else
 #define LF_HOT_LOOP
 #endif
 
 enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
+/* labels whose sums the cost volume's row loop keeps at once (cost_rows):
+ * 4 x 160 kB at 512 px, within a core's L2 */
+enum { LABEL_BLOCK = 4 };
 /* cost_rows' scratch per thread before the half gate's curves: the groups'
  * sums, combine_row's 5 rows, the vertical pass (interleaved, then 3
  * planes), the reference row's planes, track_full's 5 rows, the gate's
  * per-pixel sums (ns doubles); the first 14 rows after the groups' sums are
- * the gate's contrasts once the row's labels are done */
-#define COST_ROW_SCRATCH(ns) ((size_t)(NGROUPS * NFIELDS + 5 + 3 + 3 + 3 + 5 + 2) * (ns) + 26)
+ * the gate's contrasts once the row's labels are done; the groups' sums
+ * for LABEL_BLOCK labels */
+#define COST_ROW_SCRATCH(ns) ((size_t)(NGROUPS * NFIELDS * LABEL_BLOCK + 5 + 3 + 3 + 3 + 5 + 2) * (ns) + 26)
 
 /* Tuning constants the options do not expose (docs/depth.md, "Method",
  * gives each one's measurements). */
@@ -217,7 +221,7 @@ LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float
 
 /* Keys cubic convolution (a = -1/2) weights of the taps at -1, 0, 1, 2 for
  * a sample at phase f in [0, 1). */
-static void keys4(double f, float w[4])
+static inline void keys4(double f, float w[4])
 {
     double t = 1 + f;
     w[0] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
@@ -423,14 +427,61 @@ LF_HOT_LOOP static void select_subsets(const float *restrict sub, int L, int ns,
     }
 }
 
+/* One view's correspondence at one label along row y, added to its
+ * group's sums in acc (the label's NGROUPS x NFIELDS rows); vt, vp: the
+ * cubic lookup's vertical pass, interleaved and split into planes of vps;
+ * cp: the reference row's planes. */
+static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s, int y, float *acc, float *vt,
+                         float *vp, size_t vps, const float *cp)
+{
+    int ns = c->lf->ns, nt = c->lf->nt;
+    int ix = s->ix, xa = s->xa, xb = s->xb;
+    int r0 = y + s->iy, r1 = s->fy > 0.f ? r0 + 1 : r0;
+    if (r0 < 0 || r1 > nt - 1 || xa > xb)
+        return;
+    float *a = acc + (size_t)v->group * NFIELDS * ns;
+    if (c->cubic && !v->valid) {
+        /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
+        const float *rr[4];
+        for (int m = 0; m < 4; m++)
+            rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
+        size_t c0 = 3 * (size_t)(xa + ix - 1);
+        int n = xb - xa + 4;
+        vcomb(vt, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0], s->wy[1], s->wy[2], s->wy[3], 3 * n);
+        deinterleave3(vt, vp + xa, vp + vps + xa, vp + 2 * vps + xa, n);
+        view_row_cubic(a, ns, vp, vp + vps, vp + 2 * vps, cp, cp + ns, cp + 2 * ns, s->wx[0], s->wx[1], s->wx[2],
+                       s->wx[3], c->scale, c->tau, xa, xb);
+        return;
+    }
+    const float *cref = c->ref + (size_t)y * ns * 3;
+    float fx = s->fx, fy = s->fy;
+    const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
+    const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
+    int dx1 = fx > 0.f ? 3 : 0;
+    float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+    if (v->valid) {
+        /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
+        const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
+        int mx1 = fx > 0.f ? 1 : 0;
+        view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
+                        c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+    } else {
+        view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+    }
+}
+
+/* Rows [y0, y1) of the volume.  Labels are taken LABEL_BLOCK at a time,
+ * views outer: a view's rows, read again for the next labels of the block
+ * (their shifts differ by a fraction of a pixel), are still in cache.
+ * Each label's sums still add the views in order. */
 static void cost_rows(void *vctx, int y0, int y1, int tid)
 {
     cost_ctx *c = vctx;
     const lf_lightfield *lf = c->lf;
-    int ns = lf->ns, nt = lf->nt;
-    size_t np = (size_t)ns * nt;
-    float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
-    float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
+    int ns = lf->ns;
+    size_t np = (size_t)ns * lf->nt, gs = (size_t)NGROUPS * NFIELDS * ns;
+    float *acc = c->scratch + (size_t)tid * c->scratch_per_thread; /* LABEL_BLOCK labels' group sums */
+    float *w = acc + LABEL_BLOCK * gs;
     float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
     float *vp = vt + 3 * (size_t)ns + 12; /* 3 planes of ns + 4: the same, split by channel */
     size_t vps = (size_t)ns + 4;
@@ -440,53 +491,21 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     float *sub = c->half_gate && c->occlusion >= 2 ? (float *)(gm + ns) : NULL; /* [subset][label][x] */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
-        const float *cref = c->ref + (size_t)y * ns * 3;
-        deinterleave3(cref, cp, cp + ns, cp + 2 * ns, ns);
-        for (int l = 0; l < c->nlabels; l++) {
-            memset(acc, 0, sizeof(float) * NGROUPS * NFIELDS * ns);
-            for (int k = 0; k < c->nviews; k++) {
-                const dview *v = &c->views[k];
-                /* I_ref(x, y) = I_v(x - d du, y - d dv): the shift's parts from the table */
-                const label_view *s = &c->lv[(size_t)l * c->nviews + k];
-                int ix = s->ix, xa = s->xa, xb = s->xb;
-                int r0 = y + s->iy, r1 = s->fy > 0.f ? r0 + 1 : r0;
-                if (r0 < 0 || r1 > nt - 1 || xa > xb)
-                    continue;
-                if (c->cubic && !v->valid) {
-                    /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
-                    const float *rr[4];
-                    for (int m = 0; m < 4; m++)
-                        rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
-                    size_t c0 = 3 * (size_t)(xa + ix - 1);
-                    int n = xb - xa + 4;
-                    vcomb(vt, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0], s->wy[1], s->wy[2], s->wy[3],
-                          3 * n);
-                    deinterleave3(vt, vp + xa, vp + vps + xa, vp + 2 * vps + xa, n);
-                    view_row_cubic(acc + (size_t)v->group * NFIELDS * ns, ns, vp, vp + vps, vp + 2 * vps, cp, cp + ns,
-                                   cp + 2 * ns, s->wx[0], s->wx[1], s->wx[2], s->wx[3], c->scale, c->tau, xa, xb);
-                    continue;
-                }
-                float fx = s->fx, fy = s->fy;
-                const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
-                const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
-                int dx1 = fx > 0.f ? 3 : 0;
-                float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
-                float *a = acc + (size_t)v->group * NFIELDS * ns;
-                if (v->valid) {
-                    /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
-                    const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
-                    int mx1 = fx > 0.f ? 1 : 0;
-                    view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
-                                    c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
-                } else {
-                    view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa,
-                             xb);
-                }
+        deinterleave3(c->ref + (size_t)y * ns * 3, cp, cp + ns, cp + 2 * ns, ns);
+        for (int l0 = 0; l0 < c->nlabels; l0 += LABEL_BLOCK) {
+            int nb = c->nlabels - l0 < LABEL_BLOCK ? c->nlabels - l0 : LABEL_BLOCK;
+            memset(acc, 0, sizeof(float) * gs * (size_t)nb);
+            for (int k = 0; k < c->nviews; k++)
+                for (int j = 0; j < nb; j++)
+                    add_view_row(c, &c->views[k], &c->lv[(size_t)(l0 + j) * c->nviews + k], y, acc + j * gs, vt, vp,
+                                 vps, cp);
+            for (int j = 0; j < nb; j++) {
+                int l = l0 + j;
+                combine_row(acc + j * gs, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst,
+                            c->occlusion, sub ? sub + (size_t)l * ns : NULL, (size_t)c->nlabels * ns);
+                if (c->rawd)
+                    track_full(acc + j * gs, w, rt, ns, l);
             }
-            combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion,
-                        sub ? sub + (size_t)l * ns : NULL, (size_t)c->nlabels * ns);
-            if (c->rawd)
-                track_full(acc, w, rt, ns, l);
         }
         if (sub)
             select_subsets(sub, c->nlabels, ns, c->cost + (size_t)y * ns, np, w, gm);
@@ -706,10 +725,10 @@ static float pixel_cost(const cost_ctx *c, const float *map, float map_max, int 
     for (int k = 0; k < c->nviews; k++) {
         const dview *v = &c->views[k];
         double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
-        int ix = (int)floor(sx), iy = (int)floor(sy);
-        float fx = (float)(sx - ix), fy = (float)(sy - iy);
-        if (ix < 1 || iy < 1 || ix > ns - 3 || iy > nt - 3)
+        if (!(sx >= 1 && sy >= 1 && sx < ns - 2 && sy < nt - 2)) /* ix, iy below in [1, ns - 3], [1, nt - 3] */
             continue;
+        int ix = (int)sx, iy = (int)sy; /* floor: positive here */
+        float fx = (float)(sx - ix), fy = (float)(sy - iy);
         if (map) {
             /* occluded in view k when a nearer pixel q = p + t (du, dv) of
              * the map lands on the sample: d_q >= d + t within half a pixel */
@@ -837,7 +856,7 @@ static void thin_take_rows(void *vctx, int y0, int y1, int tid)
 /* ---------- continuous refinement (Gauss-Newton on photo-consistency) ---------- */
 
 /* Derivatives of the Keys weights (keys4) with respect to the sample position. */
-static void keys4d(double f, float w[4])
+static inline void keys4d(double f, float w[4])
 {
     double t = 1 + f;
     w[0] = (float)(-1.5 * t * t + 5 * t - 4);
@@ -861,7 +880,7 @@ typedef struct gn_ctx {
  * of one view (cubic lookup) and its derivative J with respect to d, with a
  * Cauchy weight rho = 1 / (1 + |r|^2 / c^2) that lets a view seeing an
  * occluder drop out; added to A and B. */
-static void gn_rows(void *vctx, int y0, int y1, int tid)
+LF_HOT_LOOP static void gn_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
     gn_ctx *c = vctx;
@@ -873,9 +892,9 @@ static void gn_rows(void *vctx, int y0, int y1, int tid)
             double d = c->disp[i];
             const float *p = c->ref + 3 * i;
             double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
-            int ix = (int)floor(sx), iy = (int)floor(sy);
-            if (ix < 1 || iy < 1 || ix > w - 3 || iy > h - 3)
+            if (!(sx >= 1 && sy >= 1 && sx < w - 2 && sy < h - 2)) /* ix, iy below in [1, w - 3], [1, h - 3] */
                 continue;
+            int ix = (int)sx, iy = (int)sy; /* floor: positive here */
             float wx[4], wy[4], gx[4], gy[4];
             keys4(sx - ix, wx), keys4(sy - iy, wy), keys4d(sx - ix, gx), keys4d(sy - iy, gy);
             float val[3] = {0, 0, 0}, dx[3] = {0, 0, 0}, dy[3] = {0, 0, 0};

@@ -32,7 +32,7 @@ enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
  * 4 x 160 kB at 512 px, within a core's L2 */
 enum { LABEL_BLOCK = 4 };
 /* cost_rows' scratch per thread before the half gate's curves: the groups'
- * sums, combine_row's 5 rows, the vertical pass (interleaved, then 3
+ * sums, combine_row's 5 rows, 3 spare rows, the vertical pass (3
  * planes), the reference row's planes, track_full's 5 rows, the gate's
  * per-pixel sums (ns doubles); the first 14 rows after the groups' sums are
  * the gate's contrasts once the row's labels are done; the groups' sums
@@ -232,18 +232,23 @@ static inline void keys4(double f, float w[4])
     w[3] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
 }
 
-/* o[i] = sum of the 4 rows weighted by v (n floats): the vertical pass of
- * the separable cubic lookup. */
-LF_HOT_LOOP static void vcomb(float *restrict o, const float *restrict r0, const float *restrict r1,
-                              const float *restrict r2, const float *restrict r3, float v0, float v1, float v2,
-                              float v3, int n)
+/* The vertical pass of the separable cubic lookup: o0[i] (o1, o2) = the 4
+ * rows weighted by v at pixel i (interleaved RGB rows in, n pixels), one
+ * plane per channel out, so the horizontal pass reads each contiguously. */
+LF_HOT_LOOP static void vcomb3(float *restrict o0, float *restrict o1, float *restrict o2, const float *restrict r0,
+                               const float *restrict r1, const float *restrict r2, const float *restrict r3, float v0,
+                               float v1, float v2, float v3, int n)
 {
-    for (int i = 0; i < n; i++)
-        o[i] = v0 * r0[i] + v1 * r1[i] + v2 * r2[i] + v3 * r3[i];
+    for (int i = 0; i < n; i++) {
+        int k = 3 * i;
+        o0[i] = v0 * r0[k] + v1 * r1[k] + v2 * r2[k] + v3 * r3[k];
+        o1[i] = v0 * r0[k + 1] + v1 * r1[k + 1] + v2 * r2[k + 1] + v3 * r3[k + 1];
+        o2[i] = v0 * r0[k + 2] + v1 * r1[k + 2] + v2 * r2[k + 2] + v3 * r3[k + 2];
+    }
 }
 
-/* The vertically combined row (interleaved RGB, n pixels) split into
- * planes, so the horizontal pass reads each channel contiguously. */
+/* An interleaved RGB row (n pixels) split into planes (the reference
+ * row, read by the horizontal pass beside vcomb3's planes). */
 LF_HOT_LOOP static void deinterleave3(const float *restrict t, float *restrict p0, float *restrict p1,
                                       float *restrict p2, int n)
 {
@@ -428,11 +433,11 @@ LF_HOT_LOOP static void select_subsets(const float *restrict sub, int L, int ns,
 }
 
 /* One view's correspondence at one label along row y, added to its
- * group's sums in acc (the label's NGROUPS x NFIELDS rows); vt, vp: the
- * cubic lookup's vertical pass, interleaved and split into planes of vps;
- * cp: the reference row's planes. */
-static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s, int y, float *acc, float *vt,
-                         float *vp, size_t vps, const float *cp)
+ * group's sums in acc (the label's NGROUPS x NFIELDS rows); vp: the
+ * cubic lookup's vertical pass, 3 planes of vps floats; cp: the reference
+ * row's planes. */
+static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s, int y, float *acc, float *vp,
+                         size_t vps, const float *cp)
 {
     int ns = c->lf->ns, nt = c->lf->nt;
     int ix = s->ix, xa = s->xa, xb = s->xb;
@@ -447,8 +452,8 @@ static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s,
             rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
         size_t c0 = 3 * (size_t)(xa + ix - 1);
         int n = xb - xa + 4;
-        vcomb(vt, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0], s->wy[1], s->wy[2], s->wy[3], 3 * n);
-        deinterleave3(vt, vp + xa, vp + vps + xa, vp + 2 * vps + xa, n);
+        vcomb3(vp + xa, vp + vps + xa, vp + 2 * vps + xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0],
+               s->wy[1], s->wy[2], s->wy[3], n);
         view_row_cubic(a, ns, vp, vp + vps, vp + 2 * vps, cp, cp + ns, cp + 2 * ns, s->wx[0], s->wx[1], s->wx[2],
                        s->wx[3], c->scale, c->tau, xa, xb);
         return;
@@ -482,8 +487,9 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
     size_t np = (size_t)ns * lf->nt, gs = (size_t)NGROUPS * NFIELDS * ns;
     float *acc = c->scratch + (size_t)tid * c->scratch_per_thread; /* LABEL_BLOCK labels' group sums */
     float *w = acc + LABEL_BLOCK * gs;
-    float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
-    float *vp = vt + 3 * (size_t)ns + 12; /* 3 planes of ns + 4: the same, split by channel */
+    /* 3 * ns + 12 unused while the labels run: with w, vp and cp, the 14 rows
+     * of select_subsets' contrasts */
+    float *vp = w + 5 * (size_t)ns + 3 * (size_t)ns + 12; /* 3 planes of ns + 4: the cubic lookup's vertical pass */
     size_t vps = (size_t)ns + 4;
     float *cp = vp + 3 * vps; /* 3 * ns: the reference row's planes */
     float *rt = cp + 3 * (size_t)ns; /* 5 * ns: the full aperture's winner (track_full) */
@@ -497,7 +503,7 @@ static void cost_rows(void *vctx, int y0, int y1, int tid)
             memset(acc, 0, sizeof(float) * gs * (size_t)nb);
             for (int k = 0; k < c->nviews; k++)
                 for (int j = 0; j < nb; j++)
-                    add_view_row(c, &c->views[k], &c->lv[(size_t)(l0 + j) * c->nviews + k], y, acc + j * gs, vt, vp,
+                    add_view_row(c, &c->views[k], &c->lv[(size_t)(l0 + j) * c->nviews + k], y, acc + j * gs, vp,
                                  vps, cp);
             for (int j = 0; j < nb; j++) {
                 int l = l0 + j;

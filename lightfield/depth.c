@@ -277,6 +277,22 @@ LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float 
     }
 }
 
+/* One view subset's cost from its sums: the mean truncated difference plus
+ * alpha times the mean signed difference's L1 norm; worst without views. */
+static inline float subset_cost(float sad, float s0, float s1, float s2, float n, float alpha, float worst)
+{
+    float nn = n > 0.f ? n : 1.f;
+    float c = (sad + alpha * (fabsf(s0) + fabsf(s1) + fabsf(s2))) / nn;
+    return n > 0.f ? c : worst;
+}
+
+/* The cost of the line of groups a and b (two opposite rays) at x. */
+static inline float line_cost(const float *a, const float *b, int x, int ns, float alpha, float worst)
+{
+    return subset_cost(a[x] + b[x], a[ns + x] + b[ns + x], a[2 * ns + x] + b[2 * ns + x], a[3 * ns + x] + b[3 * ns + x],
+                       a[4 * ns + x] + b[4 * ns + x], alpha, worst);
+}
+
 /* cost = min over half apertures h of  sad/n + alpha * |sum diff| / n, a
  * half being 9 consecutive groups (rays h-2..h+2 and the octants between);
  * w: 5 * ns scratch. */
@@ -310,14 +326,20 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
         }
     }
     for (int h = 0; h < 8; h++) {
-        float *so = sub ? sub + (size_t)h * sstride : NULL;
-        for (int x = 0; x < ns; x++) {
-            float n = w4[x] > 0.f ? w4[x] : 1.f;
-            float c = (w0[x] + alpha * (fabsf(w1[x]) + fabsf(w2[x]) + fabsf(w3[x]))) / n;
-            c = w4[x] > 0.f ? c : worst;
-            out[x] = c < out[x] ? c : out[x];
-            if (so)
+        /* two copies of the loop, with and without the subset's row, so
+         * that neither has a branch (both vectorise) */
+        if (sub) {
+            float *restrict so = sub + (size_t)h * sstride;
+            for (int x = 0; x < ns; x++) {
+                float c = subset_cost(w0[x], w1[x], w2[x], w3[x], w4[x], alpha, worst);
+                out[x] = c < out[x] ? c : out[x];
                 so[x] = c;
+            }
+        } else {
+            for (int x = 0; x < ns; x++) {
+                float c = subset_cost(w0[x], w1[x], w2[x], w3[x], w4[x], alpha, worst);
+                out[x] = c < out[x] ? c : out[x];
+            }
         }
         if (h == 7) {
             if (occlusion < 2)
@@ -326,17 +348,18 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
              * two occluders is seen by the views along their direction */
             for (int k = 0; k < 4; k++) {
                 const float *a = acc + (size_t)(2 * k) * NFIELDS * ns, *b = acc + (size_t)(2 * k + 8) * NFIELDS * ns;
-                for (int x = 0; x < ns; x++) {
-                    float nn = a[4 * ns + x] + b[4 * ns + x];
-                    float n = nn > 0.f ? nn : 1.f;
-                    float c = (a[x] + b[x] +
-                               alpha * (fabsf(a[ns + x] + b[ns + x]) + fabsf(a[2 * ns + x] + b[2 * ns + x]) +
-                                        fabsf(a[3 * ns + x] + b[3 * ns + x]))) / n;
-                    c = nn > 0.f ? c : worst;
-                    out[x] = c < out[x] ? c : out[x];
-                    if (sub)
-                        sub[(size_t)(8 + k) * sstride + x] = c;
-                }
+                float *restrict so = sub ? sub + (size_t)(8 + k) * sstride : NULL;
+                if (so)
+                    for (int x = 0; x < ns; x++) {
+                        float c = line_cost(a, b, x, ns, alpha, worst);
+                        out[x] = c < out[x] ? c : out[x];
+                        so[x] = c;
+                    }
+                else
+                    for (int x = 0; x < ns; x++) {
+                        float c = line_cost(a, b, x, ns, alpha, worst);
+                        out[x] = c < out[x] ? c : out[x];
+                    }
             }
             break;
         }

@@ -613,7 +613,7 @@ int lf_lightfield_folder_load_threads(const lf_lightfield_folder *f, const lf_li
     for (int k = 0; k < n && !rc; k++) {
         view_load *vl = &lc.views[k];
         if (vl->rc) {
-            rc = lf_error_set(err, vl->err.code, "%s", vl->err.msg);
+            rc = lf_error_set(err, vl->rc, "%s", vl->err.msg);
         } else if (vl->w != w || vl->h != h) {
             char item[600];
             snprintf(item, sizeof item, "%s (%d x %d)", f->files[k], vl->w, vl->h);

@@ -22,12 +22,22 @@
 #include "lightfield/depth_internal.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx2", "default")))
+#define LF_HOT_LOOP __attribute__((optimize("-ftree-vectorize", "-fvect-cost-model=dynamic"), target_clones("avx512f", "avx2", "default")))
 #else
 #define LF_HOT_LOOP
 #endif
 
 enum { NGROUPS = 16, NFIELDS = 5, MAX_LABELS = 512 };
+/* labels whose sums the cost volume's row loop keeps at once (cost_rows):
+ * 4 x 160 kB at 512 px, within a core's L2 */
+enum { LABEL_BLOCK = 4 };
+/* cost_rows' scratch per thread before the half gate's curves: the groups'
+ * sums, combine_row's 5 rows, 3 spare rows, the vertical pass (3
+ * planes), the reference row's planes, track_full's 5 rows, the gate's
+ * per-pixel sums (ns doubles); the first 14 rows after the groups' sums are
+ * the gate's contrasts once the row's labels are done; the groups' sums
+ * for LABEL_BLOCK labels */
+#define COST_ROW_SCRATCH(ns) ((size_t)(NGROUPS * NFIELDS * LABEL_BLOCK + 5 + 3 + 3 + 3 + 5 + 2) * (ns) + 26)
 
 /* Tuning constants the options do not expose (docs/depth.md, "Method",
  * gives each one's measurements). */
@@ -121,10 +131,20 @@ static void progress_add(depth_progress *p, long units, int tid)
         p->o->progress(p->o->progress_ctx, done, p->total);
 }
 
+/* One view's constant shift at one label, what every row of the volume
+ * needs of it (computed once, build_cost_volume). */
+typedef struct label_view {
+    int ix, iy;         /* whole-pixel part of the shift (floor) */
+    float fx, fy;       /* its fraction */
+    float wx[4], wy[4]; /* Keys weights of the fraction (the cubic lookup) */
+    int xa, xb;         /* the columns whose lookup stays inside the view (xa > xb: none) */
+} label_view;
+
 typedef struct cost_ctx {
     const lf_lightfield *lf;
     const dview *views;
     int nviews;
+    const label_view *lv; /* [label][view] */
     const float *ref;    /* reference view, RGB */
     const float *ref_valid; /* its validity (when lf->valid) */
     int nlabels;
@@ -137,7 +157,7 @@ typedef struct cost_ctx {
     int half_gate;       /* 1: a half aperture competes only where its contrast is the best (select_subsets) */
     float *cost;         /* [label][pixel] */
     float *rawd;         /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
-    float *scratch;      /* per thread: (NGROUPS * NFIELDS + 13) * ns + 12 floats */
+    float *scratch;      /* per thread: COST_ROW_SCRATCH(ns) + 12 * labels * ns floats */
     size_t scratch_per_thread;
     depth_progress *progress; /* or NULL */
 } cost_ctx;
@@ -201,7 +221,7 @@ LF_HOT_LOOP static void view_row_masked(float *restrict acc, int ns, const float
 
 /* Keys cubic convolution (a = -1/2) weights of the taps at -1, 0, 1, 2 for
  * a sample at phase f in [0, 1). */
-static void keys4(double f, float w[4])
+static inline void keys4(double f, float w[4])
 {
     double t = 1 + f;
     w[0] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
@@ -212,33 +232,65 @@ static void keys4(double f, float w[4])
     w[3] = (float)(((-0.5 * t + 2.5) * t - 4) * t + 2);
 }
 
-/* o[i] = sum of the 4 rows weighted by v (n floats): the vertical pass of
- * the separable cubic lookup. */
-LF_HOT_LOOP static void vcomb(float *restrict o, const float *restrict r0, const float *restrict r1,
-                              const float *restrict r2, const float *restrict r3, float v0, float v1, float v2,
-                              float v3, int n)
+/* The vertical pass of the separable cubic lookup: o0[i] (o1, o2) = the 4
+ * rows weighted by v at pixel i (interleaved RGB rows in, n pixels), one
+ * plane per channel out, so the horizontal pass reads each contiguously. */
+LF_HOT_LOOP static void vcomb3(float *restrict o0, float *restrict o1, float *restrict o2, const float *restrict r0,
+                               const float *restrict r1, const float *restrict r2, const float *restrict r3, float v0,
+                               float v1, float v2, float v3, int n)
 {
-    for (int i = 0; i < n; i++)
-        o[i] = v0 * r0[i] + v1 * r1[i] + v2 * r2[i] + v3 * r3[i];
+    for (int i = 0; i < n; i++) {
+        int k = 3 * i;
+        o0[i] = v0 * r0[k] + v1 * r1[k] + v2 * r2[k] + v3 * r3[k];
+        o1[i] = v0 * r0[k + 1] + v1 * r1[k + 1] + v2 * r2[k + 1] + v3 * r3[k + 1];
+        o2[i] = v0 * r0[k + 2] + v1 * r1[k + 2] + v2 * r2[k + 2] + v3 * r3[k + 2];
+    }
 }
 
-/* view_row with the horizontal pass of the cubic lookup: t[3 x + ch] is the
- * vertically combined row at column x + ix - 1. */
-LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float *restrict t, const float *restrict c,
-                                       float h0, float h1, float h2, float h3, float scale, float tau, int xa, int xb)
+/* An interleaved RGB row (n pixels) split into planes (the reference
+ * row, read by the horizontal pass beside vcomb3's planes). */
+LF_HOT_LOOP static void deinterleave3(const float *restrict t, float *restrict p0, float *restrict p1,
+                                      float *restrict p2, int n)
+{
+    for (int i = 0; i < n; i++)
+        p0[i] = t[3 * i], p1[i] = t[3 * i + 1], p2[i] = t[3 * i + 2];
+}
+
+/* view_row with the horizontal pass of the cubic lookup, on planes: t0[x]
+ * (t1, t2) is the vertically combined row's channel at column x + ix - 1,
+ * c0 (c1, c2) the reference row's. */
+LF_HOT_LOOP static void view_row_cubic(float *restrict acc, int ns, const float *restrict t0, const float *restrict t1,
+                                       const float *restrict t2, const float *restrict c0, const float *restrict c1,
+                                       const float *restrict c2, float h0, float h1, float h2, float h3, float scale,
+                                       float tau, int xa, int xb)
 {
     float *restrict sad = acc, *restrict s0 = acc + ns, *restrict s1 = acc + 2 * ns, *restrict s2 = acc + 3 * ns,
                     *restrict n = acc + 4 * ns;
     for (int x = xa; x <= xb; x++) {
-        int k = 3 * x;
-        float e0 = (h0 * t[k] + h1 * t[k + 3] + h2 * t[k + 6] + h3 * t[k + 9] - c[k]) * scale;
-        float e1 = (h0 * t[k + 1] + h1 * t[k + 4] + h2 * t[k + 7] + h3 * t[k + 10] - c[k + 1]) * scale;
-        float e2 = (h0 * t[k + 2] + h1 * t[k + 5] + h2 * t[k + 8] + h3 * t[k + 11] - c[k + 2]) * scale;
+        float e0 = (h0 * t0[x] + h1 * t0[x + 1] + h2 * t0[x + 2] + h3 * t0[x + 3] - c0[x]) * scale;
+        float e1 = (h0 * t1[x] + h1 * t1[x + 1] + h2 * t1[x + 2] + h3 * t1[x + 3] - c1[x]) * scale;
+        float e2 = (h0 * t2[x] + h1 * t2[x + 1] + h2 * t2[x + 2] + h3 * t2[x + 3] - c2[x]) * scale;
         float ad = fabsf(e0) + fabsf(e1) + fabsf(e2);
         sad[x] += ad < tau ? ad : tau;
         s0[x] += e0, s1[x] += e1, s2[x] += e2;
         n[x] += 1.f;
     }
+}
+
+/* One view subset's cost from its sums: the mean truncated difference plus
+ * alpha times the mean signed difference's L1 norm; worst without views. */
+static inline float subset_cost(float sad, float s0, float s1, float s2, float n, float alpha, float worst)
+{
+    float nn = n > 0.f ? n : 1.f;
+    float c = (sad + alpha * (fabsf(s0) + fabsf(s1) + fabsf(s2))) / nn;
+    return n > 0.f ? c : worst;
+}
+
+/* The cost of the line of groups a and b (two opposite rays) at x. */
+static inline float line_cost(const float *a, const float *b, int x, int ns, float alpha, float worst)
+{
+    return subset_cost(a[x] + b[x], a[ns + x] + b[ns + x], a[2 * ns + x] + b[2 * ns + x], a[3 * ns + x] + b[3 * ns + x],
+                       a[4 * ns + x] + b[4 * ns + x], alpha, worst);
 }
 
 /* cost = min over half apertures h of  sad/n + alpha * |sum diff| / n, a
@@ -274,14 +326,20 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
         }
     }
     for (int h = 0; h < 8; h++) {
-        float *so = sub ? sub + (size_t)h * sstride : NULL;
-        for (int x = 0; x < ns; x++) {
-            float n = w4[x] > 0.f ? w4[x] : 1.f;
-            float c = (w0[x] + alpha * (fabsf(w1[x]) + fabsf(w2[x]) + fabsf(w3[x]))) / n;
-            c = w4[x] > 0.f ? c : worst;
-            out[x] = c < out[x] ? c : out[x];
-            if (so)
+        /* two copies of the loop, with and without the subset's row, so
+         * that neither has a branch (both vectorise) */
+        if (sub) {
+            float *restrict so = sub + (size_t)h * sstride;
+            for (int x = 0; x < ns; x++) {
+                float c = subset_cost(w0[x], w1[x], w2[x], w3[x], w4[x], alpha, worst);
+                out[x] = c < out[x] ? c : out[x];
                 so[x] = c;
+            }
+        } else {
+            for (int x = 0; x < ns; x++) {
+                float c = subset_cost(w0[x], w1[x], w2[x], w3[x], w4[x], alpha, worst);
+                out[x] = c < out[x] ? c : out[x];
+            }
         }
         if (h == 7) {
             if (occlusion < 2)
@@ -290,17 +348,18 @@ LF_HOT_LOOP static void combine_row(const float *restrict acc, float *restrict w
              * two occluders is seen by the views along their direction */
             for (int k = 0; k < 4; k++) {
                 const float *a = acc + (size_t)(2 * k) * NFIELDS * ns, *b = acc + (size_t)(2 * k + 8) * NFIELDS * ns;
-                for (int x = 0; x < ns; x++) {
-                    float nn = a[4 * ns + x] + b[4 * ns + x];
-                    float n = nn > 0.f ? nn : 1.f;
-                    float c = (a[x] + b[x] +
-                               alpha * (fabsf(a[ns + x] + b[ns + x]) + fabsf(a[2 * ns + x] + b[2 * ns + x]) +
-                                        fabsf(a[3 * ns + x] + b[3 * ns + x]))) / n;
-                    c = nn > 0.f ? c : worst;
-                    out[x] = c < out[x] ? c : out[x];
-                    if (sub)
-                        sub[(size_t)(8 + k) * sstride + x] = c;
-                }
+                float *restrict so = sub ? sub + (size_t)(8 + k) * sstride : NULL;
+                if (so)
+                    for (int x = 0; x < ns; x++) {
+                        float c = line_cost(a, b, x, ns, alpha, worst);
+                        out[x] = c < out[x] ? c : out[x];
+                        so[x] = c;
+                    }
+                else
+                    for (int x = 0; x < ns; x++) {
+                        float c = line_cost(a, b, x, ns, alpha, worst);
+                        out[x] = c < out[x] ? c : out[x];
+                    }
             }
             break;
         }
@@ -355,107 +414,130 @@ LF_HOT_LOOP static void track_full(const float *restrict acc, float *restrict w,
  * competes only where its contrast is the largest of all 12 subsets'.  The
  * 4 lines always compete: a gap between two occluders is seen only along
  * one of them.  sub[s][l][x], s < 8 the halves; the least into cost. */
-static void select_subsets(const float *sub, int L, int ns, float *cost, size_t np)
+LF_HOT_LOOP static void select_subsets(const float *restrict sub, int L, int ns, float *restrict cost, size_t np,
+                                       float *restrict con, double *restrict m)
 {
-    for (int x = 0; x < ns; x++) {
-        float con[12], best = 0;
-        for (int s = 0; s < 12; s++) {
-            const float *c = sub + (size_t)s * L * ns + x;
-            double m = 0;
-            float mn = FLT_MAX;
-            for (int l = 0; l < L; l++) {
-                float v = c[(size_t)l * ns];
-                m += v, mn = v < mn ? v : mn;
-            }
-            con[s] = (float)(m / L) - mn;
-            best = con[s] > best ? con[s] : best;
-        }
+    /* loops over x innermost (contiguous, vectorised); per pixel the same
+     * sums in the same order as a loop over the labels per pixel */
+    float *restrict best = con + (size_t)12 * ns, *restrict mn = best + ns;
+    for (int x = 0; x < ns; x++)
+        best[x] = 0;
+    for (int s = 0; s < 12; s++) {
+        const float *c = sub + (size_t)s * L * ns;
+        float *cs = con + (size_t)s * ns;
+        for (int x = 0; x < ns; x++)
+            m[x] = 0, mn[x] = FLT_MAX;
         for (int l = 0; l < L; l++) {
-            float v = FLT_MAX;
-            for (int s = 0; s < 12; s++)
-                if (s >= 8 || con[s] >= best) {
-                    float q = sub[((size_t)s * L + l) * ns + x];
-                    v = q < v ? q : v;
-                }
-            cost[(size_t)l * np + x] = v;
+            const float *cl = c + (size_t)l * ns;
+            for (int x = 0; x < ns; x++) {
+                float v = cl[x];
+                m[x] += v, mn[x] = v < mn[x] ? v : mn[x];
+            }
+        }
+        for (int x = 0; x < ns; x++) {
+            cs[x] = (float)(m[x] / L) - mn[x];
+            best[x] = cs[x] > best[x] ? cs[x] : best[x];
+        }
+    }
+    for (int l = 0; l < L; l++) {
+        float *o = cost + (size_t)l * np;
+        for (int x = 0; x < ns; x++)
+            o[x] = FLT_MAX;
+        for (int s = 0; s < 12; s++) {
+            const float *q = sub + ((size_t)s * L + l) * ns, *cs = con + (size_t)s * ns;
+            if (s >= 8)
+                for (int x = 0; x < ns; x++)
+                    o[x] = q[x] < o[x] ? q[x] : o[x];
+            else
+                for (int x = 0; x < ns; x++)
+                    o[x] = cs[x] >= best[x] && q[x] < o[x] ? q[x] : o[x];
         }
     }
 }
 
+/* One view's correspondence at one label along row y, added to its
+ * group's sums in acc (the label's NGROUPS x NFIELDS rows); vp: the
+ * cubic lookup's vertical pass, 3 planes of vps floats; cp: the reference
+ * row's planes. */
+static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s, int y, float *acc, float *vp,
+                         size_t vps, const float *cp)
+{
+    int ns = c->lf->ns, nt = c->lf->nt;
+    int ix = s->ix, xa = s->xa, xb = s->xb;
+    int r0 = y + s->iy, r1 = s->fy > 0.f ? r0 + 1 : r0;
+    if (r0 < 0 || r1 > nt - 1 || xa > xb)
+        return;
+    float *a = acc + (size_t)v->group * NFIELDS * ns;
+    if (c->cubic && !v->valid) {
+        /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
+        const float *rr[4];
+        for (int m = 0; m < 4; m++)
+            rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
+        size_t c0 = 3 * (size_t)(xa + ix - 1);
+        int n = xb - xa + 4;
+        vcomb3(vp + xa, vp + vps + xa, vp + 2 * vps + xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0],
+               s->wy[1], s->wy[2], s->wy[3], n);
+        view_row_cubic(a, ns, vp, vp + vps, vp + 2 * vps, cp, cp + ns, cp + 2 * ns, s->wx[0], s->wx[1], s->wx[2],
+                       s->wx[3], c->scale, c->tau, xa, xb);
+        return;
+    }
+    const float *cref = c->ref + (size_t)y * ns * 3;
+    float fx = s->fx, fy = s->fy;
+    const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
+    const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
+    int dx1 = fx > 0.f ? 3 : 0;
+    float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+    if (v->valid) {
+        /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
+        const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
+        int mx1 = fx > 0.f ? 1 : 0;
+        view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
+                        c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+    } else {
+        view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+    }
+}
+
+/* Rows [y0, y1) of the volume.  Labels are taken LABEL_BLOCK at a time,
+ * views outer: a view's rows, read again for the next labels of the block
+ * (their shifts differ by a fraction of a pixel), are still in cache.
+ * Each label's sums still add the views in order. */
 static void cost_rows(void *vctx, int y0, int y1, int tid)
 {
     cost_ctx *c = vctx;
     const lf_lightfield *lf = c->lf;
-    int ns = lf->ns, nt = lf->nt;
-    size_t np = (size_t)ns * nt;
-    float *acc = c->scratch + (size_t)tid * c->scratch_per_thread;
-    float *w = acc + (size_t)NGROUPS * NFIELDS * ns;
-    float *vt = w + 5 * (size_t)ns; /* 3 * ns + 12: vertical pass of the cubic lookup */
-    float *rt = vt + 3 * (size_t)ns + 12; /* 5 * ns: the full aperture's winner (track_full) */
-    float *sub = c->half_gate && c->occlusion >= 2 ? rt + 5 * (size_t)ns : NULL; /* [subset][label][x] */
+    int ns = lf->ns;
+    size_t np = (size_t)ns * lf->nt, gs = (size_t)NGROUPS * NFIELDS * ns;
+    float *acc = c->scratch + (size_t)tid * c->scratch_per_thread; /* LABEL_BLOCK labels' group sums */
+    float *w = acc + LABEL_BLOCK * gs;
+    /* 3 * ns + 12 unused while the labels run: with w, vp and cp, the 14 rows
+     * of select_subsets' contrasts */
+    float *vp = w + 5 * (size_t)ns + 3 * (size_t)ns + 12; /* 3 planes of ns + 4: the cubic lookup's vertical pass */
+    size_t vps = (size_t)ns + 4;
+    float *cp = vp + 3 * vps; /* 3 * ns: the reference row's planes */
+    float *rt = cp + 3 * (size_t)ns; /* 5 * ns: the full aperture's winner (track_full) */
+    double *gm = (double *)(rt + 5 * (size_t)ns + (ns & 1)); /* ns: select_subsets' sums (8-byte aligned) */
+    float *sub = c->half_gate && c->occlusion >= 2 ? (float *)(gm + ns) : NULL; /* [subset][label][x] */
     float worst = c->tau * (1 + c->alpha);
     for (int y = y0; y < y1; y++) {
-        const float *cref = c->ref + (size_t)y * ns * 3;
-        for (int l = 0; l < c->nlabels; l++) {
-            double d = c->d0 + c->step * l;
-            memset(acc, 0, sizeof(float) * NGROUPS * NFIELDS * ns);
-            for (int k = 0; k < c->nviews; k++) {
-                const dview *v = &c->views[k];
-                /* I_ref(x, y) = I_v(x - d du, y - d dv) */
-                double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
-                int ix = (int)floor(sx), iy = (int)floor(sy);
-                float fx = (float)(sx - ix), fy = (float)(sy - iy);
-                int r0 = y + iy, r1 = fy > 0.f ? r0 + 1 : r0;
-                if (r0 < 0 || r1 > nt - 1)
-                    continue;
-                if (c->cubic && !v->valid) {
-                    /* separable Keys cubic: rows r0-1 .. r0+2 (clamped), columns ix-1 .. ix+2 */
-                    int xa = 1 - ix > 0 ? 1 - ix : 0, xb = ns - 3 - ix < ns - 1 ? ns - 3 - ix : ns - 1;
-                    if (xa > xb)
-                        continue;
-                    float wy[4], wx[4];
-                    keys4(sy - iy, wy);
-                    keys4(sx - ix, wx);
-                    const float *rr[4];
-                    for (int m = 0; m < 4; m++)
-                        rr[m] = v->data + (size_t)clampi(r0 - 1 + m, 0, nt - 1) * ns * 3;
-                    size_t c0 = 3 * (size_t)(xa + ix - 1);
-                    int n = 3 * (xb - xa + 4);
-                    vcomb(vt + 3 * (size_t)xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, wy[0], wy[1], wy[2],
-                          wy[3], n);
-                    view_row_cubic(acc + (size_t)v->group * NFIELDS * ns, ns, vt, cref, wx[0], wx[1], wx[2], wx[3],
-                                   c->scale, c->tau, xa, xb);
-                    continue;
-                }
-                int xa = ix < 0 ? -ix : 0;
-                int xb = ns - 1 - (fx > 0.f ? ix + 1 : ix);
-                if (xb > ns - 1)
-                    xb = ns - 1;
-                if (xa > xb)
-                    continue;
-                const float *row0 = v->data + (size_t)r0 * ns * 3 + 3 * (ptrdiff_t)ix;
-                const float *row1 = v->data + (size_t)r1 * ns * 3 + 3 * (ptrdiff_t)ix;
-                int dx1 = fx > 0.f ? 3 : 0;
-                float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
-                float *a = acc + (size_t)v->group * NFIELDS * ns;
-                if (v->valid) {
-                    /* NaN never enters: invalid texels are read as 0 (decode stores 0 there) and masked */
-                    const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
-                    int mx1 = fx > 0.f ? 1 : 0;
-                    view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
-                                    c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
-                } else {
-                    view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa,
-                             xb);
-                }
+        deinterleave3(c->ref + (size_t)y * ns * 3, cp, cp + ns, cp + 2 * ns, ns);
+        for (int l0 = 0; l0 < c->nlabels; l0 += LABEL_BLOCK) {
+            int nb = c->nlabels - l0 < LABEL_BLOCK ? c->nlabels - l0 : LABEL_BLOCK;
+            memset(acc, 0, sizeof(float) * gs * (size_t)nb);
+            for (int k = 0; k < c->nviews; k++)
+                for (int j = 0; j < nb; j++)
+                    add_view_row(c, &c->views[k], &c->lv[(size_t)(l0 + j) * c->nviews + k], y, acc + j * gs, vp,
+                                 vps, cp);
+            for (int j = 0; j < nb; j++) {
+                int l = l0 + j;
+                combine_row(acc + j * gs, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst,
+                            c->occlusion, sub ? sub + (size_t)l * ns : NULL, (size_t)c->nlabels * ns);
+                if (c->rawd)
+                    track_full(acc + j * gs, w, rt, ns, l);
             }
-            combine_row(acc, w, c->cost + (size_t)l * np + (size_t)y * ns, ns, c->alpha, worst, c->occlusion,
-                        sub ? sub + (size_t)l * ns : NULL, (size_t)c->nlabels * ns);
-            if (c->rawd)
-                track_full(acc, w, rt, ns, l);
         }
         if (sub)
-            select_subsets(sub, c->nlabels, ns, c->cost + (size_t)y * ns, np);
+            select_subsets(sub, c->nlabels, ns, c->cost + (size_t)y * ns, np, w, gm);
         if (c->rawd)
             for (int x = 0; x < ns; x++) {
                 double off = 0, cm = rt[2 * ns + x], cp = rt[3 * ns + x], cb = rt[x];
@@ -672,10 +754,10 @@ static float pixel_cost(const cost_ctx *c, const float *map, float map_max, int 
     for (int k = 0; k < c->nviews; k++) {
         const dview *v = &c->views[k];
         double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
-        int ix = (int)floor(sx), iy = (int)floor(sy);
-        float fx = (float)(sx - ix), fy = (float)(sy - iy);
-        if (ix < 1 || iy < 1 || ix > ns - 3 || iy > nt - 3)
+        if (!(sx >= 1 && sy >= 1 && sx < ns - 2 && sy < nt - 2)) /* ix, iy below in [1, ns - 3], [1, nt - 3] */
             continue;
+        int ix = (int)sx, iy = (int)sy; /* floor: positive here */
+        float fx = (float)(sx - ix), fy = (float)(sy - iy);
         if (map) {
             /* occluded in view k when a nearer pixel q = p + t (du, dv) of
              * the map lands on the sample: d_q >= d + t within half a pixel */
@@ -803,7 +885,7 @@ static void thin_take_rows(void *vctx, int y0, int y1, int tid)
 /* ---------- continuous refinement (Gauss-Newton on photo-consistency) ---------- */
 
 /* Derivatives of the Keys weights (keys4) with respect to the sample position. */
-static void keys4d(double f, float w[4])
+static inline void keys4d(double f, float w[4])
 {
     double t = 1 + f;
     w[0] = (float)(-1.5 * t * t + 5 * t - 4);
@@ -827,7 +909,7 @@ typedef struct gn_ctx {
  * of one view (cubic lookup) and its derivative J with respect to d, with a
  * Cauchy weight rho = 1 / (1 + |r|^2 / c^2) that lets a view seeing an
  * occluder drop out; added to A and B. */
-static void gn_rows(void *vctx, int y0, int y1, int tid)
+LF_HOT_LOOP static void gn_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
     gn_ctx *c = vctx;
@@ -839,18 +921,23 @@ static void gn_rows(void *vctx, int y0, int y1, int tid)
             double d = c->disp[i];
             const float *p = c->ref + 3 * i;
             double sx = x - d * v->du + v->ox, sy = y - d * v->dv + v->oy;
-            int ix = (int)floor(sx), iy = (int)floor(sy);
-            if (ix < 1 || iy < 1 || ix > w - 3 || iy > h - 3)
+            if (!(sx >= 1 && sy >= 1 && sx < w - 2 && sy < h - 2)) /* ix, iy below in [1, w - 3], [1, h - 3] */
                 continue;
+            int ix = (int)sx, iy = (int)sy; /* floor: positive here */
             float wx[4], wy[4], gx[4], gy[4];
             keys4(sx - ix, wx), keys4(sy - iy, wy), keys4d(sx - ix, gx), keys4d(sy - iy, gy);
             float val[3] = {0, 0, 0}, dx[3] = {0, 0, 0}, dy[3] = {0, 0, 0};
+            /* unrolled: the sums stay in registers (the same additions in the same order) */
+#pragma GCC unroll 4
             for (int m = 0; m < 4; m++) {
                 const float *row = c->img + ((size_t)(iy - 1 + m) * w + ix - 1) * 3;
                 float hv[3] = {0, 0, 0}, hg[3] = {0, 0, 0};
+#pragma GCC unroll 4
                 for (int n = 0; n < 4; n++)
+#pragma GCC unroll 3
                     for (int ch = 0; ch < 3; ch++)
                         hv[ch] += wx[n] * row[3 * n + ch], hg[ch] += gx[n] * row[3 * n + ch];
+#pragma GCC unroll 3
                 for (int ch = 0; ch < 3; ch++)
                     val[ch] += wy[m] * hv[ch], dx[ch] += wy[m] * hg[ch], dy[ch] += gy[m] * hv[ch];
             }
@@ -1000,6 +1087,7 @@ typedef struct depth_work {
     const float *ref;   /* reference view, RGB */
     float scale;        /* colour scale: 1 / mean channel sum of the reference */
     dview *views;       /* the other views */
+    label_view *lv;     /* [label][view]: each view's shift at each label */
     float *cost;        /* [label][pixel]; scratch for the stages after the minimum */
     float *sel;         /* NULL, or the semi-global sum the labels are chosen on (same layout) */
     float *scratch;     /* per thread: the larger of the cost rows' and the guided filter's needs */
@@ -1014,7 +1102,7 @@ typedef struct depth_work {
 
 static void depth_work_free(depth_work *w)
 {
-    free(w->views), free(w->cost), free(w->sel), free(w->scratch), free(w->guide), free(w->disp), free(w->refs);
+    free(w->views), free(w->lv), free(w->cost), free(w->sel), free(w->scratch), free(w->guide), free(w->disp), free(w->refs);
     free(w->rawd);
 }
 
@@ -1024,7 +1112,8 @@ static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lig
     int ns = lf->ns, nt = lf->nt;
     size_t np = (size_t)ns * nt;
     /* the row's per-subset curves (the half gate): 12 x labels x ns */
-    size_t cost_scratch = (size_t)(NGROUPS * NFIELDS + 13) * ns + 12 + (size_t)12 * nl * ns;
+    size_t cost_scratch = COST_ROW_SCRATCH(ns) + (size_t)12 * nl * ns;
+    cost_scratch = (cost_scratch + 15) / 16 * 16; /* each thread's part 64-byte aligned (the doubles in it too) */
     size_t gf_scratch = 10 * np;
     *w = (depth_work){
         .lf = lf,
@@ -1040,12 +1129,13 @@ static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lig
         .per_thread = cost_scratch > gf_scratch ? cost_scratch : gf_scratch,
     };
     w->views = malloc(sizeof *w->views * (size_t)lf->nu * lf->nv);
+    w->lv = malloc(sizeof *w->lv * (size_t)lf->nu * lf->nv * nl);
     w->cost = malloc(sizeof(float) * np * (size_t)nl);
     w->scratch = malloc(sizeof(float) * w->per_thread * (size_t)w->threads);
     w->guide = malloc(sizeof(float) * np * 14), w->disp = malloc(sizeof(float) * np * 2);
     w->conf = w->disp ? w->disp + np : NULL;
     w->refs = malloc(sizeof(float) * np * 3);
-    if (!w->views || !w->cost || !w->scratch || !w->guide || !w->disp || !w->refs)
+    if (!w->views || !w->lv || !w->cost || !w->scratch || !w->guide || !w->disp || !w->refs)
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory for a %d-label cost volume of %dx%d", nl, ns, nt);
     return LF_OK;
 }
@@ -1087,6 +1177,29 @@ static float reference_colour_scale(const float *ref, size_t np)
     return msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 }
 
+/* View v's shift at disparity d, I_ref(x, y) = I_v(x - d du + ox, y - d dv
+ * + oy), split as the row loop reads it; the columns it may read: with
+ * the cubic lookup (views without missing samples) ix-1 .. ix+2, else
+ * ix .. ix+1. */
+static label_view label_shift(const dview *v, double d, int ns, int cubic)
+{
+    label_view s;
+    double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
+    s.ix = (int)floor(sx), s.iy = (int)floor(sy);
+    s.fx = (float)(sx - s.ix), s.fy = (float)(sy - s.iy);
+    keys4(sx - s.ix, s.wx);
+    keys4(sy - s.iy, s.wy);
+    if (cubic && !v->valid) {
+        s.xa = 1 - s.ix > 0 ? 1 - s.ix : 0;
+        s.xb = ns - 3 - s.ix < ns - 1 ? ns - 3 - s.ix : ns - 1;
+    } else {
+        s.xa = s.ix < 0 ? -s.ix : 0;
+        s.xb = ns - 1 - (s.fx > 0.f ? s.ix + 1 : s.ix);
+        s.xb = s.xb > ns - 1 ? ns - 1 : s.xb;
+    }
+    return s;
+}
+
 /* Stages 1-2: the cost volume with its occlusion-aware view subsets, and
  * (thin structures on) the unaggregated full-aperture winner per pixel. */
 static int build_cost_volume(depth_work *w, lf_error *err)
@@ -1098,6 +1211,7 @@ static int build_cost_volume(depth_work *w, lf_error *err)
         .lf = w->lf,
         .views = w->views,
         .nviews = w->nviews,
+        .lv = w->lv,
         .ref = w->ref,
         .ref_valid = NULL,
         .nlabels = w->nlabels,
@@ -1116,6 +1230,9 @@ static int build_cost_volume(depth_work *w, lf_error *err)
         .progress = &w->progress,
     };
     const lf_lightfield *lf = w->lf;
+    for (int l = 0; l < w->nlabels; l++)
+        for (int k = 0; k < w->nviews; k++)
+            w->lv[(size_t)l * w->nviews + k] = label_shift(&w->views[k], w->d0 + w->step * l, w->ns, w->cc.cubic);
     if (lf->valid)
         w->cc.ref_valid = lf->valid + ((size_t)((lf->nv - 1) / 2) * lf->nu + (lf->nu - 1) / 2) * w->np;
     lf_parallel_for(w->nt, w->threads, 4, cost_rows, &w->cc);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "base/lf_file_write.h"
+#include "base/lf_parallel.h"
 #include "lf_lightfield.h"
 
 enum { MAX_SIDE = 4096 };
@@ -482,7 +483,82 @@ int lf_lightfield_folder_scan(const char *dir, lf_lightfield_folder *f, lf_error
 
 /* ---------- loading ---------- */
 
+/* What reading one view found. */
+typedef struct view_load {
+    int rc, w, h;
+    size_t nonfinite; /* samples left as read (NaN/Inf) for mark_nonfinite */
+    lf_error err;
+} view_load;
+
+typedef struct load_ctx {
+    const lf_lightfield_folder *f;
+    lf_lightfield *lf;
+    lf_image *first; /* view 0, read already */
+    int w, h;
+    view_load *views;
+} load_ctx;
+
+/* Views [k0, k1): read, and copied into the light field when of the
+ * first view's size. */
+static void load_views(void *vctx, int k0, int k1, int tid)
+{
+    (void)tid;
+    load_ctx *c = vctx;
+    for (int k = k0; k < k1; k++) {
+        view_load *vl = &c->views[k];
+        lf_image img = {0};
+        if (k == 0)
+            img = *c->first;
+        else if ((vl->rc = lf_image_read(c->f->files[k], &img, NULL, &vl->err)))
+            continue;
+        vl->w = img.width, vl->h = img.height;
+        if (img.width == c->w && img.height == c->h) {
+            float *dst = c->lf->data + (size_t)k * c->w * c->h * 3;
+            for (size_t p = 0; p < (size_t)c->w * c->h; p++) {
+                const float *s = img.data + p * (size_t)img.channels;
+                float v[3];
+                if (img.channels >= 3)
+                    v[0] = s[0], v[1] = s[1], v[2] = s[2];
+                else
+                    v[0] = v[1] = v[2] = s[0];
+                vl->nonfinite += !isfinite(v[0]) || !isfinite(v[1]) || !isfinite(v[2]);
+                memcpy(dst + p * 3, v, sizeof v);
+            }
+        }
+        if (k > 0)
+            lf_image_free(&img);
+    }
+}
+
+/* View k's non-finite pixels become missing samples: 0 in the data, 0 in
+ * the validity mask (allocated, all valid, at the first such view). */
+static int mark_nonfinite(lf_lightfield *lf, int k, int n, lf_error *err)
+{
+    size_t npix = (size_t)lf->ns * lf->nt;
+    if (!lf->valid) {
+        size_t all = (size_t)n * npix;
+        if (!(lf->valid = malloc(all * sizeof *lf->valid)))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
+        for (size_t i = 0; i < all; i++)
+            lf->valid[i] = 1.f;
+    }
+    float *d = lf->data + (size_t)k * npix * 3;
+    for (size_t p = 0; p < npix; p++)
+        if (!isfinite(d[3 * p]) || !isfinite(d[3 * p + 1]) || !isfinite(d[3 * p + 2])) {
+            lf->valid[(size_t)k * npix + p] = 0.f;
+            lf->nonfinite++, lf->missing++;
+            d[3 * p] = d[3 * p + 1] = d[3 * p + 2] = 0.f;
+        }
+    return LF_OK;
+}
+
 int lf_lightfield_folder_load(const lf_lightfield_folder *f, const lf_lightfield_layout *flags, lf_lightfield *lf, lf_error *err)
+{
+    return lf_lightfield_folder_load_threads(f, flags, 0, lf, err);
+}
+
+int lf_lightfield_folder_load_threads(const lf_lightfield_folder *f, const lf_lightfield_layout *flags, int threads,
+                                      lf_lightfield *lf, lf_error *err)
 {
     memset(lf, 0, sizeof *lf);
     int n = f->nu * f->nv, rc = LF_OK;
@@ -521,48 +597,32 @@ int lf_lightfield_folder_load(const lf_lightfield_folder *f, const lf_lightfield
         lf_image_free(&first);
         return rc;
     }
+    load_ctx lc = {.f = f, .lf = lf, .first = &first, .w = w, .h = h};
+    lc.views = calloc((size_t)n, sizeof *lc.views);
+    if (!lc.views) {
+        lf_image_free(&first);
+        lf_lightfield_free(lf);
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    }
+    /* the views decoded in parallel (PNG inflate and sRGB are most of the
+     * time); what they found is gathered in file order, so the messages and
+     * the mask are those of reading them one after the other */
+    lf_parallel_for(n, threads, 1, load_views, &lc);
     char odd[768] = "";
     int nodd = 0;
     for (int k = 0; k < n && !rc; k++) {
-        lf_image img = {0};
-        if (k == 0) {
-            img = first, first.data = NULL;
-        } else if ((rc = lf_image_read(f->files[k], &img, NULL, err))) {
-            break;
-        }
-        if (img.width != w || img.height != h) {
+        view_load *vl = &lc.views[k];
+        if (vl->rc) {
+            rc = lf_error_set(err, vl->rc, "%s", vl->err.msg);
+        } else if (vl->w != w || vl->h != h) {
             char item[600];
-            snprintf(item, sizeof item, "%s (%d x %d)", f->files[k], img.width, img.height);
+            snprintf(item, sizeof item, "%s (%d x %d)", f->files[k], vl->w, vl->h);
             list_append(odd, sizeof odd, &nodd, 4, item);
-            lf_image_free(&img);
-            continue;
+        } else if (vl->nonfinite) {
+            rc = mark_nonfinite(lf, k, n, err);
         }
-        float *dst = lf->data + (size_t)k * w * h * 3;
-        for (size_t p = 0; p < (size_t)w * h; p++) {
-            const float *s = img.data + p * (size_t)img.channels;
-            float c[3];
-            if (img.channels >= 3)
-                c[0] = s[0], c[1] = s[1], c[2] = s[2];
-            else
-                c[0] = c[1] = c[2] = s[0];
-            if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
-                if (!lf->valid) {
-                    size_t all = (size_t)n * w * h;
-                    if (!(lf->valid = malloc(all * sizeof *lf->valid))) {
-                        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
-                        break;
-                    }
-                    for (size_t i = 0; i < all; i++)
-                        lf->valid[i] = 1.f;
-                }
-                lf->valid[(size_t)k * w * h + p] = 0.f;
-                lf->nonfinite++, lf->missing++;
-                c[0] = c[1] = c[2] = 0.f;
-            }
-            memcpy(dst + p * 3, c, sizeof c);
-        }
-        lf_image_free(&img);
     }
+    free(lc.views);
     lf_image_free(&first);
     if (!rc && nodd)
         rc = lf_error_set(err, LF_ERR_PARSE, "%s: views differ in size: %s is %d x %d, but %s%s", f->dir, f->files[0],

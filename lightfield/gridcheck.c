@@ -74,6 +74,18 @@ static double block_cost(const float *a, const float *b, int w, int h, int bx, i
 {
     double c = 0;
     int n = 0;
+    if (s == floor(s)) {
+        /* a whole-pixel shift: sample() gives the pixel itself (the other
+         * weights are 0), so read it (4 in 5 of the shifts searched) */
+        int sx = axis == 0 ? (int)s : 0, sy = axis == 1 ? (int)s : 0;
+        for (int y = by; y < by + BLOCK; y++)
+            for (int x = bx; x < bx + BLOCK; x++) {
+                int x0 = x + sx, y0 = y + sy;
+                if (x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h)
+                    c += fabs(a[(size_t)y * w + x] - b[(size_t)y0 * w + x0]), n++;
+            }
+        return n ? c / n : INFINITY;
+    }
     for (int y = by; y < by + BLOCK; y++)
         for (int x = bx; x < bx + BLOCK; x++) {
             float v = sample(b, w, h, x + (axis == 0 ? s : 0), y + (axis == 1 ? s : 0));

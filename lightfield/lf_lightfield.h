@@ -136,6 +136,9 @@ int lf_lightfield_alloc(lf_lightfield *lf, int nu, int nv, int ns, int nt, lf_er
  * missing (lf->valid), a view dark everywhere is missing whole.  Sets
  * views_rescaled, views_dark, gain_lo/hi; adds to missing. */
 int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err);
+/* The same on `threads` threads (<= 0: every core): views measured in
+ * parallel, applied in view order (the same result). */
+int lf_lightfield_equalize_threads(lf_lightfield *lf, int threads, lf_error *err);
 void lf_lightfield_free(lf_lightfield *lf); /* accepts a zeroed struct */
 
 /* Decodes a raw image (any channel count: 1 is grey, RGB(A) used as RGB).
@@ -261,6 +264,10 @@ int lf_lightfield_folder_scan(const char *dir, lf_lightfield_folder *f, lf_error
  * geometry.  Views must all be readable and of one size; errors name the
  * file(s).  Non-finite values become missing samples (lf->nonfinite). */
 int lf_lightfield_folder_load(const lf_lightfield_folder *f, const lf_lightfield_layout *flags, lf_lightfield *lf, lf_error *err);
+/* The same on `threads` threads (<= 0: every core; lf_parallel_for): the
+ * views are decoded in parallel, the result and the messages are the same. */
+int lf_lightfield_folder_load_threads(const lf_lightfield_folder *f, const lf_lightfield_layout *flags, int threads,
+                                      lf_lightfield *lf, lf_error *err);
 void lf_lightfield_folder_free(lf_lightfield_folder *f);
 /* Writes the HCI layout: input_CamNNN.png (8-bit sRGB), parameters.cfg
  * (camera arrays: focal length, sensor size, baseline; disparity range when

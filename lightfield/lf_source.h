@@ -42,6 +42,7 @@ typedef struct lf_lightfield_open_opts {
     const char *grid;          /* folders: NULL or "check" (the grid checked against its parallax, swapped or
                                 * mirrored rows/columns corrected with a note), "off" (as named), "transpose",
                                 * "flip-x", "flip-y" (that correction, unchecked) */
+    int threads;               /* folders: views decoded on this many threads (<= 0: every core) */
 } lf_lightfield_open_opts;
 
 /* Reads a raw or a folder of views (every view is read, even with

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "base/lf_math.h"
+#include "base/lf_parallel.h"
 #include "lf_lightfield.h"
 
 enum { CELLS = 16, NPAR = 6 };
@@ -133,10 +134,37 @@ static void cell_sums(const double *ir, const double *iv, int ns, int nt, int nc
         }
 }
 
-static int cmpd(const void *a, const void *b)
+/* The k-th smallest of a[0 .. n-1] (quickselect; a is reordered): the
+ * value a sort would put at a[k], without sorting (called 2 x 129 times per
+ * view). */
+static double kth_smallest(double *a, size_t n, size_t k)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double pivot = a[lo + (hi - lo) / 2];
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (a[i] < pivot)
+                i++;
+            while (a[j] > pivot)
+                j--;
+            if (i <= j) {
+                double t = a[i];
+                a[i] = a[j], a[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return a[k];
+    }
+    return a[k];
 }
 
 /* How far the cells' log luminance ratios spread (median absolute deviation
@@ -153,12 +181,10 @@ static double ratio_spread(const double *cm, const double *vm, size_t ncell, dou
     }
     if (n < ncell / 2 || n == 0)
         return HUGE_VAL;
-    qsort(tmp, n, sizeof(double), cmpd);
-    double med = tmp[n / 2];
+    double med = kth_smallest(tmp, n, n / 2);
     for (size_t i = 0; i < n; i++)
         tmp[i] = fabs(tmp[i] - med);
-    qsort(tmp, n, sizeof(double), cmpd);
-    return tmp[n / 2];
+    return kth_smallest(tmp, n, n / 2);
 }
 
 /* What the per-view stages share: the cell grid, its buffers and the
@@ -327,29 +353,37 @@ static int record_gain(lf_lightfield *lf, int k, const view_fit *f, lf_error *er
     return LF_OK;
 }
 
-/* View k (not the centre) against the centre view: fitted, then left
- * alone, rescaled, or marked missing in its dark cells or whole. */
-static int equalize_view(lf_lightfield *lf, eq_work *w, int k, lf_error *err)
+/* View k (not the centre) against the centre view: its shift, dark
+ * cells and gain fields (reads the light field only, so views are
+ * measured in parallel). */
+static void measure_view(const lf_lightfield *lf, eq_work *w, int k, view_fit *f)
 {
     size_t np = (size_t)w->ns * w->nt;
     int iu = k % lf->nu, iv = k / lf->nu, iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
     double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
-    float *view = lf_lightfield_view(lf, iu, iv);
-    integral(view, lf->valid ? lf->valid + (size_t)k * np : NULL, w->ns, w->nt, w->iv);
-    view_fit f;
-    parallax_shift(w, iu - iu0, (iv - iv0) * rv, &f);
-    find_dark_cells(w, &f);
-    fit_gain_fields(w, &f);
-    if (!f.fitted && f.ndark == 0)
+    integral(lf->data + (size_t)k * np * 3, lf->valid ? lf->valid + (size_t)k * np : NULL, w->ns, w->nt, w->iv);
+    parallax_shift(w, iu - iu0, (iv - iv0) * rv, f);
+    find_dark_cells(w, f);
+    fit_gain_fields(w, f);
+    if (f->fitted || f->ndark >= f->ncells / 2)
+        gain_deviation(w, f);
+}
+
+/* View k as measured: left alone, rescaled, or marked missing in its
+ * dark cells or whole. */
+static int apply_view(lf_lightfield *lf, const eq_work *w, int k, const view_fit *f, lf_error *err)
+{
+    size_t np = (size_t)w->ns * w->nt;
+    float *view = lf->data + (size_t)k * np * 3;
+    if (!f->fitted && f->ndark == 0)
         return LF_OK; /* too little texture to say anything: leave the view */
-    if (!f.fitted && f.ndark < f.ncells / 2)
+    if (!f->fitted && f->ndark < f->ncells / 2)
         return LF_OK;
-    gain_deviation(w, &f);
-    int whole_dark = !f.fitted || f.ndark == f.ncells;
-    int rescale = f.ngain > 0 && (f.devsum / f.ngain > APPLY_MEAN || f.dev > APPLY_MAX);
-    if (!whole_dark && !rescale && f.ndark == 0)
+    int whole_dark = !f->fitted || f->ndark == f->ncells;
+    int rescale = f->ngain > 0 && (f->devsum / f->ngain > APPLY_MEAN || f->dev > APPLY_MAX);
+    if (!whole_dark && !rescale && f->ndark == 0)
         return LF_OK;
-    if ((f.ndark || whole_dark) && !lf->valid) {
+    if ((f->ndark || whole_dark) && !lf->valid) {
         if (!(lf->valid = malloc(sizeof(float) * np * (size_t)lf->nu * lf->nv)))
             return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the validity mask");
         for (size_t i = 0; i < np * (size_t)lf->nu * lf->nv; i++)
@@ -362,44 +396,84 @@ static int equalize_view(lf_lightfield *lf, eq_work *w, int k, lf_error *err)
         lf->views_dark++;
         return LF_OK;
     }
-    correct_view(lf, view, valid, w, &f, rescale);
-    return rescale ? record_gain(lf, k, &f, err) : LF_OK;
+    correct_view(lf, view, valid, w, f, rescale);
+    return rescale ? record_gain(lf, k, f, err) : LF_OK;
+}
+
+/* Per thread, the cell buffers and this view's integral image. */
+typedef struct eq_thread {
+    double *means, *cx, *iv;
+    int *use;
+} eq_thread;
+
+typedef struct eq_ctx {
+    const lf_lightfield *lf;
+    eq_work base; /* the shared part: sizes and the centre's integral image */
+    eq_thread *t;
+    view_fit *fits;
+    int centre;
+} eq_ctx;
+
+static void measure_views(void *vctx, int k0, int k1, int tid)
+{
+    eq_ctx *c = vctx;
+    eq_thread *t = &c->t[tid];
+    eq_work w = c->base;
+    w.cm = t->means, w.vm = t->means + 4 * w.ncell;
+    w.cx = t->cx, w.cy = t->cx + w.ncell, w.ly = t->cx + 2 * w.ncell, w.tmp = t->cx + 3 * w.ncell;
+    w.use = t->use, w.iv = t->iv;
+    for (int k = k0; k < k1; k++)
+        if (k != c->centre)
+            measure_view(c->lf, &w, k, &c->fits[k]);
 }
 
 int lf_lightfield_equalize(lf_lightfield *lf, lf_error *err)
+{
+    return lf_lightfield_equalize_threads(lf, 0, err);
+}
+
+int lf_lightfield_equalize_threads(lf_lightfield *lf, int threads, lf_error *err)
 {
     lf->views_rescaled = lf->views_dark = 0;
     lf->gain_lo = lf->gain_hi = 1;
     if (!lf->data || lf->nu * lf->nv < 2)
         return LF_OK;
-    int ns = lf->ns, nt = lf->nt, nc = CELLS;
+    int ns = lf->ns, nt = lf->nt, nc = CELLS, n = lf->nu * lf->nv;
     if (ns < 2 * nc || nt < 2 * nc)
         nc = (ns < nt ? ns : nt) / 2;
     if (nc < 2)
         return LF_OK;
-    size_t np = (size_t)ns * nt, ncell = (size_t)nc * nc;
+    size_t np = (size_t)ns * nt, ncell = (size_t)nc * nc, nint = 4 * ((size_t)ns + 1) * ((size_t)nt + 1);
     int iu0 = (lf->nu - 1) / 2, iv0 = (lf->nv - 1) / 2;
-    double *means = malloc(sizeof(double) * 4 * ncell * 2);
-    double *cx = malloc(sizeof(double) * ncell * 4);
-    int *use = malloc(sizeof(int) * ncell);
-    double *ir = malloc(sizeof(double) * 4 * ((size_t)ns + 1) * ((size_t)nt + 1));
-    double *iv_ = malloc(sizeof(double) * 4 * ((size_t)ns + 1) * ((size_t)nt + 1));
-    if (!means || !cx || !use || !ir || !iv_) {
-        free(means), free(cx), free(use), free(ir), free(iv_);
-        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
+    int nth = lf_parallel_threads(threads);
+    nth = nth < n ? nth : n;
+    eq_ctx c = {.lf = lf, .centre = iv0 * lf->nu + iu0};
+    c.base = (eq_work){.ns = ns, .nt = nt, .nc = nc, .ncell = ncell};
+    c.base.ir = malloc(sizeof(double) * nint);
+    c.t = calloc((size_t)nth, sizeof *c.t);
+    c.fits = calloc((size_t)n, sizeof *c.fits);
+    int rc = !c.base.ir || !c.t || !c.fits;
+    for (int i = 0; i < nth && !rc; i++) {
+        eq_thread *t = &c.t[i];
+        t->means = malloc(sizeof(double) * 4 * ncell * 2), t->cx = malloc(sizeof(double) * ncell * 4);
+        t->use = malloc(sizeof(int) * ncell), t->iv = malloc(sizeof(double) * nint);
+        rc = !t->means || !t->cx || !t->use || !t->iv;
     }
-    eq_work w = {
-        .ns = ns, .nt = nt, .nc = nc, .ncell = ncell,
-        .cm = means, .vm = means + 4 * ncell,
-        .cx = cx, .cy = cx + ncell, .ly = cx + 2 * ncell, .tmp = cx + 3 * ncell,
-        .use = use, .ir = ir, .iv = iv_,
-    };
-    const float *refv = lf->valid ? lf->valid + ((size_t)iv0 * lf->nu + iu0) * np : NULL;
-    integral(lf_lightfield_view(lf, iu0, iv0), refv, ns, nt, ir);
-    int rc = LF_OK;
-    for (int k = 0; k < lf->nu * lf->nv && !rc; k++)
-        if (k != iv0 * lf->nu + iu0)
-            rc = equalize_view(lf, &w, k, err);
-    free(means), free(cx), free(use), free(ir), free(iv_);
+    if (rc) {
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory for the view gains");
+        goto done;
+    }
+    const float *refv = lf->valid ? lf->valid + (size_t)c.centre * np : NULL;
+    integral(lf_lightfield_view(lf, iu0, iv0), refv, ns, nt, c.base.ir);
+    lf_parallel_for(n, nth, 1, measure_views, &c);
+    /* applied in view order: the mask, the counts and the gain range as
+     * one view after the other gave them */
+    for (int k = 0; k < n && !rc; k++)
+        if (k != c.centre)
+            rc = apply_view(lf, &c.base, k, &c.fits[k], err);
+done:
+    for (int i = 0; c.t && i < nth; i++)
+        free(c.t[i].means), free(c.t[i].cx), free(c.t[i].use), free(c.t[i].iv);
+    free(c.t), free(c.fits), free(c.base.ir);
     return rc;
 }

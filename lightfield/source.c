@@ -114,7 +114,7 @@ static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_lay
 {
     if (o->white)
         return lf_error_set(err, LF_ERR_PARAM, "%s: --white applies to raws, not to a folder of views", src->path);
-    if (lf_lightfield_folder_scan(src->path, &src->folder, err) || lf_lightfield_folder_load(&src->folder, flags, &src->lf, err)) {
+    if (lf_lightfield_folder_scan(src->path, &src->folder, err) || lf_lightfield_folder_load_threads(&src->folder, flags, o->threads, &src->lf, err)) {
         lf_lightfield_close(src);
         return err ? err->code : LF_ERR_IO;
     }
@@ -124,7 +124,7 @@ static int open_folder(const lf_lightfield_open_opts *o, const lf_lightfield_lay
     lf_error e = {0};
     if (check_grid(o, src, &e))
         return fail_named(src, &e, err);
-    if (!o->no_equalize && lf_lightfield_equalize(&src->lf, &e))
+    if (!o->no_equalize && lf_lightfield_equalize_threads(&src->lf, o->threads, &e))
         return fail_named(src, &e, err);
     return LF_OK;
 }

@@ -190,7 +190,7 @@ static int load(const opts *o, lf_lightfield_source *s, int layout_only)
     lf_error err = {0};
     if (refuse_overwrite(o))
         return LF_EXIT_FAIL;
-    lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only, .grid = o->grid};
+    lf_lightfield_open_opts oo = {&o->flags, o->white, o->allow_nonfinite, layout_only, .grid = o->grid, .threads = o->threads};
     if (lf_lightfield_open(o->input, &oo, s, &err))
         return fail(&err, NULL);
     if (lf_warnings_text(&s->warnings))

@@ -138,6 +138,7 @@ typedef struct label_view {
     float fx, fy;       /* its fraction */
     float wx[4], wy[4]; /* Keys weights of the fraction (the cubic lookup) */
     int xa, xb;         /* the columns whose lookup stays inside the view (xa > xb: none) */
+    float gain;         /* the view's difference is scaled by this (noise_gain, or 1) */
 } label_view;
 
 typedef struct cost_ctx {
@@ -478,7 +479,7 @@ static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s,
         vcomb3(vp + xa, vp + vps + xa, vp + 2 * vps + xa, rr[0] + c0, rr[1] + c0, rr[2] + c0, rr[3] + c0, s->wy[0],
                s->wy[1], s->wy[2], s->wy[3], n);
         view_row_cubic(a, ns, vp, vp + vps, vp + 2 * vps, cp, cp + ns, cp + 2 * ns, s->wx[0], s->wx[1], s->wx[2],
-                       s->wx[3], c->scale, c->tau, xa, xb);
+                       s->wx[3], c->scale * s->gain, c->tau, xa, xb);
         return;
     }
     const float *cref = c->ref + (size_t)y * ns * 3;
@@ -492,9 +493,10 @@ static void add_view_row(const cost_ctx *c, const dview *v, const label_view *s,
         const float *m0 = v->valid + (size_t)r0 * ns + ix, *m1 = v->valid + (size_t)r1 * ns + ix;
         int mx1 = fx > 0.f ? 1 : 0;
         view_row_masked(a, ns, row0, row0 + dx1, row1, row1 + dx1, m0, m0 + mx1, m1, m1 + mx1, cref,
-                        c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+                        c->ref_valid + (size_t)y * ns, w00, w01, w10, w11, c->scale * s->gain, c->tau, xa, xb);
     } else {
-        view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale, c->tau, xa, xb);
+        view_row(a, ns, row0, row0 + dx1, row1, row1 + dx1, cref, w00, w01, w10, w11, c->scale * s->gain, c->tau, xa,
+                 xb);
     }
 }
 
@@ -1177,11 +1179,29 @@ static float reference_colour_scale(const float *ref, size_t np)
     return msum > 1e-12 ? (float)(1.0 / msum) : 1.f;
 }
 
+/* The gain that gives a view's difference to the reference, looked up at
+ * a sub-pixel phase with separable weights wx, wy (4 taps each), the noise
+ * of a whole-pixel lookup.  White noise of variance s^2 per texel makes the
+ * difference's variance s^2 (1 + Sx Sy), Sx and Sy the sums of the squared
+ * weights: 2 s^2 at a whole pixel, 1.41 s^2 at half a pixel in x and y
+ * for the cubic.  Unscaled, the labels whose phases smooth the noise most
+ * cost least wherever noise is a large part of the difference, and a
+ * noisy surface's disparities pile up at them; scaled by sqrt(2 / (1 +
+ * Sx Sy)) every label's noise costs the same (docs/depth.md, "Noisy
+ * views"). */
+static float noise_gain(const float wx[4], const float wy[4])
+{
+    float sx = 0, sy = 0;
+    for (int i = 0; i < 4; i++)
+        sx += wx[i] * wx[i], sy += wy[i] * wy[i];
+    return sqrtf(2.f / (1.f + sx * sy));
+}
+
 /* View v's shift at disparity d, I_ref(x, y) = I_v(x - d du + ox, y - d dv
  * + oy), split as the row loop reads it; the columns it may read: with
  * the cubic lookup (views without missing samples) ix-1 .. ix+2, else
  * ix .. ix+1. */
-static label_view label_shift(const dview *v, double d, int ns, int cubic)
+static label_view label_shift(const dview *v, double d, int ns, int cubic, int noise_aware)
 {
     label_view s;
     double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
@@ -1196,6 +1216,11 @@ static label_view label_shift(const dview *v, double d, int ns, int cubic)
         s.xa = s.ix < 0 ? -s.ix : 0;
         s.xb = ns - 1 - (s.fx > 0.f ? s.ix + 1 : s.ix);
         s.xb = s.xb > ns - 1 ? ns - 1 : s.xb;
+    }
+    s.gain = 1.f;
+    if (noise_aware) {
+        float lx[4] = {1 - s.fx, s.fx, 0, 0}, ly[4] = {1 - s.fy, s.fy, 0, 0};
+        s.gain = cubic && !v->valid ? noise_gain(s.wx, s.wy) : noise_gain(lx, ly);
     }
     return s;
 }
@@ -1232,7 +1257,8 @@ static int build_cost_volume(depth_work *w, lf_error *err)
     const lf_lightfield *lf = w->lf;
     for (int l = 0; l < w->nlabels; l++)
         for (int k = 0; k < w->nviews; k++)
-            w->lv[(size_t)l * w->nviews + k] = label_shift(&w->views[k], w->d0 + w->step * l, w->ns, w->cc.cubic);
+            w->lv[(size_t)l * w->nviews + k] = label_shift(&w->views[k], w->d0 + w->step * l, w->ns, w->cc.cubic,
+                                                          o->noise_aware > 0);
     if (lf->valid)
         w->cc.ref_valid = lf->valid + ((size_t)((lf->nv - 1) / 2) * lf->nu + (lf->nu - 1) / 2) * w->np;
     lf_parallel_for(w->nt, w->threads, 4, cost_rows, &w->cc);

@@ -53,6 +53,9 @@ typedef struct lf_lightfield_depth_opts {
     int median_radius;   /* weighted-median radius; 0: off; < 0: 3 */
     int refine;          /* Gauss-Newton refinement steps after the labels: 0 default (1), < 0 off */
     int interp;          /* views' sub-pixel lookup in the cost volume: 0 (default) Keys cubic, 1 bilinear */
+    int noise_aware;     /* 1: views carry sensor noise (a dim or low-sample capture): each view's difference
+                          * scaled so that every label's noise costs the same (docs/depth.md, "Noisy views");
+                          * 0 (default): off, as for clean renders, where it costs precision */
     int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */

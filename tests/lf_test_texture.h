@@ -1,7 +1,8 @@
 /* lf_test_texture.h - a smooth procedural texture for the light-field tests
  * that synthesise views themselves (test_lightfield_depth, _grid, _range):
  * value noise, one unit per cell, in [0, 1), the same at every view so the
- * ground truth comes from the geometry alone. */
+ * ground truth comes from the geometry alone; and a seeded Gaussian for
+ * the views' noise. */
 #ifndef LF_TEST_TEXTURE_H
 #define LF_TEST_TEXTURE_H
 
@@ -23,6 +24,16 @@ static inline double vnoise(double x, double y)
     fx = fx * fx * (3 - 2 * fx), fy = fy * fy * (3 - 2 * fy);
     double a = hash2(i, j), b = hash2(i + 1, j), c = hash2(i, j + 1), d = hash2(i + 1, j + 1);
     return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
+}
+
+/* Gaussian deviate (Box-Muller on a 64-bit LCG, state *st) */
+static inline double lf_test_gauss(unsigned long long *st)
+{
+    *st = *st * 6364136223846793005ULL + 1442695040888963407ULL;
+    double a = ((*st >> 11) + 0.5) / 9007199254740992.0;
+    *st = *st * 6364136223846793005ULL + 1442695040888963407ULL;
+    double b = ((*st >> 11) + 0.5) / 9007199254740992.0;
+    return sqrt(-2 * log(a)) * cos(2 * M_PI * b);
 }
 
 #endif

@@ -25,16 +25,6 @@ static double hit(double cy, double dy)
     return (Z0 + GY * cy) / (1 - GY * dy);
 }
 
-/* Gaussian deviate (Box-Muller on a 64-bit LCG): the views' noise */
-static double gauss(unsigned long long *st)
-{
-    *st = *st * 6364136223846793005ULL + 1442695040888963407ULL;
-    double a = ((*st >> 11) + 0.5) / 9007199254740992.0;
-    *st = *st * 6364136223846793005ULL + 1442695040888963407ULL;
-    double b = ((*st >> 11) + 0.5) / 9007199254740992.0;
-    return sqrt(-2 * log(a)) * cos(2 * M_PI * b);
-}
-
 static void render(int u, int v, float *dst)
 {
     double cx = (u - (N - 1) / 2.0) * B, cy = -(v - (N - 1) / 2.0) * B;
@@ -49,7 +39,7 @@ static void render(int u, int v, float *dst)
                     acc += 0.6 * vnoise(X * 15, Y * 15) + 0.4 * vnoise(X * 6 + 7, Y * 6 + 3);
                 }
             for (int k = 0; k < 3; k++)
-                dst[((size_t)y * W + x) * 3 + k] = (float)(0.15 + 0.6 * acc / (SS * SS) + 0.05 * k + 0.01 * gauss(&st));
+                dst[((size_t)y * W + x) * 3 + k] = (float)(0.15 + 0.6 * acc / (SS * SS) + 0.05 * k + 0.01 * lf_test_gauss(&st));
         }
 }
 

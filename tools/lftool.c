@@ -31,7 +31,7 @@ typedef struct opts {
     lf_lightfield_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
-    int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units;
+    int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units, noisy;
     lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal; /* synth */
     int port, have_steps;                               /* export-web, serve */
@@ -446,6 +446,7 @@ static int cmd_depth(void *ctx, int n, char **pos)
     lf_progress pr;
     lf_progress_start(&pr);
     d.threads = o->threads, d.progress = isatty(2) ? lf_cli_progress : NULL, d.progress_ctx = &pr;
+    d.noise_aware = o->noisy;
     const char *src = "--from/--to";
     if (o->have_from)
         d.d0 = o->from, d.d1 = o->to;
@@ -718,6 +719,9 @@ int main(int argc, char **argv)
         {"--confidence", NULL, LF_ARG_STRING, &o.confidence, "C.exr", "also write the confidence map"},
         {"--calibrate-views", NULL, LF_ARG_FLAG, &o.calibrate_views, NULL,
          "fit each view's position and pixel offset to the data first (docs/depth.md)"},
+        {"--noisy", NULL, LF_ARG_FLAG, &o.noisy, NULL,
+         "the views carry sensor noise (a dim or low-sample capture): match so that no disparity is favoured by "
+         "how the lookup smooths the noise (docs/depth.md, \"Noisy views\")"},
         {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD",
          "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
          .choices = "volume|stack"},

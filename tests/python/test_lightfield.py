@@ -63,6 +63,16 @@ def test_depth_options_and_confidence_equal_lftool(lf, raw, tmp_path):
     assert (tmp_path / "py.exr").read_bytes() == (tmp_path / "d.exr").read_bytes()
 
 
+def test_depth_noisy_equals_lftool(lf, raw, tmp_path):
+    # --noisy / noisy=True: the same map from both, and a different one from
+    # the default (each view's difference is rescaled label by label)
+    run("lftool", "depth", raw, "-o", tmp_path / "n.pfm", "--from", 0, "--to", 2, "--noisy")
+    L = lf.open(raw)
+    d = L.depth(from_=0, to=2, noisy=True)
+    assert np.array_equal(d, read_pfm(tmp_path / "n.pfm"))
+    assert not np.array_equal(d, L.depth(from_=0, to=2))
+
+
 def test_depth_stack_method_equals_lftool(lf, raw, tmp_path):
     run("lftool", "depth", raw, "-o", tmp_path / "s.pfm", "--method", "stack", "--from", 0, "--to", 2,
         "--steps", 5)

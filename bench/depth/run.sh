@@ -15,7 +15,8 @@
 #     the files it includes (comments left out, "# post:" lines kept), the
 #     textures they read and this script's post version, so a second run
 #     only estimates depth.
-#  2. `lftool depth DIR -o d.pfm` with no flags (2 threads), timed (wall).
+#  2. `lftool depth DIR -o d.pfm` with no flags (2 threads; DEPTH_FLAGS in
+#     the environment are added, e.g. DEPTH_FLAGS=--noisy), timed (wall).
 #     The decoded parameters.cfg's disp_min/disp_max (the ground truth's
 #     range) are left out, so lftool estimates the range from the views as
 #     for any capture without metadata; --given-range keeps them, as the
@@ -151,7 +152,8 @@ for item in "${list[@]}"; do
     nx=$(sed -n 's/^num_cams_x *= *//p' "$cache/hci/parameters.cfg")
     centre=$(printf "input_Cam%03d.png" $(((nx * nx - 1) / 2)))
     t0=$(date +%s.%N)
-    "$bin/lftool" depth "$run/in" -o "$run/d.pfm" > "$run/depth.log" 2>&1 || { cat "$run/depth.log" >&2; exit 1; }
+    # shellcheck disable=SC2086 # DEPTH_FLAGS: words, deliberately split
+    "$bin/lftool" depth "$run/in" -o "$run/d.pfm" ${DEPTH_FLAGS:-} > "$run/depth.log" 2>&1 || { cat "$run/depth.log" >&2; exit 1; }
     t1=$(date +%s.%N)
     s=$("$bin/depth_score" "$run/d.pfm" "$cache/hci/gt_disp_lowres.pfm" --view "$cache/hci/$centre" \
         --error "$run/err.png" --bad "$run/bad.png" --disp "$run/disp.png")

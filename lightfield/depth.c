@@ -14,6 +14,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -85,6 +86,16 @@ static const int REFINE_RADIUS = 2;
 static const double REFINE_MAX_STEP_LABELS = 2.0;
 /* threads when the options say none */
 static const int DEFAULT_THREADS = 2;
+
+/* Plain pixels: the unaggregated curve's mean exceeds its minimum by less
+ * than half an 8-bit code step in one channel (noise-free views), or by
+ * less than the 99th percentile of what pure noise gives, relative to the
+ * curve's mean (noisy views; measured by noise_contrast_ratio). */
+static const float PLAIN_ABS_CONTRAST = 1e-3f;
+static const double PLAIN_NOISE_QUANTILE = 0.99;
+/* the simulated field: noise of 5 % of the level (far from the
+ * truncation), a fixed seed */
+static const double PLAIN_SIM_NOISE = 0.05;
 /* semi-global aggregation: penalties in units of the cost's mean contrast,
  * and the colour step (square-root encoded) that halves P2 */
 static const double DEFAULT_SGM_P1 = 0.05;
@@ -1098,6 +1109,7 @@ typedef struct depth_work {
     float *disp, *conf; /* winner-take-all disparity and confidence */
     float *refs;        /* square-root encoded reference in the working scale (median, refinement) */
     float *rawd;        /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
+    unsigned char *plain; /* NULL, or per pixel 1 where the unaggregated curve is flat within the noise */
     cost_ctx cc;
     depth_progress progress;
 } depth_work;
@@ -1105,7 +1117,7 @@ typedef struct depth_work {
 static void depth_work_free(depth_work *w)
 {
     free(w->views), free(w->lv), free(w->cost), free(w->sel), free(w->scratch), free(w->guide), free(w->disp), free(w->refs);
-    free(w->rawd);
+    free(w->rawd), free(w->plain);
 }
 
 static int depth_work_alloc(depth_work *w, const lf_lightfield *lf, const lf_lightfield_depth_opts *o, int nl,
@@ -1438,6 +1450,114 @@ static void refine_disparity(depth_work *w, float *map)
     }
 }
 
+/* Standard normal deviates from a fixed-seed xorshift generator (the
+ * simulated noise field must be the same on every run). */
+static int cmpf(const void *a, const void *b);
+
+static double gauss_next(uint64_t *s)
+{
+    double u[2];
+    for (int k = 0; k < 2; k++) {
+        *s ^= *s << 13, *s ^= *s >> 7, *s ^= *s << 17;
+        u[k] = ((double)(*s >> 11) + 0.5) / 9007199254740992.0;
+    }
+    return sqrt(-2.0 * log(u[0])) * cos(2.0 * M_PI * u[1]);
+}
+
+/* The contrast a curve of pure noise has, relative to its mean: the
+ * views' geometry, labels, subsets and gate of w run on a flat field of the
+ * reference's mean colour with white noise on every view, and the 99th
+ * percentile of (mean - min) / mean over the pixels every view covers at
+ * every label.  Scale-free: it holds for any noise level well under the
+ * truncation, so the noise need not be measured. */
+static int noise_contrast_ratio(const depth_work *w, double *ratio, lf_error *err)
+{
+    const lf_lightfield *lf = w->lf;
+    double dmax = fmax(fabs(w->d0), fabs(w->d0 + w->step * (w->nlabels - 1))), mx = 0, my = 0;
+    for (int k = 0; k < w->nviews; k++) {
+        const dview *v = &w->views[k];
+        mx = fmax(mx, dmax * fabs(v->du) + fabs(v->ox));
+        my = fmax(my, dmax * fabs(v->dv) + fabs(v->oy));
+    }
+    int bx = (int)ceil(mx) + 3, by = (int)ceil(my) + 3;
+    lf_lightfield s = *lf;
+    s.ns = 2 * bx + 48, s.nt = 2 * by + 16;
+    s.valid = NULL, s.missing = 0, s.half = NULL, s.view_gain = NULL;
+    size_t vnp = (size_t)s.ns * s.nt, nview = (size_t)s.nu * s.nv;
+    if (!(s.data = malloc(sizeof(float) * 3 * vnp * nview)))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the noise field");
+    double mean[3] = {0, 0, 0};
+    for (size_t i = 0; i < w->np; i++)
+        for (int c = 0; c < 3; c++)
+            mean[c] += w->ref[3 * i + c];
+    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    for (size_t i = 0; i < 3 * vnp * nview; i++) {
+        double m = mean[i % 3] / (double)w->np;
+        s.data[i] = (float)(m * (1.0 + PLAIN_SIM_NOISE * gauss_next(&seed)));
+    }
+    lf_lightfield_depth_opts so = *w->o;
+    so.thin = -1, so.progress = NULL;
+    depth_work sw;
+    int rc = depth_work_alloc(&sw, &s, &so, w->nlabels, w->d0, w->step, err);
+    float *r = NULL;
+    if (!rc) {
+        sw.progress.o = &so, sw.progress.total = 1;
+        atomic_init(&sw.progress.done, 0);
+        collect_views(&sw);
+        sw.scale = reference_colour_scale(sw.ref, sw.np);
+        rc = build_cost_volume(&sw, err);
+    }
+    size_t n = 0;
+    if (!rc && !(r = malloc(sizeof(float) * sw.np)))
+        rc = lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    for (int y = by; !rc && y < s.nt - by; y++)
+        for (int x = bx; x < s.ns - bx; x++) {
+            size_t i = (size_t)y * s.ns + x;
+            float mn = FLT_MAX, sum = 0;
+            for (int l = 0; l < sw.nlabels; l++) {
+                float v = sw.cost[(size_t)l * sw.np + i];
+                sum += v, mn = v < mn ? v : mn;
+            }
+            float avg = sum / sw.nlabels;
+            if (avg > 0)
+                r[n++] = (avg - mn) / avg;
+        }
+    if (!rc) {
+        qsort(r, n, sizeof *r, cmpf);
+        *ratio = n ? r[(size_t)(PLAIN_NOISE_QUANTILE * (double)(n - 1))] : 0;
+    }
+    free(r), free(s.data);
+    depth_work_free(&sw);
+    return rc;
+}
+
+/* The plain pixels (see PLAIN_ABS_CONTRAST) of the unaggregated volume,
+ * before the filter overwrites it. */
+static int mark_plain(depth_work *w, lf_error *err)
+{
+    if (w->o->plain <= 0)
+        return LF_OK;
+    double ratio = 0;
+    int rc = noise_contrast_ratio(w, &ratio, err);
+    if (rc)
+        return rc;
+    float *mn = w->disp, *sum = w->disp + w->np; /* free until the minimum */
+    if (!(w->plain = malloc(w->np)))
+        return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < w->np; i++)
+        mn[i] = FLT_MAX, sum[i] = 0;
+    for (int l = 0; l < w->nlabels; l++) {
+        const float *c = w->cost + (size_t)l * w->np;
+        for (size_t i = 0; i < w->np; i++)
+            sum[i] += c[i], mn[i] = c[i] < mn[i] ? c[i] : mn[i];
+    }
+    for (size_t i = 0; i < w->np; i++) {
+        float avg = sum[i] / w->nlabels, t = (float)ratio * avg;
+        w->plain[i] = avg - mn[i] < (t > PLAIN_ABS_CONTRAST ? t : PLAIN_ABS_CONTRAST);
+    }
+    return LF_OK;
+}
+
 /* Stage 3b: semi-global aggregation over the filtered volume, its
  * penalties in units of the volume's mean cost contrast (mean over pixels
  * of the curve's mean minus its minimum), so they follow the cost's scale. */
@@ -1488,7 +1608,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     atomic_init(&w.progress.done, 0);
     collect_views(&w);
     w.scale = reference_colour_scale(w.ref, w.np);
-    if ((rc = build_cost_volume(&w, err)))
+    if ((rc = build_cost_volume(&w, err)) || (rc = mark_plain(&w, err)))
         goto done;
     aggregate_cost_volume(&w);
     encode_reference(&w);
@@ -1500,6 +1620,10 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
         goto done;
     }
     if ((rc = weighted_median(&w, disparity->data, err)) || (rc = recover_thin_structures(&w, disparity->data, err))) {
+        lf_image_free(disparity);
+        goto done;
+    }
+    if (w.plain && (rc = lf_depth_plain_fill(disparity->data, w.plain, w.conf, w.refs, w.ns, w.nt, NULL, err))) {
         lf_image_free(disparity);
         goto done;
     }
@@ -1623,7 +1747,7 @@ static int range_pass(const lf_lightfield *small, int threads, double s0, double
     o.threads = threads;
     o.occlusion = 0;
     o.median_radius = 0;
-    o.refine = -1, o.interp = 1, o.thin = -1; /* the range needs no sub-label precision */
+    o.refine = -1, o.interp = 1, o.thin = -1, o.plain = -1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
     int rc = depth_core(small, &o, s0, s1, step, &disp, &conf, err);

@@ -59,6 +59,10 @@ typedef struct lf_lightfield_depth_opts {
     int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
+    int plain;           /* > 0: plain regions (curves flat within the views' noise) take the far end of
+                          * the evidence of their colour around them (a textured object before a plain
+                          * wall); 0 (default): off, the benchmark's held-out half did not confirm it
+                          * (docs/depth.md, "Plain regions") */
     int sgm;             /* semi-global aggregation after the guided filter: 0 default (on), < 0 off */
     double sgm_p1, sgm_p2, sgm_edge; /* its penalties and edge scale; <= 0: defaults (docs/depth.md) */
     int threads;         /* <= 0: 2 */

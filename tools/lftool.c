@@ -31,7 +31,7 @@ typedef struct opts {
     lf_lightfield_layout flags;
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
-    int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units, noisy;
+    int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units, noisy, plain_regions;
     lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal; /* synth */
     int port, have_steps;                               /* export-web, serve */
@@ -447,6 +447,7 @@ static int cmd_depth(void *ctx, int n, char **pos)
     lf_progress_start(&pr);
     d.threads = o->threads, d.progress = isatty(2) ? lf_cli_progress : NULL, d.progress_ctx = &pr;
     d.noise_aware = o->noisy;
+    d.plain = o->plain_regions;
     const char *src = "--from/--to";
     if (o->have_from)
         d.d0 = o->from, d.d1 = o->to;
@@ -722,6 +723,9 @@ int main(int argc, char **argv)
         {"--noisy", NULL, LF_ARG_FLAG, &o.noisy, NULL,
          "the views carry sensor noise (a dim or low-sample capture): match so that no disparity is favoured by "
          "how the lookup smooths the noise (docs/depth.md, \"Noisy views\")"},
+        {"--plain-regions", NULL, LF_ARG_FLAG, &o.plain_regions, NULL,
+         "untextured regions take the far end of the evidence of their colour around them (a textured object "
+         "before a plain wall; docs/depth.md, \"Plain regions\")"},
         {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD",
          "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
          .choices = "volume|stack"},

@@ -1,8 +1,8 @@
 /* lf_test_texture.h - a smooth procedural texture for the light-field tests
  * that synthesise views themselves (test_lightfield_depth, _grid, _range):
  * value noise, one unit per cell, in [0, 1), the same at every view so the
- * ground truth comes from the geometry alone; and a seeded Gaussian for
- * the views' noise. */
+ * ground truth comes from the geometry alone; a seeded Gaussian for
+ * the views' noise; and a supersampled pinhole view of a traced scene. */
 #ifndef LF_TEST_TEXTURE_H
 #define LF_TEST_TEXTURE_H
 
@@ -34,6 +34,30 @@ static inline double lf_test_gauss(unsigned long long *st)
     *st = *st * 6364136223846793005ULL + 1442695040888963407ULL;
     double b = ((*st >> 11) + 0.5) / 9007199254740992.0;
     return sqrt(-2 * log(a)) * cos(2 * M_PI * b);
+}
+
+/* A pinhole view, w x h px, focal length f px, principal point at the
+ * image centre moved by (ox, oy) px, from (cx, cy, 0) looking along +z
+ * with y up in the world: each pixel the mean of ss x ss rays, the colour
+ * of a ray from trace(cx, cy, dx, dy, col) along (dx, dy, 1). */
+typedef double (*lf_test_trace_fn)(double cx, double cy, double dx, double dy, float col[3]);
+static inline void lf_test_render_view(float *dst, int w, int h, int ss, double f, double cx, double cy, double ox,
+                                       double oy, lf_test_trace_fn trace)
+{
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double acc[3] = {0, 0, 0};
+            for (int j = 0; j < ss; j++)
+                for (int i = 0; i < ss; i++) {
+                    double px = x + (i + 0.5) / ss - w / 2.0 - ox, py = y + (j + 0.5) / ss - h / 2.0 - oy;
+                    float c[3];
+                    trace(cx, cy, px / f, -py / f, c);
+                    for (int k = 0; k < 3; k++)
+                        acc[k] += c[k];
+                }
+            for (int k = 0; k < 3; k++)
+                dst[((size_t)y * w + x) * 3 + k] = (float)(acc[k] / (ss * ss));
+        }
 }
 
 #endif

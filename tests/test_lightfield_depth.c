@@ -71,20 +71,7 @@ static double trace(double cx, double cy, double dx, double dy, float col[3])
 static void render(double fu, double fv, float *dst)
 {
     double cx = (fu - (N - 1) / 2.0) * B, cy = -(fv - (N - 1) / 2.0) * B;
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            double acc[3] = {0, 0, 0};
-            for (int j = 0; j < SS; j++)
-                for (int i = 0; i < SS; i++) {
-                    double px = x + (i + 0.5) / SS - W / 2.0 - g_ox, py = y + (j + 0.5) / SS - H / 2.0 - g_oy;
-                    float c[3];
-                    trace(cx, cy, px / F, -py / F, c);
-                    for (int k = 0; k < 3; k++)
-                        acc[k] += c[k];
-                }
-            for (int k = 0; k < 3; k++)
-                dst[((size_t)y * W + x) * 3 + k] = (float)(acc[k] / (SS * SS));
-        }
+    lf_test_render_view(dst, W, H, SS, F, cx, cy, g_ox, g_oy, trace);
 }
 
 static void make_lf(lf_lightfield *lf)

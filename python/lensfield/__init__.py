@@ -398,14 +398,16 @@ class LightField:
 
     # -- computations
     def depth(self, *, from_=None, to=None, steps=None, aperture=None, views=None, confidence=False,
-              calibrate_views=False, noisy=False, method="volume", threads=0, return_range=False):
+              calibrate_views=False, noisy=False, plain_regions=False, method="volume", threads=0,
+              return_range=False):
         """Disparity map of the centre view, (height, width) float32, px per
         view step (lftool depth; docs/depth.md).  Keywords are lftool depth's
         flags: from_/to (--from/--to; neither: the source's stated range or
         one estimated from the data), steps, aperture and views (method
         "stack" only, as in lftool), calibrate_views, method ("volume" or
-        "stack"), noisy (--noisy: views with sensor noise), threads (0: all
-        cores).  confidence=True also returns the
+        "stack"), noisy (--noisy: views with sensor noise), plain_regions
+        (--plain-regions: untextured regions from the evidence around them),
+        threads (0: all cores).  confidence=True also returns the
         confidence map; return_range=True also the range searched (d0, d1)."""
         a = _capi.DepthArgs()
         if (from_ is None) != (to is None):
@@ -424,6 +426,7 @@ class LightField:
         a.threads = _threads(threads)
         a.calibrate_views = bool(calibrate_views)
         a.noisy = bool(noisy)
+        a.plain = bool(plain_regions)
         a.stack = method == "stack"
         a.confidence = bool(confidence) and method == "volume"
         disp, conf = _OutImage(), _OutImage()

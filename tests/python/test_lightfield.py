@@ -73,6 +73,16 @@ def test_depth_noisy_equals_lftool(lf, raw, tmp_path):
     assert not np.array_equal(d, L.depth(from_=0, to=2))
 
 
+def test_depth_plain_regions_equals_lftool(lf, raw, tmp_path):
+    # --plain-regions / plain_regions=True: the same map from both, and a
+    # different one from the default (the array's plain backdrop moves)
+    run("lftool", "depth", raw, "-o", tmp_path / "p.pfm", "--from", 0, "--to", 2, "--plain-regions")
+    L = lf.open(raw)
+    d = L.depth(from_=0, to=2, plain_regions=True)
+    assert np.array_equal(d, read_pfm(tmp_path / "p.pfm"))
+    assert not np.array_equal(d, L.depth(from_=0, to=2))
+
+
 def test_depth_stack_method_equals_lftool(lf, raw, tmp_path):
     run("lftool", "depth", raw, "-o", tmp_path / "s.pfm", "--method", "stack", "--from", 0, "--to", 2,
         "--steps", 5)

@@ -1452,8 +1452,6 @@ static void refine_disparity(depth_work *w, float *map)
 
 /* Standard normal deviates from a fixed-seed xorshift generator (the
  * simulated noise field must be the same on every run). */
-static int cmpf(const void *a, const void *b);
-
 static double gauss_next(uint64_t *s)
 {
     double u[2];
@@ -1523,7 +1521,7 @@ static int noise_contrast_ratio(const depth_work *w, double *ratio, lf_error *er
                 r[n++] = (avg - mn) / avg;
         }
     if (!rc) {
-        qsort(r, n, sizeof *r, cmpf);
+        qsort(r, n, sizeof *r, lf_depth_cmpf);
         *ratio = n ? r[(size_t)(PLAIN_NOISE_QUANTILE * (double)(n - 1))] : 0;
     }
     free(r), free(s.data);
@@ -1623,7 +1621,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
         lf_image_free(disparity);
         goto done;
     }
-    if (w.plain && (rc = lf_depth_plain_fill(disparity->data, w.plain, w.conf, w.refs, w.ns, w.nt, NULL, err))) {
+    if (w.plain && (rc = lf_depth_plain_fill(disparity->data, w.plain, w.conf, w.refs, w.ns, w.nt, err))) {
         lf_image_free(disparity);
         goto done;
     }
@@ -1641,12 +1639,6 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
 done:
     depth_work_free(&w);
     return rc;
-}
-
-static int cmpf(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
 }
 
 static int check_lf(const lf_lightfield *lf, lf_error *err)
@@ -1767,7 +1759,7 @@ static int range_pass(const lf_lightfield *small, int threads, double s0, double
                 (!interior || (disp.data[i] > s0 + 0.5 * step && disp.data[i] < s1 - 0.5 * step)))
                 vals[n++] = disp.data[i];
     }
-    qsort(vals, n, sizeof(float), cmpf);
+    qsort(vals, n, sizeof(float), lf_depth_cmpf);
     *lo = vals[(size_t)(0.01 * (n - 1))], *hi = vals[(size_t)(0.99 * (n - 1))];
     free(vals);
     lf_image_free(&disp), lf_image_free(&conf);

@@ -15,14 +15,22 @@
 int lf_depth_sgm(const float *cost, float *sum, int w, int h, int nlabels, const float *refs, float p1, float p2,
                  float edge, int threads, lf_error *err);
 
-/* Plain regions (docs/depth.md, "Plain regions"): the 4-connected pixels
- * marked in plain (1: the cost curve is flat within the views' noise) whose
- * 5 x 5 mean colours in refs (square-root encoded RGB, w x h) differ by less
- * than 0.02 form regions; a region of at least 0.1 % of the image takes, where
- * map is nearer, the 10th percentile of map over the pixels with evidence
- * (not plain) within 2 px of it whose colour is within 0.04 of its mean.
- * filled (may be NULL): how many pixels moved. */
+/* Plain regions (docs/depth.md, "Plain regions, noise-relative"): the
+ * 4-connected pixels marked in plain (1: the cost curve is flat within the
+ * views' noise) whose 5 x 5 mean colours in refs (square-root encoded RGB,
+ * w x h) lie within 0.02 of the region's mean form regions; a region of at
+ * least 0.1 % of the image takes, where map is nearer, the lower quartile
+ * of map over its evidence: pixels within 2 px that are not plain, have 2
+ * or more of 8 neighbours not plain, a confidence (conf) of at least 0.3
+ * and a colour within 0.04 of the region's mean. */
 int lf_depth_plain_fill(float *map, const unsigned char *plain, const float *conf, const float *refs, int w, int h,
-                        size_t *filled, lf_error *err);
+                        lf_error *err);
+
+/* qsort's comparison of floats, ascending */
+static inline int lf_depth_cmpf(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
 
 #endif

@@ -7,7 +7,6 @@
  * evidence around it that has its colour: its own foot, the edges of the
  * shadows on it; a nearer object's outline is of another colour. */
 #include <stdlib.h>
-#include <string.h>
 
 #include "lightfield/depth_internal.h"
 
@@ -29,12 +28,6 @@ static const float EVIDENCE_MIN_CONFIDENCE = 0.3f;
  * marks' own estimates (0.1 and 0.25 compared on the tune split: 17.72 and
  * 17.58 %; the test's clean wall 25 and 2 %) */
 static const double FAR_QUANTILE = 0.25;
-
-static int cmpf(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
 
 /* 5 x 5 box means of the 3-channel image src into dst (clamped borders). */
 static void box3(const float *src, float *dst, int w, int h)
@@ -82,7 +75,7 @@ static int clustered(const unsigned char *plain, int w, int h, int x, int y)
 }
 
 int lf_depth_plain_fill(float *map, const unsigned char *plain, const float *conf, const float *refs, int w, int h,
-                        size_t *filled, lf_error *err)
+                        lf_error *err)
 {
     size_t np = (size_t)w * h;
     float *col = malloc(sizeof(float) * 3 * np), *ev = malloc(sizeof(float) * np);
@@ -96,8 +89,6 @@ int lf_depth_plain_fill(float *map, const unsigned char *plain, const float *con
     for (size_t i = 0; i < np; i++)
         region[i] = -1, stamp[i] = -1;
     size_t min_region = (size_t)(MIN_REGION * (double)np);
-    if (filled)
-        *filled = 0;
     int id = 0;
     for (size_t seed = 0; seed < np; seed++) {
         if (!plain[seed] || region[seed] >= 0)
@@ -148,16 +139,13 @@ int lf_depth_plain_fill(float *map, const unsigned char *plain, const float *con
                 }
             }
             if (ne >= MIN_EVIDENCE) {
-                qsort(ev, ne, sizeof *ev, cmpf);
+                qsort(ev, ne, sizeof *ev, lf_depth_cmpf);
                 float far = ev[(size_t)(FAR_QUANTILE * (double)(ne - 1))];
                 /* only ever farther: a plain region's error is the nearer
                  * surface grown over it, never the reverse */
                 for (size_t q = 0; q < n; q++)
-                    if (map[queue[q]] > far) {
+                    if (map[queue[q]] > far)
                         map[queue[q]] = far;
-                        if (filled)
-                            (*filled)++;
-                    }
             }
         }
         id++;

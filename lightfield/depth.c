@@ -1833,6 +1833,17 @@ int lf_lightfield_depth_range_report(const lf_lightfield *lf, int threads, doubl
                 *d1 = b;
             if (!(*d0 < *d1))
                 *d0 = a, *d1 = b;
+            /* what the reduced views lost (fine periodic texture) is
+             * checked at full resolution; it can only widen */
+            if (f > 1) {
+                lf_depth_range_check_info ci;
+                if ((rc = lf_depth_range_check(lf, threads, view_lim, m, d0, d1, &ci, err)))
+                    break;
+                if (info) {
+                    info->full_samples = ci.samples, info->full_confirmed = ci.confirmed;
+                    info->full_widened = ci.widened, info->full_lo = ci.lo, info->full_hi = ci.hi;
+                }
+            }
             break;
         }
         a = na, b = nb;

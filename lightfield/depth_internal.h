@@ -4,6 +4,7 @@
 #define LF_LIGHTFIELD_DEPTH_INTERNAL_H
 
 #include "base/lf_error.h"
+#include "lightfield/lf_lightfield.h"
 
 /* Semi-global aggregation (Hirschmueller 2008) of cost[label][pixel]
  * (w x h pixels, nlabels slices) along 4 paths (left, right, up, down):
@@ -25,6 +26,23 @@ int lf_depth_sgm(const float *cost, float *sum, int w, int h, int nlabels, const
  * and a colour within 0.04 of the region's mean. */
 int lf_depth_plain_fill(float *map, const unsigned char *plain, const float *conf, const float *refs, int w, int h,
                         lf_error *err);
+
+/* What the full-resolution check of a range found. */
+typedef struct lf_depth_range_check_info {
+    int samples, confirmed; /* sample pixels swept; confident ones confirmed by their neighbours */
+    double lo, hi;          /* the confirmed winners' 1st and 99th percentiles (confirmed >= 20) */
+    int widened;            /* 1: *d0 or *d1 moved out to them */
+} lf_depth_range_check_info;
+
+/* The full-resolution check of an estimated range [*d0, *d1] (px/view;
+ * docs/depth.md, "The range checked at full resolution"): a 3 x 3 window
+ * every 24 px of the reference, swept at half-pixel steps at the outermost
+ * view (m view steps from the reference) over the disparities up to lim
+ * at which every view stays inside the image; the winners that are
+ * confident and agree with 2 or more of their 8 neighbouring samples widen
+ * the range to their 1st..99th percentile (never narrow it). */
+int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, double m, double *d0, double *d1,
+                         lf_depth_range_check_info *info, lf_error *err);
 
 /* qsort's comparison of floats, ascending */
 static inline int lf_depth_cmpf(const void *a, const void *b)

@@ -96,6 +96,11 @@ typedef struct lf_lightfield_depth_range_info {
     double first_d0, first_d1;   /* the first sweep's estimate (px per view) */
     double search_d0, search_d1; /* the last sweep's search range */
     int widened;                 /* 1: the data reached an end of the first sweep, which was widened */
+    /* the check at full resolution (fine texture the reduced views lose):
+     * samples swept, how many were confirmed by their neighbours, and
+     * whether their winners widened the range */
+    int full_samples, full_confirmed, full_widened;
+    double full_lo, full_hi; /* the confirmed winners' 1st..99th percentile */
 } lf_lightfield_depth_range_info;
 
 /* lf_lightfield_depth_range, reporting into *info (NULL: as above). */

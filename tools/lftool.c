@@ -459,8 +459,15 @@ static int cmd_depth(void *ctx, int n, char **pos)
     char srcbuf[160];
     if (d.d0 >= d.d1 && lf_lightfield_depth_range_report(&s.lf, o->threads, &d.d0, &d.d1, &ri, &err))
         goto failed;
-    if (!strcmp(src, "estimated") && ri.widened) /* the data reached the first sweep's end */
-        snprintf(srcbuf, sizeof srcbuf, "estimated, widened from %.4g .. %.4g", ri.first_d0, ri.first_d1), src = srcbuf;
+    if (!strcmp(src, "estimated") && (ri.widened || ri.full_widened)) { /* the data reached past the estimate */
+        int k = 0;
+        if (ri.widened)
+            k = snprintf(srcbuf, sizeof srcbuf, "estimated, widened from %.4g .. %.4g", ri.first_d0, ri.first_d1);
+        if (ri.full_widened)
+            snprintf(srcbuf + k, sizeof srcbuf - (size_t)k, "%s full-resolution check found %.4g .. %.4g",
+                     k ? ";" : "estimated, widened: the", ri.full_lo, ri.full_hi);
+        src = srcbuf;
+    }
     if (o->have_steps)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
     if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */

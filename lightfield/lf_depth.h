@@ -63,6 +63,9 @@ typedef struct lf_lightfield_depth_opts {
                           * the evidence of their colour around them (a textured object before a plain
                           * wall); 0 (default): off, the benchmark's held-out half did not confirm it
                           * (docs/depth.md, "Plain regions") */
+    double prefilter;    /* Gaussian pre-smoothing of the views before matching, sigma in px: 0 default
+                          * (auto: 0.7 where the views' noise is 2 % of their level or more, docs/depth.md,
+                          * "Pre-smoothing noisy views"), < 0 off, > 0 that sigma */
     int sgm;             /* semi-global aggregation after the guided filter: 0 default (on), < 0 off */
     double sgm_p1, sgm_p2, sgm_edge; /* its penalties and edge scale; <= 0: defaults (docs/depth.md) */
     int threads;         /* <= 0: 2 */

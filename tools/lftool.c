@@ -32,6 +32,8 @@ typedef struct opts {
     int have_alpha, have_depth, have_disp, have_aperture, have_views, have_from, have_to, have_u, have_v;
     double alpha, depth, disp, aperture, from, to, u, v, oversample;
     int views[4], steps, threads, allow_nonfinite, calibrate_views, no_wb, film_units, noisy, plain_regions;
+    double prefilter; /* depth --prefilter: the views' Gaussian pre-smoothing (px), 0 off */
+    int have_prefilter;
     lf_lightfield_synth_opts synth;
     int have_outfov, have_outdim, have_pos, have_focal; /* synth */
     int port, have_steps;                               /* export-web, serve */
@@ -448,6 +450,8 @@ static int cmd_depth(void *ctx, int n, char **pos)
     d.threads = o->threads, d.progress = isatty(2) ? lf_cli_progress : NULL, d.progress_ctx = &pr;
     d.noise_aware = o->noisy;
     d.plain = o->plain_regions;
+    if (o->have_prefilter) /* else auto */
+        d.prefilter = o->prefilter > 0 ? o->prefilter : -1;
     const char *src = "--from/--to";
     if (o->have_from)
         d.d0 = o->from, d.d1 = o->to;
@@ -733,6 +737,10 @@ int main(int argc, char **argv)
         {"--plain-regions", NULL, LF_ARG_FLAG, &o.plain_regions, NULL,
          "untextured regions take the far end of the evidence of their colour around them (a textured object "
          "before a plain wall; docs/depth.md, \"Plain regions\")"},
+        {"--prefilter", NULL, LF_ARG_DOUBLE, &o.prefilter, "SIGMA",
+         "smooth the views by a Gaussian of SIGMA px before matching, 0: never (default: 0.7 where the views' "
+         "noise is 2 % of their level or more; docs/depth.md, \"Pre-smoothing noisy views\")",
+         R_IN(0, 4), .given = &o.have_prefilter},
         {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD",
          "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",
          .choices = "volume|stack"},

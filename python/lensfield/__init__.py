@@ -398,8 +398,8 @@ class LightField:
 
     # -- computations
     def depth(self, *, from_=None, to=None, steps=None, aperture=None, views=None, confidence=False,
-              calibrate_views=False, noisy=False, plain_regions=False, method="volume", threads=0,
-              return_range=False):
+              calibrate_views=False, noisy=False, plain_regions=False, prefilter=None, method="volume",
+              threads=0, return_range=False):
         """Disparity map of the centre view, (height, width) float32, px per
         view step (lftool depth; docs/depth.md).  Keywords are lftool depth's
         flags: from_/to (--from/--to; neither: the source's stated range or
@@ -407,7 +407,8 @@ class LightField:
         "stack" only, as in lftool), calibrate_views, method ("volume" or
         "stack"), noisy (--noisy: views with sensor noise), plain_regions
         (--plain-regions: untextured regions from the evidence around them),
-        threads (0: all cores).  confidence=True also returns the
+        prefilter (--prefilter: the views' Gaussian pre-smoothing in px, 0
+        never; None: 0.7 where the views are noisy), threads (0: all cores).  confidence=True also returns the
         confidence map; return_range=True also the range searched (d0, d1)."""
         a = _capi.DepthArgs()
         if (from_ is None) != (to is None):
@@ -427,6 +428,10 @@ class LightField:
         a.calibrate_views = bool(calibrate_views)
         a.noisy = bool(noisy)
         a.plain = bool(plain_regions)
+        if prefilter is not None:
+            if not 0 <= float(prefilter) <= 4:
+                raise ValueError("prefilter: 0 .. 4 px")
+            a.have_prefilter, a.prefilter = 1, float(prefilter)
         a.stack = method == "stack"
         a.confidence = bool(confidence) and method == "volume"
         disp, conf = _OutImage(), _OutImage()

@@ -78,12 +78,14 @@ class LightField:
     def depth(self, *, from_: Optional[float] = ..., to: Optional[float] = ..., steps: Optional[int] = ...,
               aperture: Optional[float] = ..., views: Optional[Sequence[int]] = ...,
               confidence: Literal[False] = ..., calibrate_views: bool = ..., noisy: bool = ...,
-              plain_regions: bool = ..., method: Literal["volume", "stack"] = ..., threads: int = ...,
+              plain_regions: bool = ..., prefilter: Optional[float] = ...,
+              method: Literal["volume", "stack"] = ..., threads: int = ...,
               return_range: Literal[False] = ...) -> F32: ...
     @overload
     def depth(self, *, from_: Optional[float] = ..., to: Optional[float] = ..., steps: Optional[int] = ...,
               aperture: Optional[float] = ..., views: Optional[Sequence[int]] = ..., confidence: bool = ...,
               calibrate_views: bool = ..., noisy: bool = ..., plain_regions: bool = ...,
+              prefilter: Optional[float] = ...,
               method: Literal["volume", "stack"] = ..., threads: int = ..., return_range: bool = ...) -> Union[F32, Tuple[Any, ...]]:
         """Disparity of the centre view (height, width), px per view step, as
         `lftool depth`; (disp, conf) with confidence, + (d0, d1) with return_range."""

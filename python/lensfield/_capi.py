@@ -70,7 +70,8 @@ class DepthArgs(C.Structure):
     _fields_ = [("have_range", C.c_int), ("from_", C.c_double), ("to", C.c_double), ("have_steps", C.c_int),
                 ("steps", C.c_int), ("have_aperture", C.c_int), ("aperture", C.c_double), ("have_views", C.c_int),
                 ("views", C.c_int * 4), ("threads", C.c_int), ("calibrate_views", C.c_int), ("stack", C.c_int),
-                ("confidence", C.c_int), ("noisy", C.c_int), ("plain", C.c_int)]
+                ("confidence", C.c_int), ("noisy", C.c_int), ("plain", C.c_int),
+                ("have_prefilter", C.c_int), ("prefilter", C.c_double)]
 
 
 class Focus(C.Structure):

@@ -258,6 +258,8 @@ typedef struct lfpy_depth_args {
     int confidence;  /* also the confidence map */
     int noisy;       /* --noisy: noise_aware */
     int plain;       /* --plain-regions */
+    int have_prefilter;
+    double prefilter; /* --prefilter SIGMA (0: never) */
 } lfpy_depth_args;
 
 static lf_lightfield_refocus_opts aperture_opts(int have_aperture, double aperture, int have_views, const int views[4],
@@ -291,6 +293,8 @@ static int depth(lfpy_lightfield *h, const lfpy_depth_args *a, lf_image *disp, l
     }
     lf_lightfield_depth_opts d = lf_lightfield_depth_defaults();
     d.threads = a->threads, d.noise_aware = a->noisy, d.plain = a->plain;
+    if (a->have_prefilter) /* else auto, as lftool */
+        d.prefilter = a->prefilter > 0 ? a->prefilter : -1;
     if (a->have_range)
         d.d0 = a->from, d.d1 = a->to;
     else if (h->borrowed || !(*range_source = lf_lightfield_source_disparity_range(&h->src, &d.d0, &d.d1)))

@@ -83,6 +83,21 @@ def test_depth_plain_regions_equals_lftool(lf, raw, tmp_path):
     assert not np.array_equal(d, L.depth(from_=0, to=2))
 
 
+def test_depth_prefilter_equals_lftool(lf, raw, tmp_path):
+    # --prefilter SIGMA / prefilter=SIGMA, and 0 (never): the same maps
+    # from both, and different ones from each other
+    run("lftool", "depth", raw, "-o", tmp_path / "f.pfm", "--from", 0, "--to", 2, "--prefilter", 0.7)
+    run("lftool", "depth", raw, "-o", tmp_path / "f0.pfm", "--from", 0, "--to", 2, "--prefilter", 0)
+    L = lf.open(raw)
+    d = L.depth(from_=0, to=2, prefilter=0.7)
+    d0 = L.depth(from_=0, to=2, prefilter=0)
+    assert np.array_equal(d, read_pfm(tmp_path / "f.pfm"))
+    assert np.array_equal(d0, read_pfm(tmp_path / "f0.pfm"))
+    assert not np.array_equal(d, d0)
+    with pytest.raises(ValueError):
+        L.depth(from_=0, to=2, prefilter=5)
+
+
 def test_depth_stack_method_equals_lftool(lf, raw, tmp_path):
     run("lftool", "depth", raw, "-o", tmp_path / "s.pfm", "--method", "stack", "--from", 0, "--to", 2,
         "--steps", 5)

@@ -60,4 +60,36 @@ static inline void lf_test_render_view(float *dst, int w, int h, int ss, double 
         }
 }
 
+/* A view of the tilted plane Z = z0 + gx X + gy Y textured with value
+ * noise (two octaves), from the pinhole at (cx, cy, 0), w x h px, focal
+ * length f px, ss x ss rays per pixel: grey level * (0.15 + 0.6 n) + 0.05 k
+ * per channel k, plus Gaussian noise sigma of full scale from the LCG
+ * state seed.  hit: the depth along (dx, dy, 1) and the point hit. */
+static inline double lf_test_plane_hit(double z0, double gx, double gy, double cx, double cy, double dx, double dy,
+                                       double *X, double *Y)
+{
+    double t = (z0 + gx * cx + gy * cy) / (1 - gx * dx - gy * dy);
+    if (X)
+        *X = cx + t * dx, *Y = cy + t * dy;
+    return t;
+}
+static inline void lf_test_plane_view(float *dst, int w, int h, int ss, double f, double cx, double cy, double z0,
+                                      double gx, double gy, double level, double sigma, unsigned long long seed)
+{
+    unsigned long long st = seed;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double acc = 0;
+            for (int j = 0; j < ss; j++)
+                for (int i = 0; i < ss; i++) {
+                    double X, Y, dx = (x + (i + 0.5) / ss - w / 2.0) / f, dy = -(y + (j + 0.5) / ss - h / 2.0) / f;
+                    lf_test_plane_hit(z0, gx, gy, cx, cy, dx, dy, &X, &Y);
+                    acc += 0.6 * vnoise(X * 15, Y * 15) + 0.4 * vnoise(X * 6 + 7, Y * 6 + 3);
+                }
+            for (int k = 0; k < 3; k++)
+                dst[((size_t)y * w + x) * 3 + k] =
+                    (float)(level * (0.15 + 0.6 * acc / (ss * ss) + 0.05 * k) + sigma * lf_test_gauss(&st));
+        }
+}
+
 #endif

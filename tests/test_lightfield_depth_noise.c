@@ -24,29 +24,13 @@ static const double D0 = 0.6, D1 = 1.4, STEP = 0.05, SIGMA = 0.03;
 /* ray from camera (cx, cy, 0) along (dx, dy, 1): depth of the plane */
 static double hit(double cx, double cy, double dx, double dy, double *X, double *Y)
 {
-    double t = (Z0 + GX * cx + GY * cy) / (1 - GX * dx - GY * dy);
-    if (X)
-        *X = cx + t * dx, *Y = cy + t * dy;
-    return t;
+    return lf_test_plane_hit(Z0, GX, GY, cx, cy, dx, dy, X, Y);
 }
 
 static void render(int u, int v, double sigma, float *dst)
 {
     double cx = (u - (N - 1) / 2.0) * B, cy = -(v - (N - 1) / 2.0) * B;
-    unsigned long long st = 7919ULL * (unsigned long long)(v * N + u + 1);
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            double acc = 0;
-            for (int j = 0; j < SS; j++)
-                for (int i = 0; i < SS; i++) {
-                    double X, Y, dx = (x + (i + 0.5) / SS - W / 2.0) / F, dy = -(y + (j + 0.5) / SS - H / 2.0) / F;
-                    hit(cx, cy, dx, dy, &X, &Y);
-                    acc += 0.6 * vnoise(X * 15, Y * 15) + 0.4 * vnoise(X * 6 + 7, Y * 6 + 3);
-                }
-            for (int k = 0; k < 3; k++)
-                dst[((size_t)y * W + x) * 3 + k] =
-                    (float)(0.15 + 0.6 * acc / (SS * SS) + 0.05 * k + sigma * lf_test_gauss(&st));
-        }
+    lf_test_plane_view(dst, W, H, SS, F, cx, cy, Z0, GX, GY, 1.0, sigma, 7919ULL * (unsigned long long)(v * N + u + 1));
 }
 
 typedef struct stats {

@@ -27,10 +27,7 @@ static const double D0 = 0.6, D1 = 1.4;
 
 static double hit(double cx, double cy, double dx, double dy, double *X, double *Y)
 {
-    double t = (Z0 + GX * cx + GY * cy) / (1 - GX * dx - GY * dy);
-    if (X)
-        *X = cx + t * dx, *Y = cy + t * dy;
-    return t;
+    return lf_test_plane_hit(Z0, GX, GY, cx, cy, dx, dy, X, Y);
 }
 
 /* level: the texture's scale (1: 0.15 .. 0.85 of full scale); sigma: the
@@ -38,24 +35,10 @@ static double hit(double cx, double cy, double dx, double dy, double *X, double 
 static void make_lf(lf_lightfield *lf, double level, double sigma)
 {
     for (int v = 0; v < N; v++)
-        for (int u = 0; u < N; u++) {
-            double cx = (u - (N - 1) / 2.0) * B, cy = -(v - (N - 1) / 2.0) * B;
-            unsigned long long st = 104729ULL * (unsigned long long)(v * N + u + 1);
-            float *dst = lf_lightfield_view(lf, u, v);
-            for (int y = 0; y < H; y++)
-                for (int x = 0; x < W; x++) {
-                    double acc = 0;
-                    for (int j = 0; j < SS; j++)
-                        for (int i = 0; i < SS; i++) {
-                            double X, Y, dx = (x + (i + 0.5) / SS - W / 2.0) / F, dy = -(y + (j + 0.5) / SS - H / 2.0) / F;
-                            hit(cx, cy, dx, dy, &X, &Y);
-                            acc += 0.6 * vnoise(X * 15, Y * 15) + 0.4 * vnoise(X * 6 + 7, Y * 6 + 3);
-                        }
-                    for (int k = 0; k < 3; k++)
-                        dst[((size_t)y * W + x) * 3 + k] =
-                            (float)(level * (0.15 + 0.6 * acc / (SS * SS) + 0.05 * k) + sigma * lf_test_gauss(&st));
-                }
-        }
+        for (int u = 0; u < N; u++)
+            lf_test_plane_view(lf_lightfield_view(lf, u, v), W, H, SS, F, (u - (N - 1) / 2.0) * B,
+                               -(v - (N - 1) / 2.0) * B, Z0, GX, GY, level, sigma,
+                               104729ULL * (unsigned long long)(v * N + u + 1));
 }
 
 /* BadPix0.07 (%) of map against F B / Z, BORDER px left out */

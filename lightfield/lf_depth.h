@@ -9,6 +9,8 @@
  * division: the centre view of an odd grid) in pixels per view step, as in
  * lf_lightfield.h: I_ref(x, y) = I_(iu,iv)(x - d (iu - iu_ref),
  * y - d r (iv - iv_ref)), r = lf->disp_v_per_u.  The method (docs/depth.md):
+ *   0. noisy views (the reference's noise 2 % of its level or more) are
+ *      smoothed by a Gaussian of 0.7 px first (prefilter);
  *   1. cost volume over disparity labels (views looked up by Keys cubic
  *      convolution): per view a truncated absolute
  *      colour difference to the reference pixel (correspondence) and the

@@ -103,7 +103,7 @@ static const double PLAIN_SIM_NOISE = 0.05;
  * the flatter half of its pixels) is at least PREFILTER_NOISE of their mean
  * level are blurred by a Gaussian of PREFILTER_SIGMA px before matching;
  * both chosen on the benchmark's tune half and backgammon. */
-static const double PREFILTER_NOISE = 0.02;
+static const double PREFILTER_NOISE = LF_DEPTH_PREFILTER_NOISE;
 static const double PREFILTER_SIGMA = 0.7;
 static const double DEFAULT_SGM_P1 = 0.05;
 static const double DEFAULT_SGM_P2 = 8.0;
@@ -1700,6 +1700,12 @@ static double view_noise_ratio(const lf_lightfield *lf, lf_error *err, int *rc)
     if (!n || !(mean > 1e-6))
         return -1;
     return sqrt(M_PI / 2) / 6 * (sum / (double)n) / mean;
+}
+
+double lf_lightfield_depth_noise_ratio(const lf_lightfield *lf, lf_error *err)
+{
+    int rc;
+    return lf && lf->data ? view_noise_ratio(lf, err, &rc) : -1;
 }
 
 typedef struct blur_ctx {

@@ -79,6 +79,13 @@ typedef struct lf_lightfield_depth_opts {
 } lf_lightfield_depth_opts;
 lf_lightfield_depth_opts lf_lightfield_depth_defaults(void);
 
+/* The views' noise as lf_lightfield_depth's prefilter judges it: Immerkaer's
+ * estimate on the reference's sRGB-encoded grey over its flatter half,
+ * over its mean level (0.02 or more: the views are pre-smoothed by
+ * default); -1 when it cannot be measured. */
+double lf_lightfield_depth_noise_ratio(const lf_lightfield *lf, lf_error *err);
+#define LF_DEPTH_PREFILTER_NOISE 0.02 /* the ratio from which the default pre-smooths */
+
 /* Disparity map (1 channel) and, when confidence is non-NULL, a confidence
  * map in [0, 1] (1: a single sharp cost minimum).  Needs at least 2 views. */
 int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, lf_image *disparity, lf_image *confidence,

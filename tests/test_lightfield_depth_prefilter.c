@@ -73,6 +73,9 @@ int main(void)
     lf.disp_v_per_u = 1.0;
 
     make_lf(&lf, 0.2, 0.01);
+    double nr = lf_lightfield_depth_noise_ratio(&lf, &err);
+    printf("dim noisy views: noise ratio %.4f (pre-smoothed from %.2f)\n", nr, LF_DEPTH_PREFILTER_NOISE);
+    CHECK(nr >= LF_DEPTH_PREFILTER_NOISE);
     lf_image a = {0}, off = {0};
     CHECK(!depth(&lf, 0, &a) && !depth(&lf, -1, &off));
     double ba = badpix(&a), bo = badpix(&off);
@@ -82,6 +85,9 @@ int main(void)
     lf_image_free(&a), lf_image_free(&off);
 
     make_lf(&lf, 1, 0);
+    nr = lf_lightfield_depth_noise_ratio(&lf, &err);
+    printf("clean views: noise ratio %.4f\n", nr);
+    CHECK(nr >= 0 && nr < LF_DEPTH_PREFILTER_NOISE);
     lf_image e = {0};
     CHECK(!depth(&lf, 0, &a) && !depth(&lf, -1, &off) && !depth(&lf, 0.7, &e));
     int same = a.data && off.data && !memcmp(a.data, off.data, sizeof(float) * W * H);

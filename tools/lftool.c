@@ -486,9 +486,17 @@ static int cmd_depth(void *ctx, int n, char **pos)
     rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o, o->confidence, &conf, NULL);
+    char smooth[96] = "";
+    if (!rc && d.prefilter > 0)
+        snprintf(smooth, sizeof smooth, ", views pre-smoothed by %.3g px", d.prefilter);
+    else if (!rc && d.prefilter == 0 && !s.lf.valid) { /* what the default did, and why */
+        double nr = lf_lightfield_depth_noise_ratio(&s.lf, &err);
+        if (nr >= LF_DEPTH_PREFILTER_NOISE)
+            snprintf(smooth, sizeof smooth, ", views pre-smoothed: noise %.1f %% of their level", 100 * nr);
+    }
     if (!rc)
-        printf("%s: disparity map (range %.4g .. %.4g px/view, %s) -> %s%s%s\n", o->input, d.d0, d.d1, src, o->output,
-               o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
+        printf("%s: disparity map (range %.4g .. %.4g px/view, %s%s) -> %s%s%s\n", o->input, d.d0, d.d1, src, smooth,
+               o->output, o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
     else /* no half-written result: the disparity map goes with its confidence */
         remove(o->output);
     goto done;

@@ -244,7 +244,7 @@ static int attrs_move(lf_attrs *dst, lf_attrs *src)
 /* ------------------------------------------------------------------ sRGB */
 
 /* IEC 61966-2-1 transfer functions, the exact piecewise curve. */
-static double srgb_from_linear(double v)
+double lf_srgb_from_linear(double v)
 {
     return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
 }
@@ -261,7 +261,7 @@ unsigned char lf_srgb_encode(float linear)
         v = 0.0;
     if (v > 1.0)
         v = 1.0;
-    double c = srgb_from_linear(v) * 255.0 + 0.5;
+    double c = lf_srgb_from_linear(v) * 255.0 + 0.5;
     return (unsigned char)(c > 255.0 ? 255.0 : c);
 }
 

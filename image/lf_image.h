@@ -138,6 +138,8 @@ int lf_image_fits_half(const lf_image *img);
 
 /* Linear -> 8-bit sRGB (exposure in stops, clamp, sRGB curve), for previews. */
 unsigned char lf_srgb_encode(float linear);
+/* The sRGB transfer curve itself (IEC 61966-2-1), linear [0, 1] -> code [0, 1]. */
+double lf_srgb_from_linear(double linear);
 float lf_srgb_decode(unsigned char v);
 
 /* Comparison, over channels common to both, skipping nothing: images must

@@ -57,8 +57,6 @@ static const int MIN_GUIDE_RADIUS = 2;
 static const float DEFAULT_GUIDE_EPS = 1e-3f;
 /* confidence 4 (c2 - c_min) / mean(c): c2 the lowest cost more than 2
  * labels away (the minimum's own slope is not a second mode) */
-static const float CONFIDENCE_GAIN = 4.f;
-static const int CONFIDENCE_AWAY_LABELS = 2;
 /* weighted median over a 7 x 7 window: removes isolated outliers */
 static const int DEFAULT_MEDIAN_RADIUS = 3;
 /* a zero-confidence neighbour still votes a little, so a window never has
@@ -96,15 +94,14 @@ static const double PLAIN_NOISE_QUANTILE = 0.99;
 /* the simulated field: noise of 5 % of the level (far from the
  * truncation), a fixed seed */
 static const double PLAIN_SIM_NOISE = 0.05;
-/* semi-global aggregation: penalties in units of the cost's mean contrast,
- * and the colour step (square-root encoded) that halves P2 */
 /* Pre-smoothing (docs/depth.md, "Pre-smoothing noisy views"): views whose
  * noise (Immerkaer's estimate on the reference, sRGB-encoded grey, over
- * the flatter half of its pixels) is at least PREFILTER_NOISE of their mean
- * level are blurred by a Gaussian of PREFILTER_SIGMA px before matching;
- * both chosen on the benchmark's tune half and backgammon. */
-static const double PREFILTER_NOISE = LF_DEPTH_PREFILTER_NOISE;
+ * the flatter half of its pixels) is at least LF_DEPTH_PREFILTER_NOISE of
+ * their mean level are blurred by a Gaussian of PREFILTER_SIGMA px before
+ * matching; both chosen on the benchmark's tune half and backgammon. */
 static const double PREFILTER_SIGMA = 0.7;
+/* semi-global aggregation: penalties in units of the cost's mean contrast,
+ * and the colour step (square-root encoded) that halves P2 */
 static const double DEFAULT_SGM_P1 = 0.05;
 static const double DEFAULT_SGM_P2 = 8.0;
 static const double DEFAULT_SGM_EDGE = 0.05;
@@ -744,11 +741,11 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             float c2 = FLT_MAX;
             cb = cv[(size_t)best * np + i];
             for (int l = 0; l < L; l++)
-                if (abs(l - best) > CONFIDENCE_AWAY_LABELS && cv[(size_t)l * np + i] < c2)
+                if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cv[(size_t)l * np + i] < c2)
                     c2 = cv[(size_t)l * np + i];
             float mean = sum / L;
             float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
-            conf = conf * CONFIDENCE_GAIN;
+            conf = conf * LF_DEPTH_CONFIDENCE_GAIN;
             c->conf[i] = conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
         }
 }
@@ -1176,14 +1173,12 @@ static void collect_views(depth_work *w)
             dview *v = &w->views[w->nviews++];
             v->data = lf_lightfield_view(lf, iu, iv);
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * w->np : NULL;
-            v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
             /* the angular group from the grid: calibrated positions a little
              * off a row or diagonal still belong to it */
-            v->group = view_group(v->du, v->dv);
-            if (lf->view_shift) {
-                const double *p = lf->view_shift + 4 * ((size_t)iv * lf->nu + iu);
-                v->du = p[0], v->dv = p[1], v->ox = p[2], v->oy = p[3];
-            }
+            v->group = view_group(iu - iu0, (iv - iv0) * rv);
+            double off[4];
+            lf_depth_view_offset(lf, iu, iv, off);
+            v->du = off[0], v->dv = off[1], v->ox = off[2], v->oy = off[3];
         }
 }
 
@@ -1648,13 +1643,6 @@ done:
     return rc;
 }
 
-/* The sRGB code (0..1) of a linear level. */
-static double srgb_encode(double v)
-{
-    v = v < 0 ? 0 : (v > 1 ? 1 : v);
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
-}
-
 /* The views' noise relative to their level: Immerkaer's estimate (1996),
  * sqrt(pi / 2) / 6 times the mean |I * [1 -2 1; -2 4 -2; 1 -2 1]|, of
  * the reference's sRGB-encoded grey over the half of its pixels with the
@@ -1677,7 +1665,8 @@ static double view_noise_ratio(const lf_lightfield *lf, lf_error *err, int *rc)
     const float *ref = lf_lightfield_view(lf, (lf->nu - 1) / 2, (lf->nv - 1) / 2);
     double mean = 0;
     for (size_t i = 0; i < np; i++) {
-        g[i] = (float)srgb_encode((ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2]) / 3.0);
+        double v = (ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2]) / 3.0;
+        g[i] = (float)lf_srgb_from_linear(v < 0 ? 0 : (v > 1 ? 1 : v));
         mean += g[i];
     }
     mean /= (double)np;
@@ -1706,6 +1695,22 @@ double lf_lightfield_depth_noise_ratio(const lf_lightfield *lf, lf_error *err)
 {
     int rc;
     return lf && lf->data ? view_noise_ratio(lf, err, &rc) : -1;
+}
+
+int lf_lightfield_depth_prefilter(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double *sigma,
+                                  double *noise_ratio, lf_error *err)
+{
+    int rc = LF_OK;
+    double ratio = -1;
+    *sigma = o->prefilter > 0 ? o->prefilter : 0;
+    /* views with missing samples are not smoothed: a blur spreads the holes */
+    if (o->prefilter == 0 && !lf->valid) {
+        ratio = view_noise_ratio(lf, err, &rc);
+        *sigma = !rc && ratio >= LF_DEPTH_PREFILTER_NOISE ? PREFILTER_SIGMA : 0;
+    }
+    if (noise_ratio)
+        *noise_ratio = ratio;
+    return rc;
 }
 
 typedef struct blur_ctx {
@@ -1805,15 +1810,10 @@ int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts 
      * sub-label fit keep the precision) */
     if (o->step <= 0 && (d1 - d0) / step + 1 > MAX_LABELS)
         step = (d1 - d0) / (MAX_LABELS - 1);
-    /* noisy views are matched pre-smoothed; views with missing samples
-     * are not (a blur would spread the holes) */
-    double sigma = o->prefilter > 0 ? o->prefilter : 0;
-    if (o->prefilter == 0 && !lf->valid) {
-        double ratio = view_noise_ratio(lf, err, &rc);
-        if (rc)
-            return rc;
-        sigma = ratio >= PREFILTER_NOISE ? PREFILTER_SIGMA : 0;
-    }
+    /* noisy views are matched pre-smoothed */
+    double sigma;
+    if ((rc = lf_lightfield_depth_prefilter(lf, o, &sigma, NULL, err)))
+        return rc;
     if (sigma > 0)
         return depth_core_smoothed(lf, o, sigma, d0, d1, step, disparity, confidence, err);
     return depth_core(lf, o, d0, d1, step, disparity, confidence, err);

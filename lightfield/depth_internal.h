@@ -44,6 +44,25 @@ typedef struct lf_depth_range_check_info {
 int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, double m, double *d0, double *d1,
                          lf_depth_range_check_info *info, lf_error *err);
 
+/* A winner's confidence: the best cost more than LF_DEPTH_CONFIDENCE_AWAY
+ * labels from the minimum, minus the minimum, over the curve's mean, times
+ * LF_DEPTH_CONFIDENCE_GAIN, at most 1 (the main method and the range's
+ * full-resolution check). */
+#define LF_DEPTH_CONFIDENCE_GAIN 4.f
+#define LF_DEPTH_CONFIDENCE_AWAY 2
+
+/* View (iu, iv)'s offset from the reference: out[0], out[1] its baseline
+ * in view steps (v scaled by disp_v_per_u), out[2], out[3] a constant pixel
+ * offset (0, or lf->view_shift's calibration). */
+static inline void lf_depth_view_offset(const lf_lightfield *lf, int iu, int iv, double out[4])
+{
+    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
+    out[0] = iu - (lf->nu - 1) / 2, out[1] = (iv - (lf->nv - 1) / 2) * rv, out[2] = out[3] = 0;
+    if (lf->view_shift)
+        for (int i = 0; i < 4; i++)
+            out[i] = lf->view_shift[4 * ((size_t)iv * lf->nu + iu) + i];
+}
+
 /* qsort's comparison of floats, ascending */
 static inline int lf_depth_cmpf(const void *a, const void *b)
 {

@@ -25,8 +25,6 @@
 enum { RC_GRID = 24, RC_WIN = 1 }; /* sample spacing; window half size (3 x 3) */
 static const float RC_TRUNC = 0.5f;        /* truncation of a view's grey difference, in mean levels */
 static const float RC_CONFIDENT = 0.3f;    /* a sample's confidence to count */
-static const int RC_AWAY = 2;              /* the rival minimum lies more than this many labels away */
-static const float RC_CONF_GAIN = 4.f;     /* as the main winner's confidence */
 static const double RC_AGREE_PX = 1.0;     /* neighbours agree within this many px at the outermost view */
 static const int RC_MIN_COUNT = 20;        /* confirmed samples needed to widen anything */
 
@@ -96,7 +94,7 @@ static void rc_samples(void *vctx, int i0, int i1, int tid)
         c->win[i] = NAN, c->conf[i] = 0.f;
         double reach = sample_reach(c, x, y);
         int half = (int)floor(reach / c->step);
-        if (half < RC_AWAY + 2)
+        if (half < LF_DEPTH_CONFIDENCE_AWAY + 2)
             continue;
         if (c->ref_valid) {
             int ok = 1;
@@ -144,10 +142,10 @@ static void rc_samples(void *vctx, int i0, int i1, int tid)
         if (nbad == 0 && best > 0 && best < L - 1) {
             float c2 = FLT_MAX;
             for (int l = 0; l < L; l++)
-                if (abs(l - best) > RC_AWAY && cost[l] < c2)
+                if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cost[l] < c2)
                     c2 = cost[l];
             double mean = sum / L;
-            float conf = c2 < FLT_MAX && mean > 0 ? (float)((c2 - cost[best]) / (mean + 1e-6)) * RC_CONF_GAIN : 0.f;
+            float conf = c2 < FLT_MAX && mean > 0 ? (float)((c2 - cost[best]) / (mean + 1e-6)) * LF_DEPTH_CONFIDENCE_GAIN : 0.f;
             double cm = cost[best - 1], c0 = cost[best], cp = cost[best + 1], den = cm - 2 * c0 + cp;
             double off = den > 1e-12 ? 0.5 * (cm - cp) / den : 0;
             off = off < -0.5 ? -0.5 : (off > 0.5 ? 0.5 : off);
@@ -182,7 +180,6 @@ int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, doubl
         free(views), free(win), free(vals), free(grey);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory");
     }
-    double rv = lf->disp_v_per_u > 0 ? lf->disp_v_per_u : 1.0;
     int n = 0;
     for (int iv = 0; iv < lf->nv; iv++)
         for (int iu = 0; iu < lf->nu; iu++) {
@@ -193,11 +190,9 @@ int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, doubl
             v->grey = grey + (size_t)(n + 1) * np;
             n++;
             v->valid = lf->valid ? lf->valid + ((size_t)iv * lf->nu + iu) * np : NULL;
-            v->du = iu - iu0, v->dv = (iv - iv0) * rv, v->ox = v->oy = 0;
-            if (lf->view_shift) {
-                const double *p = lf->view_shift + 4 * ((size_t)iv * lf->nu + iu);
-                v->du = p[0], v->dv = p[1], v->ox = p[2], v->oy = p[3];
-            }
+            double off[4];
+            lf_depth_view_offset(lf, iu, iv, off);
+            v->du = off[0], v->dv = off[1], v->ox = off[2], v->oy = off[3];
         }
     const float *ref = grey;
     to_grey(lf_lightfield_view(lf, iu0, iv0), grey, np);

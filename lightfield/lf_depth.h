@@ -85,6 +85,14 @@ lf_lightfield_depth_opts lf_lightfield_depth_defaults(void);
  * default); -1 when it cannot be measured. */
 double lf_lightfield_depth_noise_ratio(const lf_lightfield *lf, lf_error *err);
 #define LF_DEPTH_PREFILTER_NOISE 0.02 /* the ratio from which the default pre-smooths */
+/* The Gaussian sigma (px) lf_lightfield_depth smooths the views by under
+ * opts o (0: none): o->prefilter when > 0, none when < 0, and by default
+ * 0.7 where the noise ratio above is LF_DEPTH_PREFILTER_NOISE or more
+ * (views with missing samples: none).  *noise_ratio (may be NULL): the
+ * ratio measured, -1 when not measured.  A tool passes the sigma back in
+ * o->prefilter (-1 for none) to run and report the same choice. */
+int lf_lightfield_depth_prefilter(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double *sigma,
+                                  double *noise_ratio, lf_error *err);
 
 /* Disparity map (1 channel) and, when confidence is non-NULL, a confidence
  * map in [0, 1] (1: a single sharp cost minimum).  Needs at least 2 views. */

@@ -474,6 +474,10 @@ static int cmd_depth(void *ctx, int n, char **pos)
     }
     if (o->have_steps)
         d.step = (d.d1 - d.d0) / (o->steps - 1);
+    double sigma, noise; /* the views' pre-smoothing, chosen once, run and reported as chosen */
+    if (lf_lightfield_depth_prefilter(&s.lf, &d, &sigma, &noise, &err))
+        goto failed;
+    d.prefilter = sigma > 0 ? sigma : -1;
     if (o->calibrate_views) { /* depth on the nominal grid, view positions fitted to it */
         if (lf_lightfield_depth(&s.lf, &d, &disp, &conf, &err) ||
             lf_lightfield_calibrate_views(&s.lf, &disp, &conf, o->threads, NULL, &err))
@@ -487,13 +491,10 @@ static int cmd_depth(void *ctx, int n, char **pos)
     if (!rc && o->confidence)
         rc = write_image(o, o->confidence, &conf, NULL);
     char smooth[96] = "";
-    if (!rc && d.prefilter > 0)
-        snprintf(smooth, sizeof smooth, ", views pre-smoothed by %.3g px", d.prefilter);
-    else if (!rc && d.prefilter == 0 && !s.lf.valid) { /* what the default did, and why */
-        double nr = lf_lightfield_depth_noise_ratio(&s.lf, &err);
-        if (nr >= LF_DEPTH_PREFILTER_NOISE)
-            snprintf(smooth, sizeof smooth, ", views pre-smoothed: noise %.1f %% of their level", 100 * nr);
-    }
+    if (sigma > 0 && noise >= 0) /* the default's choice, and why */
+        snprintf(smooth, sizeof smooth, ", views pre-smoothed: noise %.1f %% of their level", 100 * noise);
+    else if (sigma > 0)
+        snprintf(smooth, sizeof smooth, ", views pre-smoothed by %.3g px", sigma);
     if (!rc)
         printf("%s: disparity map (range %.4g .. %.4g px/view, %s%s) -> %s%s%s\n", o->input, d.d0, d.d1, src, smooth,
                o->output, o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");

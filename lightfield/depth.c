@@ -100,6 +100,14 @@ static const double PLAIN_SIM_NOISE = 0.05;
  * their mean level are blurred by a Gaussian of PREFILTER_SIGMA px before
  * matching; both chosen on the benchmark's tune half and backgammon. */
 static const double PREFILTER_SIGMA = 0.7;
+/* On pre-smoothed views the noise left still outweighs weak texture in a
+ * window of the guided filter's radius: the cost is also filtered with a
+ * window WIDE_WINDOW_FACTOR times wider, and a pixel whose narrow-window
+ * curve has confidence c < WIDE_WINDOW_CONFIDENCE takes c / that of it and
+ * the rest from the wide one (docs/depth.md, "Noisy views: whitened and a
+ * wider window"); both chosen on the benchmark's tune half. */
+enum { WIDE_WINDOW_FACTOR = 4 };
+static const float WIDE_WINDOW_CONFIDENCE = 0.2f;
 /* semi-global aggregation: penalties in units of the cost's mean contrast,
  * and the colour step (square-root encoded) that halves P2 */
 static const double DEFAULT_SGM_P1 = 0.05;
@@ -705,6 +713,23 @@ typedef struct wta_ctx {
     float *disp, *conf;
 } wta_ctx;
 
+/* The confidence of pixel i's cost curve cv ([label][pixel], np pixels, L
+ * labels) at label best: the least cost more than LF_DEPTH_CONFIDENCE_AWAY
+ * labels away against the cost at best, relative to the curve's mean sum
+ * / L, times LF_DEPTH_CONFIDENCE_GAIN, in [0, 1] (a flat or multi-modal
+ * curve gives about 0). */
+static float curve_confidence(const float *cv, size_t np, size_t i, int L, int best, float sum)
+{
+    float c2 = FLT_MAX, cb = cv[(size_t)best * np + i];
+    for (int l = 0; l < L; l++)
+        if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cv[(size_t)l * np + i] < c2)
+            c2 = cv[(size_t)l * np + i];
+    float mean = sum / L;
+    float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
+    conf = conf * LF_DEPTH_CONFIDENCE_GAIN;
+    return conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
+}
+
 static void wta_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
@@ -738,15 +763,7 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             c->disp[i] = (float)(c->d0 + c->step * (best + off));
             /* confidence: the minimum against the best cost away from it
              * (more than 2 labels off), relative to the curve's mean */
-            float c2 = FLT_MAX;
-            cb = cv[(size_t)best * np + i];
-            for (int l = 0; l < L; l++)
-                if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cv[(size_t)l * np + i] < c2)
-                    c2 = cv[(size_t)l * np + i];
-            float mean = sum / L;
-            float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
-            conf = conf * LF_DEPTH_CONFIDENCE_GAIN;
-            c->conf[i] = conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
+            c->conf[i] = curve_confidence(cv, np, i, L, best, sum);
         }
 }
 
@@ -1114,6 +1131,7 @@ typedef struct depth_work {
     float *refs;        /* square-root encoded reference in the working scale (median, refinement) */
     float *rawd;        /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     unsigned char *plain; /* NULL, or per pixel 1 where the unaggregated curve is flat within the noise */
+    double smoothed;    /* the Gaussian sigma (px) the views were pre-smoothed by; 0: as captured */
     cost_ctx cc;
     depth_progress progress;
 } depth_work;
@@ -1211,11 +1229,33 @@ static float noise_gain(const float wx[4], const float wy[4])
     return sqrtf(2.f / (1.f + sx * sy));
 }
 
+/* The same for views pre-smoothed by a Gaussian of sigma px: their noise
+ * is no longer white, its correlation between texels k apart is
+ * exp(-k^2 / (4 sigma^2)) (white noise through the Gaussian twice), so the
+ * lookup's variance along an axis is sum_ij w_i w_j rho(|i - j|) instead of
+ * sum w_i^2 (lf_depth_noise_variance, depth_internal.h). */
+static float noise_gain_smoothed(const float wx[4], const float wy[4], double sigma)
+{
+    double vx = lf_depth_noise_variance(wx, sigma), vy = lf_depth_noise_variance(wy, sigma);
+    return (float)sqrt(2.0 / (1.0 + vx * vy));
+}
+
+double lf_depth_noise_variance(const float w[4], double sigma)
+{
+    double rho[4], v = 0;
+    for (int k = 0; k < 4; k++)
+        rho[k] = sigma > 0 ? exp(-0.25 * k * k / (sigma * sigma)) : (k == 0);
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            v += (double)w[i] * w[j] * rho[abs(i - j)];
+    return v;
+}
+
 /* View v's shift at disparity d, I_ref(x, y) = I_v(x - d du + ox, y - d dv
  * + oy), split as the row loop reads it; the columns it may read: with
  * the cubic lookup (views without missing samples) ix-1 .. ix+2, else
  * ix .. ix+1. */
-static label_view label_shift(const dview *v, double d, int ns, int cubic, int noise_aware)
+static label_view label_shift(const dview *v, double d, int ns, int cubic, int noise_aware, double smoothed)
 {
     label_view s;
     double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
@@ -1232,7 +1272,9 @@ static label_view label_shift(const dview *v, double d, int ns, int cubic, int n
         s.xb = s.xb > ns - 1 ? ns - 1 : s.xb;
     }
     s.gain = 1.f;
-    if (noise_aware) {
+    if (noise_aware && smoothed > 0 && cubic && !v->valid) {
+        s.gain = noise_gain_smoothed(s.wx, s.wy, smoothed);
+    } else if (noise_aware) {
         float lx[4] = {1 - s.fx, s.fx, 0, 0}, ly[4] = {1 - s.fy, s.fy, 0, 0};
         s.gain = cubic && !v->valid ? noise_gain(s.wx, s.wy) : noise_gain(lx, ly);
     }
@@ -1272,7 +1314,8 @@ static int build_cost_volume(depth_work *w, lf_error *err)
     for (int l = 0; l < w->nlabels; l++)
         for (int k = 0; k < w->nviews; k++)
             w->lv[(size_t)l * w->nviews + k] = label_shift(&w->views[k], w->d0 + w->step * l, w->ns, w->cc.cubic,
-                                                          o->noise_aware > 0);
+                                                          o->noise_aware > 0 || (o->noise_aware == 0 && w->smoothed > 0),
+                                                          w->smoothed);
     if (lf->valid)
         w->cc.ref_valid = lf->valid + ((size_t)((lf->nv - 1) / 2) * lf->nu + (lf->nu - 1) / 2) * w->np;
     lf_parallel_for(w->nt, w->threads, 4, cost_rows, &w->cc);
@@ -1305,17 +1348,70 @@ static void guide_inverse_covariance(float *I, float *mI, float *Sinv, float *tm
     }
 }
 
+/* The wide window's blend (aggregate_cost_volume): per pixel, the narrow
+ * window's curve where it is confident, the wide one's where it is not. */
+typedef struct blend_ctx {
+    float *cost;       /* the narrow window's volume, blended in place */
+    const float *wide; /* the wide window's */
+    int w, L;
+    size_t np;
+} blend_ctx;
+
+static void blend_rows(void *vctx, int y0, int y1, int tid)
+{
+    (void)tid;
+    blend_ctx *c = vctx;
+    size_t np = c->np;
+    for (size_t i = (size_t)y0 * c->w; i < (size_t)y1 * c->w; i++) {
+        float cb = FLT_MAX, sum = 0;
+        int best = 0;
+        for (int l = 0; l < c->L; l++) {
+            float v = c->cost[(size_t)l * np + i];
+            sum += v;
+            if (v < cb)
+                cb = v, best = l;
+        }
+        float a = curve_confidence(c->cost, np, i, c->L, best, sum) / WIDE_WINDOW_CONFIDENCE;
+        a = a > 1.f ? 1.f : a;
+        if (a >= 1.f)
+            continue;
+        for (int l = 0; l < c->L; l++) {
+            size_t k = (size_t)l * np + i;
+            c->cost[k] = a * c->cost[k] + (1.f - a) * c->wide[k];
+        }
+    }
+}
+
+/* The guided filter of radius r over every slice of cost, guide I (3
+ * planes) with its statistics for r computed into the work's planes. */
+static void guided_filter_volume(depth_work *w, float *cost, int r, float eps)
+{
+    size_t np = w->np;
+    int ns = w->ns, nt = w->nt;
+    float *I = w->guide, *mI = w->guide + 3 * np, *Sinv = w->guide + 6 * np, *tmp = w->guide + 12 * np,
+          *t2 = w->guide + 13 * np;
+    for (int ch = 0; ch < 3; ch++)
+        box_mean(I + ch * np, mI + ch * np, tmp, ns, nt, r);
+    guide_inverse_covariance(I, mI, Sinv, tmp, t2, ns, nt, r, eps);
+    gf_ctx gc = {
+        .w = ns, .h = nt, .r = r, .I = I, .mI = mI, .Sinv = Sinv,
+        .cost = cost, .scratch = w->scratch, .per_thread = w->per_thread, .progress = &w->progress,
+    };
+    lf_parallel_for(w->nlabels, w->threads, 1, gf_slices, &gc);
+}
+
 /* Stage 3: edge-aware aggregation, every cost slice through a colour
- * guided filter guided by the reference. */
-static void aggregate_cost_volume(depth_work *w)
+ * guided filter guided by the reference; on pre-smoothed (noisy) views
+ * also through one WIDE_WINDOW_FACTOR times wider, blended in where the
+ * narrow one leaves a pixel unsure. */
+static int aggregate_cost_volume(depth_work *w, lf_error *err)
 {
     const lf_lightfield_depth_opts *o = w->o;
     int ns = w->ns, nt = w->nt;
     size_t np = w->np;
     /* guide: the reference colour, square-root encoded (closer to perceptual
      * steps than linear) and normalised to [0, 1] */
-    float *I = w->guide, *mI = w->guide + 3 * np, *Sinv = w->guide + 6 * np, *tmp = w->guide + 12 * np,
-          *t2 = w->guide + 13 * np;
+    float *I = w->guide;
     float gmax = 0;
     for (size_t i = 0; i < np; i++)
         for (int ch = 0; ch < 3; ch++) {
@@ -1330,14 +1426,25 @@ static void aggregate_cost_volume(depth_work *w)
     if (r < MIN_GUIDE_RADIUS)
         r = MIN_GUIDE_RADIUS;
     float eps = o->eps > 0 ? (float)o->eps : DEFAULT_GUIDE_EPS;
-    for (int ch = 0; ch < 3; ch++)
-        box_mean(I + ch * np, mI + ch * np, tmp, ns, nt, r);
-    guide_inverse_covariance(I, mI, Sinv, tmp, t2, ns, nt, r, eps);
-    gf_ctx gc = {
-        .w = ns, .h = nt, .r = r, .I = I, .mI = mI, .Sinv = Sinv,
-        .cost = w->cost, .scratch = w->scratch, .per_thread = w->per_thread, .progress = &w->progress,
-    };
-    lf_parallel_for(w->nlabels, w->threads, 1, gf_slices, &gc);
+    int wide = o->wide_window > 0 || (o->wide_window == 0 && w->smoothed > 0);
+    float *raw = NULL;
+    size_t nv = np * (size_t)w->nlabels;
+    if (wide) {
+        if (!(raw = malloc(sizeof(float) * nv)))
+            return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the wide window's cost volume (%d labels)",
+                                w->nlabels);
+        memcpy(raw, w->cost, sizeof(float) * nv);
+    }
+    guided_filter_volume(w, w->cost, r, eps);
+    if (!wide)
+        return LF_OK;
+    int rw = o->wide_window > 0 ? o->wide_window : WIDE_WINDOW_FACTOR * r;
+    int lim = (ns < nt ? ns : nt) / 2 - 1;
+    guided_filter_volume(w, raw, rw < lim ? rw : lim, eps);
+    blend_ctx bc = {.cost = w->cost, .wide = raw, .w = ns, .L = w->nlabels, .np = np};
+    lf_parallel_for(nt, w->threads, 8, blend_rows, &bc);
+    free(raw);
+    return LF_OK;
 }
 
 /* Stages 4-5: winner-take-all, the parabola's sub-label offset, and the
@@ -1502,6 +1609,7 @@ static int noise_contrast_ratio(const depth_work *w, double *ratio, lf_error *er
     float *r = NULL;
     if (!rc) {
         sw.progress.o = &so, sw.progress.total = 1;
+        sw.smoothed = w->smoothed;
         atomic_init(&sw.progress.done, 0);
         collect_views(&sw);
         sw.scale = reference_colour_scale(sw.ref, sw.np);
@@ -1592,8 +1700,9 @@ static int label_count(double d0, double d1, double step)
     return nl < 3 ? 3 : nl;
 }
 
+/* smoothed: the Gaussian sigma the views were pre-smoothed by (0: none) */
 static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double d0, double d1, double step,
-                      lf_image *disparity, lf_image *confidence, lf_error *err)
+                      double smoothed, lf_image *disparity, lf_image *confidence, lf_error *err)
 {
     int nl = label_count(d0, d1, step);
     if (nl > MAX_LABELS)
@@ -1604,13 +1713,16 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     int rc = depth_work_alloc(&w, lf, o, nl, d0, step, err);
     if (rc)
         goto done;
-    w.progress.o = o, w.progress.total = 2L * w.nt * nl;
+    w.smoothed = smoothed;
+    int wide = o->wide_window > 0 || (o->wide_window == 0 && smoothed > 0);
+    w.progress.o = o, w.progress.total = (wide ? 3L : 2L) * w.nt * nl;
     atomic_init(&w.progress.done, 0);
     collect_views(&w);
     w.scale = reference_colour_scale(w.ref, w.np);
     if ((rc = build_cost_volume(&w, err)) || (rc = mark_plain(&w, err)))
         goto done;
-    aggregate_cost_volume(&w);
+    if ((rc = aggregate_cost_volume(&w, err)))
+        goto done;
     encode_reference(&w);
     if ((rc = semi_global(&w, err)))
         goto done;
@@ -1776,7 +1888,7 @@ static int depth_core_smoothed(const lf_lightfield *lf, const lf_lightfield_dept
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the smoothed views");
     blur_ctx bc = {lf, b.data, k, r};
     lf_parallel_for(lf->nu * lf->nv, o->threads > 0 ? o->threads : DEFAULT_THREADS, 1, blur_views, &bc);
-    int rc = depth_core(&b, o, d0, d1, step, disparity, confidence, err);
+    int rc = depth_core(&b, o, d0, d1, step, sigma, disparity, confidence, err);
     free(b.data);
     return rc;
 }
@@ -1816,7 +1928,7 @@ int lf_lightfield_depth(const lf_lightfield *lf, const lf_lightfield_depth_opts 
         return rc;
     if (sigma > 0)
         return depth_core_smoothed(lf, o, sigma, d0, d1, step, disparity, confidence, err);
-    return depth_core(lf, o, d0, d1, step, disparity, confidence, err);
+    return depth_core(lf, o, d0, d1, step, 0, disparity, confidence, err);
 }
 
 /* The views box-averaged f x f (calibrated offsets and missing samples
@@ -1888,7 +2000,7 @@ static int range_pass(const lf_lightfield *small, int threads, double s0, double
     o.refine = -1, o.interp = 1, o.thin = -1, o.plain = -1; /* the range needs no sub-label precision */
     o.radius = 2;
     lf_image disp = {0}, conf = {0};
-    int rc = depth_core(small, &o, s0, s1, step, &disp, &conf, err);
+    int rc = depth_core(small, &o, s0, s1, step, 0, &disp, &conf, err);
     if (rc)
         return rc;
     size_t np = (size_t)small->ns * small->nt, n = 0;

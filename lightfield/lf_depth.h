@@ -57,7 +57,8 @@ typedef struct lf_lightfield_depth_opts {
     int interp;          /* views' sub-pixel lookup in the cost volume: 0 (default) Keys cubic, 1 bilinear */
     int noise_aware;     /* 1: views carry sensor noise (a dim or low-sample capture): each view's difference
                           * scaled so that every label's noise costs the same (docs/depth.md, "Noisy views");
-                          * 0 (default): off, as for clean renders, where it costs precision */
+                          * 0 (default): only on views the prefilter smoothed (with the smoothed noise's
+                          * model), off on others, as for clean renders, where it costs precision; < 0 off */
     int thin;            /* thin-structure recovery after the median: 0 default (on), < 0 off */
     double thin_ratio;   /* its decisiveness: the pixel's own cost minimum below this times the cost at
                           * the aggregated disparity; <= 0: 0.2 */
@@ -68,6 +69,9 @@ typedef struct lf_lightfield_depth_opts {
     double prefilter;    /* Gaussian pre-smoothing of the views before matching, sigma in px: 0 default
                           * (auto: 0.7 where the views' noise is 2 % of their level or more, docs/depth.md,
                           * "Pre-smoothing noisy views"), < 0 off, > 0 that sigma */
+    int wide_window;     /* a second, wider guided filter blended in where the first leaves a pixel unsure:
+                          * 0 default (on for views the prefilter smoothed, 4 times the radius), < 0 off,
+                          * > 0 on with that radius (px) */
     int sgm;             /* semi-global aggregation after the guided filter: 0 default (on), < 0 off */
     double sgm_p1, sgm_p2, sgm_edge; /* its penalties and edge scale; <= 0: defaults (docs/depth.md) */
     int threads;         /* <= 0: 2 */

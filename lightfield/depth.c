@@ -1131,7 +1131,8 @@ typedef struct depth_work {
     float *refs;        /* square-root encoded reference in the working scale (median, refinement) */
     float *rawd;        /* NULL, or per pixel the winner of the unaggregated full-aperture cost */
     unsigned char *plain; /* NULL, or per pixel 1 where the unaggregated curve is flat within the noise */
-    double smoothed;    /* the Gaussian sigma (px) the views were pre-smoothed by; 0: as captured */
+    int smoothed;       /* 1: the views were pre-smoothed, their noise correlated by rho */
+    double rho[4];      /* the noise's correlation between texels 0 .. 3 apart (smoothed views) */
     cost_ctx cc;
     depth_progress progress;
 } depth_work;
@@ -1229,33 +1230,59 @@ static float noise_gain(const float wx[4], const float wy[4])
     return sqrtf(2.f / (1.f + sx * sy));
 }
 
-/* The same for views pre-smoothed by a Gaussian of sigma px: their noise
- * is no longer white, its correlation between texels k apart is
- * exp(-k^2 / (4 sigma^2)) (white noise through the Gaussian twice), so the
- * lookup's variance along an axis is sum_ij w_i w_j rho(|i - j|) instead of
- * sum w_i^2 (lf_depth_noise_variance, depth_internal.h). */
-static float noise_gain_smoothed(const float wx[4], const float wy[4], double sigma)
+/* The same for pre-smoothed views: their noise is no longer white but
+ * correlated by rho between texels k apart (the blur's kernel against
+ * itself), so the lookup's variance along an axis is
+ * sum_ij w_i w_j rho(|i - j|) instead of sum w_i^2. */
+static float noise_gain_smoothed(const float wx[4], const float wy[4], const double rho[4])
 {
-    double vx = lf_depth_noise_variance(wx, sigma), vy = lf_depth_noise_variance(wy, sigma);
+    double vx = lf_depth_noise_variance(wx, rho), vy = lf_depth_noise_variance(wy, rho);
     return (float)sqrt(2.0 / (1.0 + vx * vy));
 }
 
-double lf_depth_noise_variance(const float w[4], double sigma)
+double lf_depth_noise_variance(const float w[4], const double rho[4])
 {
-    double rho[4], v = 0;
-    for (int k = 0; k < 4; k++)
-        rho[k] = sigma > 0 ? exp(-0.25 * k * k / (sigma * sigma)) : (k == 0);
+    double v = 0;
     for (int i = 0; i < 4; i++)
         for (int j = 0; j < 4; j++)
-            v += (double)w[i] * w[j] * rho[abs(i - j)];
+            v += (double)w[i] * w[j] * (rho ? rho[abs(i - j)] : i == j);
     return v;
+}
+
+/* The normalised Gaussian kernel of sigma px the views are pre-smoothed
+ * by: k[0 .. 2r], r = ceil(3 sigma) within 1 .. LF_DEPTH_SMOOTH_MAX_R. */
+static int smoothing_kernel(double sigma, float k[2 * LF_DEPTH_SMOOTH_MAX_R + 1])
+{
+    int r = (int)ceil(3 * sigma);
+    r = r > LF_DEPTH_SMOOTH_MAX_R ? LF_DEPTH_SMOOTH_MAX_R : (r < 1 ? 1 : r);
+    double ks = 0;
+    for (int i = -r; i <= r; i++)
+        ks += k[i + r] = (float)exp(-0.5 * i * i / (sigma * sigma));
+    for (int i = 0; i <= 2 * r; i++)
+        k[i] = (float)(k[i] / ks);
+    return r;
+}
+
+void lf_depth_smoothed_noise_correlation(double sigma, double rho[4])
+{
+    float k[2 * LF_DEPTH_SMOOTH_MAX_R + 1];
+    int r = smoothing_kernel(sigma, k);
+    double e = 0;
+    for (int i = 0; i <= 2 * r; i++)
+        e += (double)k[i] * k[i];
+    for (int m = 0; m < 4; m++) {
+        double c = 0;
+        for (int i = 0; i + m <= 2 * r; i++)
+            c += (double)k[i] * k[i + m];
+        rho[m] = c / e;
+    }
 }
 
 /* View v's shift at disparity d, I_ref(x, y) = I_v(x - d du + ox, y - d dv
  * + oy), split as the row loop reads it; the columns it may read: with
  * the cubic lookup (views without missing samples) ix-1 .. ix+2, else
  * ix .. ix+1. */
-static label_view label_shift(const dview *v, double d, int ns, int cubic, int noise_aware, double smoothed)
+static label_view label_shift(const dview *v, double d, int ns, int cubic, int noise_aware, const double *rho)
 {
     label_view s;
     double sx = -d * v->du + v->ox, sy = -d * v->dv + v->oy;
@@ -1272,8 +1299,8 @@ static label_view label_shift(const dview *v, double d, int ns, int cubic, int n
         s.xb = s.xb > ns - 1 ? ns - 1 : s.xb;
     }
     s.gain = 1.f;
-    if (noise_aware && smoothed > 0 && cubic && !v->valid) {
-        s.gain = noise_gain_smoothed(s.wx, s.wy, smoothed);
+    if (noise_aware && rho && cubic && !v->valid) {
+        s.gain = noise_gain_smoothed(s.wx, s.wy, rho);
     } else if (noise_aware) {
         float lx[4] = {1 - s.fx, s.fx, 0, 0}, ly[4] = {1 - s.fy, s.fy, 0, 0};
         s.gain = cubic && !v->valid ? noise_gain(s.wx, s.wy) : noise_gain(lx, ly);
@@ -1314,8 +1341,8 @@ static int build_cost_volume(depth_work *w, lf_error *err)
     for (int l = 0; l < w->nlabels; l++)
         for (int k = 0; k < w->nviews; k++)
             w->lv[(size_t)l * w->nviews + k] = label_shift(&w->views[k], w->d0 + w->step * l, w->ns, w->cc.cubic,
-                                                          o->noise_aware > 0 || (o->noise_aware == 0 && w->smoothed > 0),
-                                                          w->smoothed);
+                                                          o->noise_aware > 0 || (o->noise_aware == 0 && w->smoothed),
+                                                          w->smoothed ? w->rho : NULL);
     if (lf->valid)
         w->cc.ref_valid = lf->valid + ((size_t)((lf->nv - 1) / 2) * lf->nu + (lf->nu - 1) / 2) * w->np;
     lf_parallel_for(w->nt, w->threads, 4, cost_rows, &w->cc);
@@ -1426,7 +1453,7 @@ static int aggregate_cost_volume(depth_work *w, lf_error *err)
     if (r < MIN_GUIDE_RADIUS)
         r = MIN_GUIDE_RADIUS;
     float eps = o->eps > 0 ? (float)o->eps : DEFAULT_GUIDE_EPS;
-    int wide = o->wide_window > 0 || (o->wide_window == 0 && w->smoothed > 0);
+    int wide = o->wide_window > 0 || (o->wide_window == 0 && w->smoothed);
     float *raw = NULL;
     size_t nv = np * (size_t)w->nlabels;
     if (wide) {
@@ -1610,6 +1637,7 @@ static int noise_contrast_ratio(const depth_work *w, double *ratio, lf_error *er
     if (!rc) {
         sw.progress.o = &so, sw.progress.total = 1;
         sw.smoothed = w->smoothed;
+        memcpy(sw.rho, w->rho, sizeof sw.rho);
         atomic_init(&sw.progress.done, 0);
         collect_views(&sw);
         sw.scale = reference_colour_scale(sw.ref, sw.np);
@@ -1713,8 +1741,10 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     int rc = depth_work_alloc(&w, lf, o, nl, d0, step, err);
     if (rc)
         goto done;
-    w.smoothed = smoothed;
-    int wide = o->wide_window > 0 || (o->wide_window == 0 && smoothed > 0);
+    w.smoothed = smoothed > 0;
+    if (w.smoothed)
+        lf_depth_smoothed_noise_correlation(smoothed, w.rho);
+    int wide = o->wide_window > 0 || (o->wide_window == 0 && w.smoothed);
     w.progress.o = o, w.progress.total = (wide ? 3L : 2L) * w.nt * nl;
     atomic_init(&w.progress.done, 0);
     collect_views(&w);
@@ -1872,15 +1902,8 @@ static void blur_views(void *vctx, int v0, int v1, int tid)
 static int depth_core_smoothed(const lf_lightfield *lf, const lf_lightfield_depth_opts *o, double sigma, double d0,
                                double d1, double step, lf_image *disparity, lf_image *confidence, lf_error *err)
 {
-    enum { MAX_R = 8 };
-    float k[2 * MAX_R + 1];
-    int r = (int)ceil(3 * sigma);
-    r = r > MAX_R ? MAX_R : (r < 1 ? 1 : r);
-    double ks = 0;
-    for (int i = -r; i <= r; i++)
-        ks += k[i + r] = (float)exp(-0.5 * i * i / (sigma * sigma));
-    for (int i = 0; i <= 2 * r; i++)
-        k[i] = (float)(k[i] / ks);
+    float k[2 * LF_DEPTH_SMOOTH_MAX_R + 1];
+    int r = smoothing_kernel(sigma, k);
     size_t n = (size_t)lf->nu * lf->nv * lf->ns * lf->nt * 3;
     lf_lightfield b = *lf;
     b.half = NULL;

@@ -52,10 +52,15 @@ int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, doubl
 #define LF_DEPTH_CONFIDENCE_AWAY 2
 
 /* The variance, in units of the views' per-texel noise variance, of a
- * 4-tap lookup with weights w of noise smoothed by a Gaussian of sigma px
- * (texels k apart correlated by exp(-k^2 / (4 sigma^2))); sigma 0: white
- * noise, the sum of w^2.  depth.c whitens pre-smoothed views by it. */
-double lf_depth_noise_variance(const float w[4], double sigma);
+ * 4-tap lookup with weights w of noise whose texels k apart are correlated
+ * by rho[k] (rho NULL: white noise, the sum of w^2).  depth.c whitens
+ * pre-smoothed views by it. */
+double lf_depth_noise_variance(const float w[4], const double rho[4]);
+/* rho of white noise after the pre-smoothing by a Gaussian of sigma px
+ * (its sampled kernel, radius ceil(3 sigma) up to LF_DEPTH_SMOOTH_MAX_R,
+ * against itself): rho[0] = 1. */
+#define LF_DEPTH_SMOOTH_MAX_R 8
+void lf_depth_smoothed_noise_correlation(double sigma, double rho[4]);
 
 /* View (iu, iv)'s offset from the reference: out[0], out[1] its baseline
  * in view steps (v scaled by disp_v_per_u), out[2], out[3] a constant pixel

@@ -490,11 +490,14 @@ static int cmd_depth(void *ctx, int n, char **pos)
     rc = lf_lightfield_write_disparity(o->output, &disp, d.d0, d.d1, &wo, &err) ? fail(&err, NULL) : LF_EXIT_OK;
     if (!rc && o->confidence)
         rc = write_image(o, o->confidence, &conf, NULL);
-    char smooth[96] = "";
+    char smooth[160] = "";
     if (sigma > 0 && noise >= 0) /* the default's choice, and why */
-        snprintf(smooth, sizeof smooth, ", views pre-smoothed: noise %.1f %% of their level", 100 * noise);
+        snprintf(smooth, sizeof smooth,
+                 ", views pre-smoothed: noise %.1f %% of their level; matched whitened, with a wider window where unsure",
+                 100 * noise);
     else if (sigma > 0)
-        snprintf(smooth, sizeof smooth, ", views pre-smoothed by %.3g px", sigma);
+        snprintf(smooth, sizeof smooth, ", views pre-smoothed by %.3g px; matched whitened, with a wider window where unsure",
+                 sigma);
     if (!rc)
         printf("%s: disparity map (range %.4g .. %.4g px/view, %s%s) -> %s%s%s\n", o->input, d.d0, d.d1, src, smooth,
                o->output, o->confidence ? ", confidence -> " : "", o->confidence ? o->confidence : "");
@@ -748,7 +751,8 @@ int main(int argc, char **argv)
          "before a plain wall; docs/depth.md, \"Plain regions\")"},
         {"--prefilter", NULL, LF_ARG_DOUBLE, &o.prefilter, "SIGMA",
          "smooth the views by a Gaussian of SIGMA px before matching, 0: never (default: 0.7 where the views' "
-         "noise is 2 % of their level or more; docs/depth.md, \"Pre-smoothing noisy views\")",
+         "noise is 2 % of their level or more; smoothed views are matched with the noise whitened and a wider "
+         "window where unsure; docs/depth.md, \"Pre-smoothing noisy views\")",
          R_IN(0, 4), .given = &o.have_prefilter},
         {"--method", NULL, LF_ARG_CHOICE, &o.method, "METHOD",
          "volume: cost volume with occlusion handling (default); stack: focal-stack contrast",

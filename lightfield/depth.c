@@ -713,23 +713,6 @@ typedef struct wta_ctx {
     float *disp, *conf;
 } wta_ctx;
 
-/* The confidence of pixel i's cost curve cv ([label][pixel], np pixels, L
- * labels) at label best: the least cost more than LF_DEPTH_CONFIDENCE_AWAY
- * labels away against the cost at best, relative to the curve's mean sum
- * / L, times LF_DEPTH_CONFIDENCE_GAIN, in [0, 1] (a flat or multi-modal
- * curve gives about 0). */
-static float curve_confidence(const float *cv, size_t np, size_t i, int L, int best, float sum)
-{
-    float c2 = FLT_MAX, cb = cv[(size_t)best * np + i];
-    for (int l = 0; l < L; l++)
-        if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cv[(size_t)l * np + i] < c2)
-            c2 = cv[(size_t)l * np + i];
-    float mean = sum / L;
-    float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
-    conf = conf * LF_DEPTH_CONFIDENCE_GAIN;
-    return conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
-}
-
 static void wta_rows(void *vctx, int y0, int y1, int tid)
 {
     (void)tid;
@@ -763,7 +746,7 @@ static void wta_rows(void *vctx, int y0, int y1, int tid)
             c->disp[i] = (float)(c->d0 + c->step * (best + off));
             /* confidence: the minimum against the best cost away from it
              * (more than 2 labels off), relative to the curve's mean */
-            c->conf[i] = curve_confidence(cv, np, i, L, best, sum);
+            c->conf[i] = lf_depth_curve_confidence(cv + i, np, L, best, sum);
         }
 }
 
@@ -1398,7 +1381,7 @@ static void blend_rows(void *vctx, int y0, int y1, int tid)
             if (v < cb)
                 cb = v, best = l;
         }
-        float a = curve_confidence(c->cost, np, i, c->L, best, sum) / WIDE_WINDOW_CONFIDENCE;
+        float a = lf_depth_curve_confidence(c->cost + i, np, c->L, best, sum) / WIDE_WINDOW_CONFIDENCE;
         a = a > 1.f ? 1.f : a;
         if (a >= 1.f)
             continue;

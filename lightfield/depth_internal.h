@@ -3,6 +3,9 @@
 #ifndef LF_LIGHTFIELD_DEPTH_INTERNAL_H
 #define LF_LIGHTFIELD_DEPTH_INTERNAL_H
 
+#include <float.h>
+#include <stdlib.h>
+
 #include "base/lf_error.h"
 #include "lightfield/lf_lightfield.h"
 
@@ -50,6 +53,20 @@ int lf_depth_range_check(const lf_lightfield *lf, int threads, double lim, doubl
  * full-resolution check). */
 #define LF_DEPTH_CONFIDENCE_GAIN 4.f
 #define LF_DEPTH_CONFIDENCE_AWAY 2
+
+/* That confidence of a curve of L costs cv[l * stride] whose minimum is at
+ * label best and whose costs sum to sum, in [0, 1]. */
+static inline float lf_depth_curve_confidence(const float *cv, size_t stride, int L, int best, float sum)
+{
+    float c2 = FLT_MAX, cb = cv[(size_t)best * stride];
+    for (int l = 0; l < L; l++)
+        if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cv[(size_t)l * stride] < c2)
+            c2 = cv[(size_t)l * stride];
+    float mean = sum / L;
+    float conf = c2 < FLT_MAX && mean > 0 ? (c2 - cb) / (mean + 1e-6f) : 0.f;
+    conf = conf * LF_DEPTH_CONFIDENCE_GAIN;
+    return conf > 1.f ? 1.f : (conf < 0.f ? 0.f : conf);
+}
 
 /* The variance, in units of the views' per-texel noise variance, of a
  * 4-tap lookup with weights w of noise whose texels k apart are correlated

@@ -140,17 +140,12 @@ static void rc_samples(void *vctx, int i0, int i1, int tid)
         }
         /* missing samples change the views' set from label to label */
         if (nbad == 0 && best > 0 && best < L - 1) {
-            float c2 = FLT_MAX;
-            for (int l = 0; l < L; l++)
-                if (abs(l - best) > LF_DEPTH_CONFIDENCE_AWAY && cost[l] < c2)
-                    c2 = cost[l];
-            double mean = sum / L;
-            float conf = c2 < FLT_MAX && mean > 0 ? (float)((c2 - cost[best]) / (mean + 1e-6)) * LF_DEPTH_CONFIDENCE_GAIN : 0.f;
+            float conf = lf_depth_curve_confidence(cost, 1, L, best, (float)sum);
             double cm = cost[best - 1], c0 = cost[best], cp = cost[best + 1], den = cm - 2 * c0 + cp;
             double off = den > 1e-12 ? 0.5 * (cm - cp) / den : 0;
             off = off < -0.5 ? -0.5 : (off > 0.5 ? 0.5 : off);
             c->win[i] = (float)((best - half + off) * c->step);
-            c->conf[i] = conf > 1.f ? 1.f : conf;
+            c->conf[i] = conf;
         }
         free(cost);
     }

@@ -55,8 +55,6 @@ static const int MIN_GUIDE_RADIUS = 2;
 /* guided-filter regulariser for a guide in [0, 1]: keeps colour edges of
  * a few percent */
 static const float DEFAULT_GUIDE_EPS = 1e-3f;
-/* confidence 4 (c2 - c_min) / mean(c): c2 the lowest cost more than 2
- * labels away (the minimum's own slope is not a second mode) */
 /* weighted median over a 7 x 7 window: removes isolated outliers */
 static const int DEFAULT_MEDIAN_RADIUS = 3;
 /* a zero-confidence neighbour still votes a little, so a window never has
@@ -1197,27 +1195,18 @@ static float reference_colour_scale(const float *ref, size_t np)
 
 /* The gain that gives a view's difference to the reference, looked up at
  * a sub-pixel phase with separable weights wx, wy (4 taps each), the noise
- * of a whole-pixel lookup.  White noise of variance s^2 per texel makes the
- * difference's variance s^2 (1 + Sx Sy), Sx and Sy the sums of the squared
- * weights: 2 s^2 at a whole pixel, 1.41 s^2 at half a pixel in x and y
- * for the cubic.  Unscaled, the labels whose phases smooth the noise most
- * cost least wherever noise is a large part of the difference, and a
- * noisy surface's disparities pile up at them; scaled by sqrt(2 / (1 +
- * Sx Sy)) every label's noise costs the same (docs/depth.md, "Noisy
- * views"). */
-static float noise_gain(const float wx[4], const float wy[4])
-{
-    float sx = 0, sy = 0;
-    for (int i = 0; i < 4; i++)
-        sx += wx[i] * wx[i], sy += wy[i] * wy[i];
-    return sqrtf(2.f / (1.f + sx * sy));
-}
-
-/* The same for pre-smoothed views: their noise is no longer white but
+ * of a whole-pixel lookup.  Noise of variance s^2 per texel makes the
+ * difference's variance s^2 (1 + Vx Vy), Vx and Vy the lookup's variance
+ * along each axis (lf_depth_noise_variance): for white noise (rho NULL) the
+ * sums of the squared weights, 2 s^2 at a whole pixel and 1.41 s^2 at half
+ * a pixel in x and y for the cubic; for pre-smoothed views, whose noise is
  * correlated by rho between texels k apart (the blur's kernel against
- * itself), so the lookup's variance along an axis is
- * sum_ij w_i w_j rho(|i - j|) instead of sum w_i^2. */
-static float noise_gain_smoothed(const float wx[4], const float wy[4], const double rho[4])
+ * itself), sum_ij w_i w_j rho(|i - j|).  Unscaled, the labels whose phases
+ * smooth the noise most cost least wherever noise is a large part of the
+ * difference, and a noisy surface's disparities pile up at them; scaled by
+ * sqrt(2 / (1 + Vx Vy)) every label's noise costs the same (docs/depth.md,
+ * "Noisy views"). */
+static float noise_gain(const float wx[4], const float wy[4], const double *rho)
 {
     double vx = lf_depth_noise_variance(wx, rho), vy = lf_depth_noise_variance(wy, rho);
     return (float)sqrt(2.0 / (1.0 + vx * vy));
@@ -1282,11 +1271,9 @@ static label_view label_shift(const dview *v, double d, int ns, int cubic, int n
         s.xb = s.xb > ns - 1 ? ns - 1 : s.xb;
     }
     s.gain = 1.f;
-    if (noise_aware && rho && cubic && !v->valid) {
-        s.gain = noise_gain_smoothed(s.wx, s.wy, rho);
-    } else if (noise_aware) {
+    if (noise_aware) {
         float lx[4] = {1 - s.fx, s.fx, 0, 0}, ly[4] = {1 - s.fy, s.fy, 0, 0};
-        s.gain = cubic && !v->valid ? noise_gain(s.wx, s.wy) : noise_gain(lx, ly);
+        s.gain = cubic && !v->valid ? noise_gain(s.wx, s.wy, rho) : noise_gain(lx, ly, NULL);
     }
     return s;
 }
@@ -1356,6 +1343,12 @@ static void guide_inverse_covariance(float *I, float *mI, float *Sinv, float *tm
         Sinv[3 * np + i] = (float)(c11 * id), Sinv[4 * np + i] = (float)(c12 * id);
         Sinv[5 * np + i] = (float)(c22 * id);
     }
+}
+
+/* Whether stage 3 adds the wide window (opts wide_window). */
+static int wide_window_on(const lf_lightfield_depth_opts *o, int smoothed)
+{
+    return o->wide_window > 0 || (o->wide_window == 0 && smoothed);
 }
 
 /* The wide window's blend (aggregate_cost_volume): per pixel, the narrow
@@ -1436,7 +1429,7 @@ static int aggregate_cost_volume(depth_work *w, lf_error *err)
     if (r < MIN_GUIDE_RADIUS)
         r = MIN_GUIDE_RADIUS;
     float eps = o->eps > 0 ? (float)o->eps : DEFAULT_GUIDE_EPS;
-    int wide = o->wide_window > 0 || (o->wide_window == 0 && w->smoothed);
+    int wide = wide_window_on(o, w->smoothed);
     float *raw = NULL;
     size_t nv = np * (size_t)w->nlabels;
     if (wide) {
@@ -1727,8 +1720,7 @@ static int depth_core(const lf_lightfield *lf, const lf_lightfield_depth_opts *o
     w.smoothed = smoothed > 0;
     if (w.smoothed)
         lf_depth_smoothed_noise_correlation(smoothed, w.rho);
-    int wide = o->wide_window > 0 || (o->wide_window == 0 && w.smoothed);
-    w.progress.o = o, w.progress.total = (wide ? 3L : 2L) * w.nt * nl;
+    w.progress.o = o, w.progress.total = (wide_window_on(o, w.smoothed) ? 3L : 2L) * w.nt * nl;
     atomic_init(&w.progress.done, 0);
     collect_views(&w);
     w.scale = reference_colour_scale(w.ref, w.np);
@@ -1843,24 +1835,20 @@ typedef struct blur_ctx {
     float *out;
     const float *k;
     int r;
+    float *scratch; /* per thread: one view */
 } blur_ctx;
 
 /* Views [v0, v1) blurred by the separable kernel k (2 r + 1 taps, borders
  * clamped). */
 static void blur_views(void *vctx, int v0, int v1, int tid)
 {
-    (void)tid;
     blur_ctx *c = vctx;
     int w = c->lf->ns, h = c->lf->nt, r = c->r;
     size_t vn = (size_t)w * h * 3;
-    float *tmp = malloc(sizeof(float) * vn);
+    float *tmp = c->scratch + (size_t)tid * vn;
     for (int v = v0; v < v1; v++) {
         const float *src = c->lf->data + (size_t)v * vn;
         float *dst = c->out + (size_t)v * vn;
-        if (!tmp) { /* no scratch: the view unblurred rather than nothing */
-            memcpy(dst, src, sizeof(float) * vn);
-            continue;
-        }
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++)
                 for (int ch = 0; ch < 3; ch++) {
@@ -1878,7 +1866,6 @@ static void blur_views(void *vctx, int v0, int v1, int tid)
                     dst[((size_t)y * w + x) * 3 + ch] = a;
                 }
     }
-    free(tmp);
 }
 
 /* depth_core on the views blurred by a Gaussian of sigma px. */
@@ -1888,12 +1875,18 @@ static int depth_core_smoothed(const lf_lightfield *lf, const lf_lightfield_dept
     float k[2 * LF_DEPTH_SMOOTH_MAX_R + 1];
     int r = smoothing_kernel(sigma, k);
     size_t n = (size_t)lf->nu * lf->nv * lf->ns * lf->nt * 3;
+    int threads = lf_parallel_threads(o->threads > 0 ? o->threads : DEFAULT_THREADS);
     lf_lightfield b = *lf;
     b.half = NULL;
-    if (!(b.data = malloc(sizeof(float) * n)))
+    b.data = malloc(sizeof(float) * n);
+    float *scratch = malloc(sizeof(float) * (size_t)lf->ns * lf->nt * 3 * (size_t)threads);
+    if (!b.data || !scratch) {
+        free(b.data), free(scratch);
         return lf_error_set(err, LF_ERR_NOMEM, "out of memory for the smoothed views");
-    blur_ctx bc = {lf, b.data, k, r};
-    lf_parallel_for(lf->nu * lf->nv, o->threads > 0 ? o->threads : DEFAULT_THREADS, 1, blur_views, &bc);
+    }
+    blur_ctx bc = {lf, b.data, k, r, scratch};
+    lf_parallel_for(lf->nu * lf->nv, threads, 1, blur_views, &bc);
+    free(scratch);
     int rc = depth_core(&b, o, d0, d1, step, sigma, disparity, confidence, err);
     free(b.data);
     return rc;
